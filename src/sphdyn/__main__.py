@@ -1,0 +1,7 @@
+"""``python -m sphdyn`` is ``sphdyn``."""
+
+import sys
+
+from .cli import main
+
+sys.exit(main())

@@ -1,0 +1,194 @@
+"""Command line: ``sphdyn run|check|restart|plot|export|info|bench``.
+
+Each subcommand is a thin function over the Python API. Exit codes: 0 success,
+1 a failed run (guard stopped it; all output kept), 2 bad input (deck or
+arguments).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+
+def _threads(n):
+    if n:
+        import numba
+
+        numba.set_num_threads(n)
+
+
+def cmd_run(args) -> int:
+    from .deck import load_deck
+    from .simulation import Simulation
+
+    deck = load_deck(args.deck, args.set)
+    out = Path(args.out) if args.out else Path("out") / Path(args.deck).stem
+    _threads(args.threads)
+    sim = Simulation.from_deck(deck, out)
+    print(f"sphdyn: {sim.solver.p.n} particles, {deck.run.dimension}D, "
+          f"t_end = {deck.run.t_end:g} s, initial dt = {sim.solver.dt0:.3e} s -> {out}")
+    return _finish(sim.run(max_steps=args.max_steps, progress=not args.quiet and None))
+
+
+def cmd_restart(args) -> int:
+    from .simulation import Simulation
+
+    _threads(args.threads)
+    sim = Simulation.from_directory(args.dir)
+    print(f"sphdyn: restarting {args.dir} at t = {sim.solver.t:.6e} s "
+          f"(step {sim.solver.step_count})")
+    return _finish(sim.run(t_end=args.t_end, max_steps=args.max_steps,
+                           progress=not args.quiet and None))
+
+
+def _finish(summary: dict) -> int:
+    keys = ("status", "particles", "steps", "time", "wall_seconds",
+            "particle_steps_per_s", "energy_error_max_rel")
+    print(json.dumps({k: summary.get(k) for k in keys}))
+    return 0
+
+
+def cmd_check(args) -> int:
+    from .deck import load_deck
+    from .model import build_model
+
+    deck = load_deck(args.deck, args.set)
+    model = build_model(deck)
+    p = model.particles
+    print(f"{args.deck}: OK")
+    print(f"  {deck.run.dimension}D, t_end = {deck.run.t_end:g} s, {p.n} particles in "
+          f"{len(model.body_names)} bodies, {len(deck.material)} materials, "
+          f"{len(model.walls)} walls, sets {sorted(model.sets) or '-'}")
+    if args.resolved:
+        from .deck import dump_resolved
+
+        dump_resolved(deck, args.resolved)
+        print(f"  resolved deck written to {args.resolved}")
+    return 0
+
+
+def cmd_plot(args) -> int:
+    from .io import plot_history
+
+    paths = plot_history(Path(args.dir) / "history.csv", Path(args.dir) / "plots")
+    for p in paths:
+        print(p)
+    return 0
+
+
+def cmd_export(args) -> int:
+    from .io import export_csv, export_vtk
+
+    if args.format == "vtk":
+        print(export_vtk(args.dir))
+    else:
+        print(export_csv(args.dir, frame=args.frame))
+    return 0
+
+
+def cmd_info(args) -> int:
+    import h5py
+    import numba
+    import numpy
+    import scipy
+
+    from . import __version__
+
+    cache = Path(__file__).parent / "__pycache__"
+    n_cached = len(list(cache.glob("*.nbi"))) + len(list(Path(__file__).parent.glob(
+        "*/__pycache__/*.nbi")))
+    info = {
+        "sphdyn": __version__, "python": sys.version.split()[0],
+        "numpy": numpy.__version__, "numba": numba.__version__,
+        "scipy": scipy.__version__, "h5py": h5py.__version__,
+        "threads": numba.get_num_threads(), "threading_layer_default":
+        numba.config.THREADING_LAYER, "numba_cache_entries": n_cached,
+        "numba_cache_dir": str(numba.config.CACHE_DIR or "next to the package sources"),
+    }
+    for k, v in info.items():
+        print(f"{k:>24}: {v}")
+    return 0
+
+
+def cmd_bench(args) -> int:
+    from .bench import main_json
+
+    print(main_json(case=args.case, steps=args.steps, threads=args.threads,
+                    particles=args.particles))
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="sphdyn", description=__doc__.splitlines()[0])
+    sub = ap.add_subparsers(dest="command", required=True)
+
+    r = sub.add_parser("run", help="validate and run a deck")
+    r.add_argument("deck")
+    r.add_argument("--out", help="output directory (default out/<deck name>)")
+    r.add_argument("--threads", type=int, default=0, help="Numba threads (default all)")
+    r.add_argument("--set", action="append", metavar="KEY=VALUE",
+                   help="override a deck value, e.g. --set run.t_end=1e-4")
+    r.add_argument("--max-steps", type=int, help="stop after this many steps")
+    r.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    r.set_defaults(func=cmd_run)
+
+    c = sub.add_parser("check", help="validate a deck and build its model, run nothing")
+    c.add_argument("deck")
+    c.add_argument("--set", action="append", metavar="KEY=VALUE")
+    c.add_argument("--resolved", help="also write the resolved deck here")
+    c.set_defaults(func=cmd_check)
+
+    s = sub.add_parser("restart", help="continue a run from DIR/checkpoint.h5")
+    s.add_argument("dir")
+    s.add_argument("--t-end", type=float, help="new end time [s] (default the deck's)")
+    s.add_argument("--threads", type=int, default=0)
+    s.add_argument("--max-steps", type=int)
+    s.add_argument("-q", "--quiet", action="store_true")
+    s.set_defaults(func=cmd_restart)
+
+    p = sub.add_parser("plot", help="plot DIR/history.csv into DIR/plots")
+    p.add_argument("dir")
+    p.set_defaults(func=cmd_plot)
+
+    e = sub.add_parser("export", help="convert native frames (VTK series or CSV)")
+    e.add_argument("dir")
+    e.add_argument("--format", choices=("vtk", "csv"), default="vtk")
+    e.add_argument("--frame", type=int, default=-1, help="frame for CSV (default last)")
+    e.set_defaults(func=cmd_export)
+
+    i = sub.add_parser("info", help="versions, threads, Numba cache")
+    i.set_defaults(func=cmd_info)
+
+    b = sub.add_parser("bench", help="run a built-in benchmark, print one JSON line")
+    b.add_argument("case", choices=("rings2d", "block3d"))
+    b.add_argument("--steps", type=int, default=1000)
+    b.add_argument("--threads", type=int, default=0)
+    b.add_argument("--particles", type=int, help="block3d: approximate particle count")
+    b.set_defaults(func=cmd_bench)
+    return ap
+
+
+def main(argv=None) -> int:
+    from .deck import DeckError
+    from .guards import SimulationFailed
+
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except DeckError as exc:
+        print(f"sphdyn: the deck is not valid:\n{exc}", file=sys.stderr)
+        return 2
+    except (FileNotFoundError, ValueError) as exc:
+        print(f"sphdyn: {exc}", file=sys.stderr)
+        return 2
+    except SimulationFailed as exc:
+        print(f"sphdyn: {exc.diagnosis}\nAll output written so far is kept.",
+              file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

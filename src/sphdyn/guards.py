@@ -1,0 +1,94 @@
+"""Run guards: non-finite values, particles leaving the domain, time-step collapse.
+
+A failed check raises :class:`SimulationFailed` with a diagnosis naming the
+particles, where they are and which quantity went wrong; the runner then
+writes everything it has and exits non-zero.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+OK = 0
+NONFINITE = 1
+OUTSIDE = 2
+
+
+class SimulationFailed(RuntimeError):
+    """The run stopped on a guard; ``diagnosis`` is a human-readable report."""
+
+    def __init__(self, diagnosis: str):
+        super().__init__(diagnosis)
+        self.diagnosis = diagnosis
+
+
+@njit(cache=True, parallel=True)
+def _flags(x, v, a, sig, rho, lo, hi, out):
+    n = x.shape[0]
+    bad = 0
+    for i in prange(n):
+        f = OK
+        s = a[i, 0] + a[i, 1] + a[i, 2] + v[i, 0] + v[i, 1] + v[i, 2] + rho[i]
+        s += sig[i, 0, 0] + sig[i, 1, 1] + sig[i, 2, 2] + sig[i, 0, 1]
+        s += sig[i, 0, 2] + sig[i, 1, 2] + x[i, 0] + x[i, 1] + x[i, 2]
+        if not np.isfinite(s) or rho[i] <= 0.0:
+            f = NONFINITE
+        else:
+            for d in range(3):
+                if x[i, d] < lo[d] or x[i, d] > hi[d]:
+                    f = OUTSIDE
+        out[i] = f
+        if f != OK:
+            bad += 1
+    return bad
+
+
+def check_particles(p, lo, hi, t, step, work: np.ndarray) -> None:
+    """Raise :class:`SimulationFailed` if any particle is non-finite or outside.
+
+    ``work`` is an (N,) int8 scratch array (no allocation per step).
+    """
+    if _flags(p.x, p.v, p.a, p.sig, p.rho, lo, hi, work) == 0:
+        return
+    lines = [f"run stopped at t = {t:.6e} s, step {step}:"]
+    nonfinite = np.flatnonzero(work == NONFINITE)
+    outside = np.flatnonzero(work == OUTSIDE)
+    if nonfinite.size:
+        fields = {"position": p.x, "velocity": p.v, "acceleration": p.a,
+                  "stress": p.sig.reshape(p.n, 9), "density": p.rho[:, None]}
+        which = [name for name, arr in fields.items()
+                 if not np.all(np.isfinite(arr[nonfinite]))]
+        if np.any(p.rho[nonfinite] <= 0):
+            which.append("density <= 0")
+        lines.append(f"  {nonfinite.size} particle(s) with non-finite values in "
+                     f"{', '.join(which) or 'state'}; first: "
+                     + _describe(p, nonfinite[:5]))
+        lines.append("  Likely causes: time step too large (lower time.cfl), too "
+                     "stiff contact (lower wall.alpha), or a material failing to converge.")
+    if outside.size:
+        lines.append(f"  {outside.size} particle(s) left the domain box "
+                     f"[{_fmt(lo)} .. {_fmt(hi)}]; first: " + _describe(p, outside[:5]))
+        lines.append("  Enlarge [domain] (lo/hi or margin) if this motion is physical.")
+    raise SimulationFailed("\n".join(lines))
+
+
+def check_time_step(dt, dt0, ratio, t, step, k, p) -> None:
+    """Raise :class:`SimulationFailed` when ``dt < ratio * dt0`` (time-step collapse)."""
+    if dt >= ratio * dt0 and np.isfinite(dt):
+        return
+    raise SimulationFailed(
+        f"run stopped at t = {t:.6e} s, step {step}: time step collapsed to "
+        f"{dt:.3e} s (< {ratio:g} x initial {dt0:.3e} s), controlled by particle {k} "
+        f"at {_fmt(p.x[k])} with h = {p.h[k]:.3e} m, wave speed {p.c[k]:.3e} m/s, "
+        f"speed {np.linalg.norm(p.v[k]):.3e} m/s.\n"
+        "  Likely causes: a particle being crushed (h at its minimum) or accelerating "
+        "without bound; check materials and contact stiffness.")
+
+
+def _fmt(v) -> str:
+    return "(" + ", ".join(f"{c:.4g}" for c in v) + ")"
+
+
+def _describe(p, idx) -> str:
+    return "; ".join(f"#{i} (body {p.body[i]}) at {_fmt(p.x[i])}" for i in idx)

@@ -1,0 +1,35 @@
+"""Output and restart I/O: frames, ParaView files, histories, checkpoints, plots.
+
+Nothing is lost: every file is written to a temporary file in the same
+directory and atomically renamed onto its destination
+(:mod:`sphdyn.io.atomic`), so a crash never leaves a truncated file.
+
+* :mod:`~sphdyn.io.hdf5` -- native frames and bitwise-exact checkpoints,
+* :mod:`~sphdyn.io.vtk` -- ``.vtu`` particle files and ``.pvd`` time series,
+* :mod:`~sphdyn.io.fields` -- output fields computed from the state,
+* :mod:`~sphdyn.io.frames` -- numbered frames of a run directory, restart,
+  VTK/CSV export,
+* :mod:`~sphdyn.io.history` -- global time histories (CSV),
+* :mod:`~sphdyn.io.plots` -- figures of a history (Matplotlib, Agg).
+"""
+
+from .atomic import atomic_path, atomic_write_bytes, atomic_write_text
+from .fields import DERIVED_FIELDS, particle_fields
+from .frames import FrameWriter, export_csv, export_vtk, list_frames
+from .hdf5 import (read_checkpoint, read_frame, read_frame_header,
+                   write_checkpoint, write_frame)
+from .history import History, read_history_csv
+from .plots import plot_history  # imports Matplotlib only when called
+from .vtk import read_pvd, write_pvd, write_vtu
+
+
+__all__ = [
+    "atomic_path", "atomic_write_bytes", "atomic_write_text",
+    "DERIVED_FIELDS", "particle_fields",
+    "FrameWriter", "export_csv", "export_vtk", "list_frames",
+    "read_checkpoint", "read_frame", "read_frame_header",
+    "write_checkpoint", "write_frame",
+    "History", "read_history_csv",
+    "read_pvd", "write_pvd", "write_vtu",
+    "plot_history",
+]

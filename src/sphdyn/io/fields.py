@@ -1,0 +1,108 @@
+"""Output fields computed from the particle state.
+
+:func:`particle_fields` turns a :class:`~sphdyn.state.Particles` into the
+dictionary of arrays written to frames. The arrays are copies, so the state can
+keep evolving after the call. ``"position"`` is always included.
+
+Stress sign convention: ``sig`` is the Cauchy stress, tension positive. The
+output pressure is positive in compression, ``p = -tr(sig) / 3``; the von Mises
+stress is ``sqrt(3/2 s:s)`` with ``s = sig + p I`` the deviatoric stress.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from sphdyn.state import Particles
+
+__all__ = ["DERIVED_FIELDS", "particle_fields", "pressure", "von_mises"]
+
+#: Output field names (besides history variables) and what they contain.
+DERIVED_FIELDS: dict[str, str] = {
+    "position": "current position x [m], (N, 3)",
+    "velocity": "velocity v [m/s], (N, 3)",
+    "displacement": "x - x0 [m], (N, 3)",
+    "stress": "Cauchy stress [Pa], tension positive, (N, 9) row-major",
+    "pressure": "-tr(sig)/3 [Pa], positive in compression, (N,)",
+    "von_mises": "sqrt(3/2 s:s) [Pa], s deviatoric stress, (N,)",
+    "density": "current density rho [kg/m^3], (N,)",
+    "mass": "mass m [kg] (kg/m in 2D), (N,)",
+    "smoothing_length": "smoothing length h [m], (N,)",
+    "damage": "scalar damage in [0, 1], (N,)",
+    "internal_energy": "specific internal energy e [J/kg], (N,)",
+    "bc": "boundary-condition flag (int8), (N,)",
+    "body": "body index (int32), (N,)",
+    "material": "material index (int32), (N,)",
+}
+
+
+def pressure(sig: np.ndarray) -> np.ndarray:
+    """Pressure ``-tr(sig)/3`` [Pa], positive in compression, of ``(N, 3, 3)`` stresses."""
+    return -np.trace(sig, axis1=1, axis2=2) / 3.0
+
+
+def von_mises(sig: np.ndarray) -> np.ndarray:
+    """Von Mises equivalent stress ``sqrt(3/2 s:s)`` [Pa] of ``(N, 3, 3)`` stresses."""
+    mean = np.trace(sig, axis1=1, axis2=2) / 3.0
+    s = sig - mean[:, None, None] * np.eye(3)
+    return np.sqrt(1.5 * np.einsum("nij,nij->n", s, s))
+
+
+def _compute(p: "Particles", name: str) -> np.ndarray:
+    if name == "position":
+        return p.x.copy()
+    if name == "velocity":
+        return p.v.copy()
+    if name == "displacement":
+        return p.x - p.x0
+    if name == "stress":
+        return p.sig.reshape(p.n, 9).copy()
+    if name == "pressure":
+        return pressure(p.sig)
+    if name == "von_mises":
+        return von_mises(p.sig)
+    simple = {"density": "rho", "mass": "m", "smoothing_length": "h",
+              "damage": "damage", "internal_energy": "e", "bc": "bc",
+              "body": "body", "material": "mat"}
+    if name in simple:
+        return getattr(p, simple[name]).copy()
+    # History variable (checked by the caller).
+    return p.hist[:, p.hist_names.index(name)].copy()
+
+
+def particle_fields(p: "Particles", names: list[str]) -> dict[str, np.ndarray]:
+    """Compute output fields from the particle state.
+
+    Parameters
+    ----------
+    p : Particles
+        The particle state.
+    names : list of str
+        Field names from :data:`DERIVED_FIELDS` or ``p.hist_names`` (a history
+        column). Built-in names take precedence over history names.
+        Duplicates are ignored.
+
+    Returns
+    -------
+    dict of str to ndarray
+        ``"position"`` first, then the requested fields in the order given.
+        Every array is a fresh copy.
+
+    Raises
+    ------
+    ValueError
+        If a name is neither a built-in field nor a history variable; the
+        message lists the allowed names.
+    """
+    allowed = list(DERIVED_FIELDS) + [h for h in p.hist_names if h not in DERIVED_FIELDS]
+    unknown = [n for n in names if n not in allowed]
+    if unknown:
+        raise ValueError(f"unknown output field(s) {unknown}; allowed: {allowed}")
+    out: dict[str, np.ndarray] = {}
+    for name in ["position", *names]:
+        if name not in out:
+            out[name] = _compute(p, name)
+    return out

@@ -1,0 +1,41 @@
+"""Constitutive models, registered by name.
+
+Every model provides a point function and a group kernel with the common
+signature ``update(idx, L, dt, rho, sig, e, c, damage, hist, params)``
+(see :mod:`sphdyn.materials.base`). Importing this package registers the
+built-in models ``"elastic"`` and ``"j2"``.
+"""
+
+from .base import (
+    KERNEL_SIGNATURE_DOC,
+    REGISTRY,
+    MaterialModel,
+    available_models,
+    deviatoric_split,
+    energy_increment,
+    get_model,
+    jaumann_rotate,
+    register,
+    von_mises,
+)
+from .elastic import ELASTIC, elastic_point, elastic_update
+from .j2 import J2, j2_point, j2_update
+
+__all__ = [
+    "KERNEL_SIGNATURE_DOC",
+    "REGISTRY",
+    "MaterialModel",
+    "available_models",
+    "get_model",
+    "register",
+    "jaumann_rotate",
+    "deviatoric_split",
+    "von_mises",
+    "energy_increment",
+    "ELASTIC",
+    "elastic_point",
+    "elastic_update",
+    "J2",
+    "j2_point",
+    "j2_update",
+]

@@ -1,0 +1,161 @@
+"""Deck -> model: particles of every body, material groups, sets, walls, guard box.
+
+This is the only place where deck objects are turned into arrays; the solver
+below it sees arrays and scalars only.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import kernels
+from .contact.wall import STIFFNESS_BULK, STIFFNESS_MASS
+from .geometry import lattice_from_shape, select
+from .materials import get_model
+from .state import BC_FIXED, BC_VELOCITY, Particles
+
+
+@dataclass
+class MaterialGroup:
+    """Particles sharing one material: the model's group kernel runs over ``idx``."""
+
+    name: str
+    model: object  # materials.base.MaterialModel
+    params: np.ndarray
+    idx: np.ndarray  # int64 particle indices
+
+
+@dataclass
+class Wall:
+    """A rigid planar wall in array form (see :mod:`sphdyn.contact.wall`)."""
+
+    name: str
+    point: np.ndarray
+    normal: np.ndarray
+    method: int
+    alpha: float
+    friction: float
+    thickness_factor: float
+    kbulk: np.ndarray  # (N,) bulk modulus used by the bulk method [Pa]
+
+
+@dataclass
+class Model:
+    particles: Particles
+    groups: list[MaterialGroup]
+    walls: list[Wall]
+    sets: dict[str, np.ndarray]
+    body_names: list[str]
+    domain_lo: np.ndarray
+    domain_hi: np.ndarray
+    kernel_id: int
+    kernel_sigma: float
+    radius_factor: float
+    bulk_modulus: np.ndarray = field(repr=False, default=None)  # (N,) per particle
+
+
+def _material_params(mat) -> dict:
+    d = mat.model_dump()
+    d.pop("name", None)
+    d.pop("model", None)
+    return {k: v for k, v in d.items() if v is not None}
+
+
+def build_model(deck) -> Model:
+    """Create the particle model described by a validated deck."""
+    dim = deck.run.dimension
+    kid = kernels.kernel_id(deck.sph.kernel)
+    mats = {m.name: m for m in deck.material}
+    mat_index = {m.name: k for k, m in enumerate(deck.material)}
+    models = {m.name: get_model(m.model) for m in deck.material}
+    params = {name: models[name].pack(_material_params(m)) for name, m in mats.items()}
+    n_hist = max([len(models[n].history_names) for n in mats] + [0])
+
+    parts = []
+    for b, body in enumerate(deck.body):
+        x = lattice_from_shape(body.geometry.model_dump(), body.dx, dim)
+        n = x.shape[0]
+        if n == 0:
+            raise ValueError(f"body {body.name!r}: its geometry holds no particle at "
+                             f"dx = {body.dx} m; make dx smaller or the shape larger")
+        mat = mats[body.material]
+        p = Particles.allocate(n, dim, n_hist)
+        p.x[:] = x
+        p.x0[:] = x
+        p.v[:] = np.asarray(body.velocity, dtype=float)
+        vol = body.dx ** dim
+        p.vol0[:] = vol
+        p.rho[:] = mat.density
+        p.rho0[:] = mat.density
+        p.m[:] = mat.density * vol
+        p.h[:] = deck.sph.h_factor * body.dx
+        p.h0[:] = p.h
+        p.body[:] = b
+        p.mat[:] = mat_index[body.material]
+        p.c[:] = models[body.material].wave_speed(params[body.material], mat.density)
+        p.hist_names = list(models[body.material].history_names)
+        parts.append(p)
+    particles = Particles.concatenate(parts)
+    hist_names: list[str] = []
+    for name in mats:
+        for hn in models[name].history_names:
+            if hn not in hist_names:
+                hist_names.append(hn)
+    particles.hist_names = hist_names[: particles.hist.shape[1]]
+
+    groups = []
+    for name, m in mats.items():
+        idx = np.flatnonzero(particles.mat == mat_index[name]).astype(np.int64)
+        if idx.size:
+            groups.append(MaterialGroup(name, models[name], params[name], idx))
+
+    kb = np.zeros(particles.n)
+    for g in groups:
+        kb[g.idx] = g.model.bulk_modulus(g.params)
+
+    body_index = {b.name: k for k, b in enumerate(deck.body)}
+    sets: dict[str, np.ndarray] = {}
+    for s in deck.set:
+        cand = np.arange(particles.n) if s.body is None else np.flatnonzero(
+            particles.body == body_index[s.body])
+        region = None if s.region is None else s.region.model_dump()
+        sel = select(particles.x[cand], region, dim)
+        sets[s.name] = cand[sel].astype(np.int64)
+    for bnd in deck.boundary:
+        idx = sets[bnd.set]
+        if bnd.type == "fixed":
+            particles.bc[idx] = BC_FIXED
+            particles.v[idx] = 0.0
+        else:
+            particles.bc[idx] = BC_VELOCITY
+            particles.bc_v[idx] = np.asarray(bnd.velocity, dtype=float)
+            particles.v[idx] = particles.bc_v[idx]
+
+    walls = []
+    for w in deck.wall:
+        kbw = kb.copy() if w.bulk_modulus is None else np.full(particles.n, w.bulk_modulus)
+        walls.append(Wall(
+            name=w.name, point=np.asarray(w.point, float),
+            normal=np.asarray(w.normal, float) / np.linalg.norm(w.normal),
+            method=STIFFNESS_MASS if w.stiffness == "mass" else STIFFNESS_BULK,
+            alpha=w.alpha, friction=w.friction, thickness_factor=w.thickness_factor,
+            kbulk=kbw))
+
+    lo_b = particles.x.min(axis=0)
+    hi_b = particles.x.max(axis=0)
+    size = np.maximum(hi_b - lo_b, particles.h.max())
+    lo = lo_b - deck.domain.margin * size if deck.domain.lo is None else np.asarray(
+        deck.domain.lo, float)
+    hi = hi_b + deck.domain.margin * size if deck.domain.hi is None else np.asarray(
+        deck.domain.hi, float)
+    if dim == 2:
+        lo[2], hi[2] = -np.inf, np.inf
+
+    return Model(
+        particles=particles, groups=groups, walls=walls, sets=sets,
+        body_names=[b.name for b in deck.body], domain_lo=lo, domain_hi=hi,
+        kernel_id=kid, kernel_sigma=kernels.normalisation(kid, dim),
+        radius_factor=kernels.support(kid) * deck.sph.support_scale,
+        bulk_modulus=kb)

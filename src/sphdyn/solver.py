@@ -1,0 +1,207 @@
+"""The time stepper: ordered SPH passes, material update and contact per step.
+
+The solver holds the model's arrays and advances them; it writes no file.
+Order of one step (state at :math:`t^n`: :math:`\\mathbf x^n,\\ \\mathbf
+v^{n-1/2},\\ \\sigma^n,\\ \\mathbf a^n`):
+
+1. time step from the CFL condition (and contact limit);
+2. kick to :math:`\\mathbf v^{n+1/2}` with boundary conditions; energies at
+   :math:`t^n` (see :mod:`sphdyn.integrate`);
+3. drift to :math:`\\mathbf x^{n+1}` (XSPH-smoothed velocity if enabled);
+4. neighbour list update (only when the Verlet skin is exhausted);
+5. velocity gradient, density and smoothing length, material update
+   (:math:`\\sigma^{n+1}`, internal energy);
+6. stress divergence and artificial viscosity, then contact, giving
+   :math:`\\mathbf a^{n+1}`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .contact.wall import STIFFNESS_BULK, bulk_contact_time_step, wall_contact
+from .guards import check_particles, check_time_step
+from .integrate import add_heat, cfl_time_step, drift, internal_energies, kick
+from .model import Model
+from .neighbours import build_neighbours, update_neighbours
+from .sph.passes import forces, update_density_and_h, velocity_gradient, xsph_velocity
+
+
+class Solver:
+    """Advance a :class:`~sphdyn.model.Model` in time.
+
+    Parameters
+    ----------
+    model : the particle model.
+    deck : the validated deck (reads the ``sph`` and ``time`` sections).
+    """
+
+    def __init__(self, model: Model, deck):
+        self.model = model
+        p = self.p = model.particles
+        sph = deck.sph
+        self.dim = p.dim
+        self.kid = model.kernel_id
+        self.sigma = model.kernel_sigma
+        self.kscale = sph.support_scale
+        self.correct = bool(sph.correction)
+        self.alpha = sph.viscosity.alpha
+        self.beta = sph.viscosity.beta
+        self.xsph = sph.xsph
+        self.benz = sph.smoothing_length.mode == "benz"
+        self.hmin = sph.smoothing_length.min_factor
+        self.hmax = sph.smoothing_length.max_factor
+        self.cfl = deck.time.cfl
+        self.dt_max = deck.time.dt_max if deck.time.dt_max is not None else np.inf
+        self.collapse_ratio = deck.time.collapse_ratio
+        n = p.n
+        self.B = np.zeros((n, 3, 3))
+        self.dedt_av = np.zeros(n)
+        self.a_contact = np.zeros((n, 3))
+        self.vmean = np.zeros((n, 3))
+        self.vs = np.zeros((n, 3)) if self.xsph > 0 else None
+        self.wall_force = np.zeros((n, 3))
+        self.guard_work = np.zeros(n, dtype=np.int8)
+        self.wall_totals = {w.name: np.zeros(3) for w in model.walls}
+        self.wall_counts = {w.name: 0 for w in model.walls}
+        # contact stability limit of bulk-modulus springs (mass springs need none)
+        self.dt_contact = np.inf
+        for w in model.walls:
+            if w.method == STIFFNESS_BULK and n:
+                self.dt_contact = min(self.dt_contact, 0.5 * bulk_contact_time_step(
+                    p.m, p.vol0, p.rho, w.kbulk, self.dim, w.alpha))
+        r0 = model.radius_factor * float(p.h.max()) if n else 0.0
+        self.skin = sph.neighbours.skin_factor * r0
+        self.t = 0.0
+        self.step_count = 0
+        self.dt_prev = 0.0  # 0 before the first kick (half kick)
+        self.work_contact = 0.0
+        self.work_external = 0.0
+        self.nl = build_neighbours(p.x, p.h, model.radius_factor, self.skin, self.dim)
+        self.dt0, _ = self._cfl()
+        nl = self.nl
+        velocity_gradient(p.x, p.v, p.m, p.rho, p.h, nl.offsets, nl.idx, self.kid,
+                          self.sigma, self.dim, self.kscale, self.correct, p.L, self.B)
+        self._accelerations(self.dt0)
+
+    # ------------------------------------------------------------------ parts
+    def _cfl(self):
+        p = self.p
+        dt, k = cfl_time_step(p.h, p.c, p.v, p.m, min(1.0, self.kscale), self.cfl)
+        return min(dt, self.dt_max, self.dt_contact), k
+
+    def _accelerations(self, dt):
+        """Stress divergence, artificial viscosity and contact at the current state."""
+        p, nl = self.p, self.nl
+        forces(p.x, p.v, p.m, p.rho, p.h, p.c, p.sig, self.B, nl.offsets, nl.idx,
+               self.kid, self.sigma, self.dim, self.kscale, self.correct, self.alpha,
+               self.beta, p.a, self.dedt_av)
+        self.a_contact[:] = 0.0
+        for w in self.model.walls:
+            cnt = wall_contact(p.x, p.v, p.m, p.vol0, p.rho, w.kbulk, self.dim, w.point,
+                               w.normal, w.thickness_factor, w.method, w.alpha,
+                               w.friction, dt, self.a_contact, self.wall_force)
+            self.wall_counts[w.name] = int(cnt)
+            self.wall_totals[w.name] = self.wall_force.sum(axis=0)
+        p.a += self.a_contact
+
+    # ------------------------------------------------------------------- step
+    def step(self, t_stop: float | None = None) -> dict:
+        """Advance one step; returns the energy/force record at the kick time t^n.
+
+        ``t_stop`` shortens the step so that the run ends exactly there.
+        """
+        p, model = self.p, self.model
+        dt, k = self._cfl()
+        check_time_step(dt, self.dt0, self.collapse_ratio, self.t, self.step_count, k, p)
+        if t_stop is not None and self.t + dt > t_stop:
+            dt = max(t_stop - self.t, 0.0)
+        dt_kick = 0.5 * dt if self.step_count == 0 else 0.5 * (self.dt_prev + dt)
+        ke, wc, we = kick(p.v, p.a, self.a_contact, p.m, p.bc, p.bc_v, dt_kick,
+                          self.vmean)
+        self.work_contact += wc
+        self.work_external += we
+        record = self.energies(ke, dt)
+
+        nl = self.nl
+        if self.vs is not None:
+            xsph_velocity(p.x, p.v, p.m, p.rho, p.h, nl.offsets, nl.idx, self.kid,
+                          self.sigma, self.dim, self.kscale, self.xsph, self.vs)
+            drift(p.x, self.vs, dt)
+        else:
+            drift(p.x, p.v, dt)
+        self.t += dt
+        self.step_count += 1
+        self.dt_prev = dt
+
+        nl = self.nl = update_neighbours(nl, p.x, p.h, self.dim)
+        velocity_gradient(p.x, p.v, p.m, p.rho, p.h, nl.offsets, nl.idx, self.kid,
+                          self.sigma, self.dim, self.kscale, self.correct, p.L, self.B)
+        update_density_and_h(p.L, dt, self.dim, self.benz, p.h0, self.hmin, self.hmax,
+                             p.rho, p.h)
+        for g in model.groups:
+            g.model.update(g.idx, p.L, dt, p.rho, p.sig, p.e, p.c, p.damage, p.hist,
+                           g.params)
+        self._accelerations(dt)
+        add_heat(p.e, p.e_av, self.dedt_av, dt)
+        check_particles(p, model.domain_lo, model.domain_hi, self.t, self.step_count,
+                        self.guard_work)
+        return record
+
+    def energies(self, kinetic: float, dt: float) -> dict:
+        """Energy balance at the last kick (J, J/m in 2D) and the step ``dt`` [s]."""
+        ie, iav = internal_energies(self.p.m, self.p.e, self.p.e_av)
+        e_contact = -self.work_contact
+        rec = {
+            "time": self.t, "step": float(self.step_count), "dt": dt,
+            "E_kinetic": kinetic, "E_internal": ie, "E_viscous": iav,
+            "E_contact": e_contact, "W_external": self.work_external,
+            "E_total": kinetic + ie + e_contact - self.work_external,
+        }
+        for w in self.model.walls:
+            f = self.wall_totals[w.name]
+            fn = float(f @ w.normal)
+            rec[f"F_wall_{w.name}"] = fn
+            rec[f"F_wall_{w.name}_t"] = float(np.linalg.norm(f - fn * w.normal))
+            rec[f"contacts_{w.name}"] = float(self.wall_counts[w.name])
+        return rec
+
+    # ------------------------------------------------------------- checkpoint
+    def state_scalars(self) -> dict:
+        return {"t": self.t, "step": self.step_count, "dt_prev": self.dt_prev,
+                "dt0": self.dt0, "work_contact": self.work_contact,
+                "work_external": self.work_external}
+
+    def state_arrays(self) -> dict:
+        nl = self.nl
+        return {"a_contact": self.a_contact, "B": self.B, "dedt_av": self.dedt_av,
+                "nl_offsets": nl.offsets, "nl_idx": nl.idx, "nl_x_ref": nl.x_ref,
+                "nl_h_ref": nl.h_ref}
+
+    def restore(self, scalars: dict, arrays: dict, particle_arrays: dict) -> None:
+        """Continue from a checkpoint (bitwise identical continuation)."""
+        for name, arr in particle_arrays.items():
+            getattr(self.p, name)[...] = arr
+        self.t = float(scalars["t"])
+        self.step_count = int(scalars["step"])
+        self.dt_prev = float(scalars["dt_prev"])
+        self.dt0 = float(scalars["dt0"])
+        self.work_contact = float(scalars["work_contact"])
+        self.work_external = float(scalars["work_external"])
+        self.a_contact[...] = arrays["a_contact"]
+        self.B[...] = arrays["B"]
+        self.dedt_av[...] = arrays["dedt_av"]
+        self.nl.offsets = arrays["nl_offsets"].copy()
+        self.nl.idx = arrays["nl_idx"].copy()
+        self.nl.x_ref = arrays["nl_x_ref"].copy()
+        self.nl.h_ref = arrays["nl_h_ref"].copy()
+        # wall totals at the restored state (forces depend on x, v, dt only)
+        for w in self.model.walls:
+            self.wall_force[:] = 0.0
+            tmp = np.zeros_like(self.a_contact)
+            cnt = wall_contact(self.p.x, self.p.v, self.p.m, self.p.vol0, self.p.rho,
+                               w.kbulk, self.dim, w.point, w.normal, w.thickness_factor,
+                               w.method, w.alpha, w.friction, self.dt_prev or self.dt0,
+                               tmp, self.wall_force)
+            self.wall_counts[w.name] = int(cnt)
+            self.wall_totals[w.name] = self.wall_force.sum(axis=0)

@@ -1,0 +1,173 @@
+"""Whole runs through the Python API and the CLI: output, restart, guards."""
+
+import json
+import shutil
+from pathlib import Path
+
+import meshio
+import numpy as np
+import pytest
+
+from sphdyn.cli import main
+from sphdyn.deck import loads_deck
+from sphdyn.guards import SimulationFailed
+from sphdyn.io import read_checkpoint, read_frame, read_history_csv, read_pvd
+from sphdyn.simulation import Simulation
+
+SMALL = """
+[run]
+title = "small disc on a wall"
+dimension = 2
+t_end = "{t_end}"
+[[material]]
+name = "rubber"
+model = "j2"
+density = 1000.0
+E = 1e7
+nu = 0.3
+yield_stress = 2e5
+hardening_modulus = 1e6
+[[body]]
+name = "disc"
+material = "rubber"
+dx = 1e-3
+velocity = [0, -5.0, 0]
+geometry = {{ shape = "cylinder", centre = [0, 0.0062, 0], radius = 0.006 }}
+[[wall]]
+name = "floor"
+point = [0, 0, 0]
+normal = [0, 1, 0]
+[output]
+every = "0.5 ms"
+history_every = 2
+checkpoint_every = {ck}
+progress = false
+fields = ["velocity", "stress", "von_mises", "plastic_strain", "damage"]
+"""
+
+
+def _sim(tmp_path, name, t_end="3 ms", ck=0, **extra):
+    text = SMALL.format(t_end=t_end, ck=ck)
+    for key, val in extra.items():
+        text = text.replace(key, val)
+    return Simulation.from_deck(loads_deck(text), tmp_path / name)
+
+
+def test_run_writes_everything_paraview_can_read(tmp_path):
+    sim = _sim(tmp_path, "run")
+    summary = sim.run()
+    out = tmp_path / "run"
+    assert summary["status"] == "completed"
+    for name in ("deck.resolved.toml", "history.csv", "summary.json", "checkpoint.h5",
+                 "particles.pvd", "plots/energies.png", "plots/forces.png"):
+        assert (out / name).exists(), name
+    entries = read_pvd(out / "particles.pvd")
+    assert len(entries) >= 7  # t = 0, 0.5, ..., 3 ms
+    times = [t for t, _ in entries]
+    assert times[0] == 0.0 and abs(times[-1] - 3e-3) < 1e-9
+    mesh = meshio.read(out / entries[-1][1])
+    t, step, fields, _ = read_frame(sorted((out / "frames").glob("*.h5"))[-1])
+    assert np.allclose(mesh.points, fields["position"])
+    assert mesh.point_data["stress"].shape == (sim.solver.p.n, 9)
+    assert np.allclose(mesh.point_data["plastic_strain"], sim.solver.p.hist[:, 0])
+    hist = read_history_csv(out / "history.csv")
+    assert hist["F_wall_floor"].max() > 0
+    assert sim.solver.p.hist[:, 0].max() > 0  # it yielded at the contact
+
+
+def test_restart_continues_to_the_same_result(tmp_path):
+    # An interrupted run restarted from its checkpoint must reproduce the
+    # uninterrupted run bitwise (same neighbour list, same operation order).
+    full = _sim(tmp_path, "full")
+    full.run()
+    part = _sim(tmp_path, "part", ck=20)
+    part.run(max_steps=50)  # "interrupted" after 50 steps (checkpoint at 40 and exit)
+    ck_t = read_checkpoint(tmp_path / "part" / "checkpoint.h5")[1]["t"]
+    assert 0 < ck_t < 3e-3
+    assert main(["restart", str(tmp_path / "part"), "-q"]) == 0
+    _, _, f_full, _ = read_frame(sorted((tmp_path / "full/frames").glob("*.h5"))[-1])
+    _, _, f_part, _ = read_frame(sorted((tmp_path / "part/frames").glob("*.h5"))[-1])
+    for key in f_full:
+        assert np.array_equal(f_full[key], f_part[key]), key
+    h_full = read_history_csv(tmp_path / "full/history.csv")
+    h_part = read_history_csv(tmp_path / "part/history.csv")
+    assert np.array_equal(h_full["time"], h_part["time"])
+    assert np.array_equal(h_full["E_total"], h_part["E_total"])
+
+
+def test_particles_leaving_the_domain_stop_the_run_with_a_diagnosis(tmp_path):
+    sim = _sim(tmp_path, "escape", t_end="20 ms",
+               **{"[output]": "[domain]\nlo = [-0.02, -0.02, 0]\nhi = [0.02, 0.02, 0]\n"
+                  "[output]"})
+    with pytest.raises(SimulationFailed) as err:
+        sim.run()
+    msg = err.value.diagnosis
+    assert "left the domain box" in msg and "#" in msg
+    out = tmp_path / "escape"
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "failed"
+    assert (out / "history.csv").exists() and len(list((out / "frames").glob("*.h5"))) >= 2
+
+
+def test_nan_is_caught_with_the_quantity_named(tmp_path):
+    sim = _sim(tmp_path, "nan")
+    sim.solver.p.sig[3, 0, 0] = np.nan
+    with pytest.raises(SimulationFailed) as err:
+        sim.run()
+    assert "non-finite" in err.value.diagnosis and "#3" in err.value.diagnosis
+
+
+def test_time_step_collapse_is_caught(tmp_path):
+    sim = _sim(tmp_path, "collapse")
+    sim.solver.p.c[7] = 1e12  # a wave speed that makes dt collapse
+    with pytest.raises(SimulationFailed) as err:
+        sim.run()
+    assert "time step collapsed" in err.value.diagnosis
+    assert "particle 7" in err.value.diagnosis
+
+
+def test_cli_check_run_export_plot_info(tmp_path, capsys):
+    deck = tmp_path / "small.toml"
+    deck.write_text(SMALL.format(t_end="1 ms", ck=0))
+    assert main(["check", str(deck)]) == 0
+    assert "OK" in capsys.readouterr().out
+    out = tmp_path / "cli"
+    assert main(["run", str(deck), "--out", str(out), "-q", "--threads", "1"]) == 0
+    assert (out / "summary.json").exists()
+    shutil.rmtree(out / "vtk")
+    assert main(["export", str(out)]) == 0
+    assert len(list((out / "vtk").glob("*.vtu"))) >= 3
+    assert main(["export", str(out), "--format", "csv"]) == 0
+    assert main(["plot", str(out)]) == 0
+    assert main(["info"]) == 0
+    assert "numba" in capsys.readouterr().out
+
+
+def test_cli_rejects_a_bad_deck_before_running(tmp_path, capsys):
+    deck = tmp_path / "bad.toml"
+    deck.write_text(SMALL.format(t_end="1 ms", ck=0).replace("dx = 1e-3", "dx = '3 MPa'")
+                    .replace("nu = 0.3", "nu = 0.7\ncolour = 'red'"))
+    assert main(["run", str(deck), "--out", str(tmp_path / "x")]) == 2
+    err = capsys.readouterr().err
+    assert "dx" in err and "nu" in err and "colour" in err and "Fix:" in err
+    assert not (tmp_path / "x").exists()  # nothing ran, nothing written
+    assert main(["check", str(tmp_path / "missing.toml")]) == 2
+
+
+def test_cli_bench_prints_one_json_line(capsys):
+    assert main(["bench", "block3d", "--particles", "1000", "--steps", "5"]) == 0
+    line = capsys.readouterr().out.strip().splitlines()[-1]
+    rec = json.loads(line)
+    for key in ("case", "particles", "steps", "threads", "seconds", "compile_seconds",
+                "particle_steps_per_s"):
+        assert key in rec
+    assert rec["steps"] == 5 and rec["particles"] == 1000
+
+
+EXAMPLES = sorted(Path(__file__).parent.parent.glob("examples/*.toml"))
+
+
+@pytest.mark.parametrize("deck", EXAMPLES, ids=[d.stem for d in EXAMPLES])
+def test_every_example_deck_runs_two_steps(deck, tmp_path):
+    assert main(["run", str(deck), "--out", str(tmp_path / deck.stem), "--max-steps",
+                 "2", "-q"]) == 0

@@ -1,0 +1,269 @@
+"""Whole-solver verification against analytical results and conservation laws.
+
+Every case is a small deck run through the same code path as ``sphdyn run``.
+"""
+
+import numpy as np
+import pytest
+
+from sphdyn.deck import loads_deck
+from sphdyn.model import build_model
+from sphdyn.solver import Solver
+
+ELASTIC = """
+[[material]]
+name = "m"
+model = "elastic"
+density = {rho}
+E = {E}
+nu = {nu}
+"""
+
+
+def _solver(text):
+    deck = loads_deck(text)
+    return Solver(build_model(deck), deck), deck
+
+
+def _run_until(solver, t_end, probe=None):
+    out = []
+    while solver.t < t_end:
+        rec = solver.step()
+        if probe is not None:
+            out.append((solver.t, probe(solver)))
+    return out
+
+
+# ----------------------------------------------------------------- wave speed
+def _column_deck(dim, dx, length, width, v0=1.0):
+    zhi = width if dim == 3 else 0.0
+    return f"""
+[run]
+dimension = {dim}
+t_end = 1.0
+[sph.viscosity]
+alpha = 0.5
+beta = 0.0
+[domain]
+margin = 0.5
+{ELASTIC.format(rho=2400.0, E=30e9, nu=0.25)}
+[[body]]
+name = "col"
+material = "m"
+dx = {dx}
+geometry = {{ shape = "box", lo = [0, 0, 0], hi = [{length}, {width}, {zhi}] }}
+[[set]]
+name = "piston"
+region = {{ shape = "box", lo = [-1, -1, -1], hi = [{1.01 * dx}, 1, 1] }}
+[[boundary]]
+set = "piston"
+type = "velocity"
+velocity = [{v0}, 0, 0]
+"""
+
+
+def _front_arrival(solver, deck_dx, positions, v0, t_end):
+    """Times at which the particle velocity on the centre line reaches v0/2."""
+    p = solver.p
+    x0 = p.x0
+    yc = 0.5 * (x0[:, 1].min() + x0[:, 1].max())
+    zc = 0.5 * (x0[:, 2].min() + x0[:, 2].max())
+    probes = [np.argmin((x0[:, 0] - xp) ** 2 + (x0[:, 1] - yc) ** 2 + (x0[:, 2] - zc) ** 2)
+              for xp in positions]
+    hist = _run_until(solver, t_end, lambda s: s.p.v[probes, 0].copy())
+    t = np.array([h[0] for h in hist])
+    v = np.array([h[1] for h in hist])
+    arrivals = []
+    for k in range(len(probes)):
+        i = np.flatnonzero(v[:, k] >= 0.5 * v0)[0]
+        # linear interpolation of the half-amplitude crossing
+        f = (0.5 * v0 - v[i - 1, k]) / (v[i, k] - v[i - 1, k])
+        arrivals.append(t[i - 1] + f * (t[i] - t[i - 1]))
+    return np.array([x0[k, 0] for k in probes]), np.array(arrivals)
+
+
+def _wave_speed(dim, dx, width, sph_options):
+    text = _column_deck(dim, dx, 0.2, width).replace(
+        "[sph.viscosity]", "[sph]\n" + sph_options + "\n[sph.viscosity]")
+    s, _ = _solver(text)
+    xs, ts = _front_arrival(s, dx, [0.04, 0.1], 1.0, 0.11 / CP)
+    return (xs[1] - xs[0]) / (ts[1] - ts[0])
+
+
+E_COL, NU_COL, RHO_COL = 30e9, 0.25, 2400.0
+_K = E_COL / (3 * (1 - 2 * NU_COL))
+_G = E_COL / (2 * (1 + NU_COL))
+CP = np.sqrt((_K + 4 * _G / 3) / RHO_COL)
+
+
+@pytest.mark.parametrize("sph_options", ["h_factor = 1.5", "correction = true"])
+def test_p_wave_speed_in_laterally_confined_column(sph_options):
+    # A piston drives a step wave into a wide plane-strain block; on the
+    # centre line the material is in uniaxial strain (laterally confined), so
+    # the front (half amplitude) travels at c_P = sqrt((K + 4G/3)/rho).
+    # Tolerance 2 % (issue). Measured: 0.2 % with h = 1.5 dx, 0.6 % with the
+    # Randles-Libersky correction. (Uncorrected SPH with h = 1.2 dx is about
+    # 2 % slow in 2D and 3 % in 3D: the lattice sum of the kernel gradient
+    # misses I by 1-2 %, which softens the discrete operator; docs/theory.md.)
+    c = _wave_speed(2, 2e-3, 0.2, sph_options)
+    assert abs(c / CP - 1) < 0.02, (c, CP)
+
+
+@pytest.mark.slow
+def test_2d_and_3d_agree_on_plane_strain_wave():
+    # The same confined-column problem in 3D (wide in y and z: uniaxial
+    # strain on the centre line, the plane-strain state of the 2D model)
+    # gives the 2D wave speed: both within 2 % of c_P and of each other
+    # (measured 0.6 % and 1.0 % from c_P, 0.4 % apart).
+    c2 = _wave_speed(2, 5e-3, 0.2, "correction = true")
+    c3 = _wave_speed(3, 5e-3, 0.2, "correction = true")
+    assert abs(c2 / CP - 1) < 0.02 and abs(c3 / CP - 1) < 0.02, (c2, c3, CP)
+    assert abs(c3 / c2 - 1) < 0.02, (c2, c3)
+
+
+# -------------------------------------------------------- bounce off the wall
+def _disc_on_wall(stiffness="mass", alpha=0.1, vel=5.0, friction=0.0, vx=0.0):
+    return f"""
+[run]
+dimension = 2
+t_end = 1.0
+[sph.viscosity]
+alpha = 0.3
+beta = 0.0
+[domain]
+margin = 10.0
+{ELASTIC.format(rho=1000.0, E=1e7, nu=0.3)}
+[[body]]
+name = "disc"
+material = "m"
+dx = 1e-3
+velocity = [{vx}, {-vel}, 0]
+geometry = {{ shape = "cylinder", centre = [0, 0.0106, 0], radius = 0.01, length = 1 }}
+[[wall]]
+name = "floor"
+point = [0, 0, 0]
+normal = [0, 1, 0]
+stiffness = "{stiffness}"
+alpha = {alpha}
+friction = {friction}
+"""
+
+
+@pytest.mark.parametrize("stiffness,alpha", [("mass", 0.1), ("bulk", 0.5)])
+def test_elastic_disc_bounces_with_energy_conserved(stiffness, alpha):
+    # Total energy (kinetic + internal incl. viscous heat + contact) is
+    # conserved by the scheme to O(dt^2); tolerance 2 % of the initial kinetic
+    # energy over the whole impact. The rebound speed of the centre of mass
+    # is at least 80 % of the impact speed (energy lost to elastic vibration
+    # of the disc and to artificial viscosity only) and at most 100.5 %.
+    # Measured: drift 0.55 % (mass) / 0.39 % (bulk), rebound 95 % / 96 %.
+    s, _ = _solver(_disc_on_wall(stiffness, alpha))
+    m = s.p.m
+    vel0 = 5.0
+    records = []
+    t_end = 0.003  # contact lasts from 0.12 to 0.76 ms
+    while s.t < t_end:
+        records.append(s.step())
+    e = np.array([r["E_total"] for r in records])
+    ke0 = records[0]["E_kinetic"]
+    assert np.abs(e - e[0]).max() < 0.02 * ke0
+    vcm = (m[:, None] * s.p.v).sum(axis=0) / m.sum()
+    assert vcm[1] > 0.8 * vel0 and vcm[1] < 1.005 * vel0, vcm
+    assert max(r["F_wall_floor"] for r in records) > 0
+    assert records[-1]["contacts_floor"] == 0  # it has left the wall
+
+
+def test_friction_slows_sliding_but_not_without_it():
+    # Oblique impact: Coulomb friction removes tangential momentum, frictionless
+    # contact keeps it (to round-off: normal forces have no x component).
+    vt = []
+    for mu in (0.0, 0.5):
+        s, _ = _solver(_disc_on_wall(friction=mu, vx=3.0))
+        while s.t < 0.006:
+            s.step()
+        vt.append((s.p.m * s.p.v[:, 0]).sum() / s.p.m.sum())
+    assert abs(vt[0] - 3.0) < 1e-9
+    assert vt[1] < 2.9
+
+
+# ------------------------------------------------------ free two-body impact
+def test_momentum_conserved_in_free_collision():
+    # Two discs of different size and speed collide with nothing else in the
+    # model: total linear momentum is conserved to round-off (antisymmetric
+    # pair forces), relative tolerance 1e-12 of sum m |v|.
+    text = f"""
+[run]
+dimension = 2
+t_end = 1.0
+{ELASTIC.format(rho=1000.0, E=1e7, nu=0.3)}
+[[body]]
+name = "a"
+material = "m"
+dx = 1e-3
+velocity = [8.0, 1.0, 0]
+geometry = {{ shape = "cylinder", centre = [-0.0115, 0.002, 0], radius = 0.01, length = 1 }}
+[[body]]
+name = "b"
+material = "m"
+dx = 1e-3
+velocity = [-4.0, 0, 0]
+geometry = {{ shape = "ring", centre = [0.0085, 0, 0], inner_radius = 0.003, outer_radius = 0.007, length = 1 }}
+"""
+    s, _ = _solver(text)
+    p0 = (s.p.m[:, None] * s.p.v).sum(axis=0)
+    scale = (s.p.m * np.linalg.norm(s.p.v, axis=1)).sum()
+    body_a = s.p.body == 0
+    pa0 = (s.p.m[body_a, None] * s.p.v[body_a]).sum(axis=0)
+    while s.t < 0.002:
+        s.step()
+    p1 = (s.p.m[:, None] * s.p.v).sum(axis=0)
+    assert np.abs(p1 - p0).max() < 1e-12 * scale
+    pa1 = (s.p.m[body_a, None] * s.p.v[body_a]).sum(axis=0)
+    assert abs(pa1[0] - pa0[0]) > 0.1 * abs(pa0[0])  # they did collide
+
+
+# --------------------------------------------- thesis 3.1: two passing boxes
+def _boxes(gap_in_dx, dx=0.5e-3):
+    h = 1.2 * dx
+    gap = gap_in_dx * dx
+    top = 10e-3
+    return f"""
+[run]
+dimension = 2
+t_end = 1.0
+[sph]
+h_factor = 1.2
+[sph.viscosity]
+alpha = 1.0
+beta = 2.0
+{ELASTIC.format(rho=7850.0, E=200e9, nu=0.3)}
+[[body]]
+name = "lower"
+material = "m"
+dx = {dx}
+velocity = [300.0, 0, 0]
+geometry = {{ shape = "box", lo = [0, 0, 0], hi = [10e-3, 10e-3, 0] }}
+[[body]]
+name = "upper"
+material = "m"
+dx = {dx}
+velocity = [-300.0, 0, 0]
+geometry = {{ shape = "box", lo = [5e-3, {top - dx + gap}, 0], hi = [15e-3, {2 * top - dx + gap}, 0] }}
+"""
+
+
+@pytest.mark.parametrize("gap_in_dx,interacts", [(2.4, False), (1.0, True)])
+def test_thesis_two_boxes(gap_in_dx, interacts):
+    # Thesis sec. 3.1: with h = 1.2 dx and support 2h = 2.4 dx, boxes whose
+    # facing particle rows are 2.4 dx apart never see each other (lateral
+    # momentum exchanged exactly zero), at 1.0 dx apart they interact.
+    s, _ = _solver(_boxes(gap_in_dx))
+    lower = s.p.body == 0
+    while s.t < 12e-6:
+        s.step()
+    py = (s.p.m[lower] * s.p.v[lower, 1]).sum()
+    scale = (s.p.m[lower] * 300.0).sum()
+    if interacts:
+        assert abs(py) > 1e-6 * scale
+    else:
+        assert py == 0.0
