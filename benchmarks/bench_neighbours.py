@@ -4,7 +4,8 @@ Prints the wall time of ``build_neighbours`` for
 * 100k and 1M uniformly random 3D particles (h chosen so that a particle
   has ~ 60 neighbours), and
 * a 1M-particle cubic lattice with spacing dx, h = 1.2 dx,
-  radius_factor = 2, skin = 0.1 * 2.4 dx (~ 76 neighbours per particle).
+  radius_factor = 2, skin = 0.1 * 2.4 dx (~ 78 neighbours per particle),
+  natural and shuffled index order, and its rebuild via update_neighbours.
 
 Usage: ``python benchmarks/bench_neighbours.py [--threads T] [--repeat R]``.
 The first (untimed) call compiles or loads the Numba cache.
@@ -19,7 +20,7 @@ import numba
 import numpy as np
 
 from sphdyn.neighbours import (build_neighbours, max_neighbours,
-                               mean_neighbours)
+                               mean_neighbours, update_neighbours)
 
 
 def _time_build(label, x, h, rf, skin, repeat):
@@ -35,7 +36,8 @@ def _time_build(label, x, h, rf, skin, repeat):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--threads", type=int, default=numba.config.NUMBA_NUM_THREADS)
+    ap.add_argument("--threads", type=int,
+                    default=numba.config.NUMBA_NUM_THREADS)
     ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args()
     numba.set_num_threads(args.threads)
@@ -63,6 +65,16 @@ def main():
     perm = rng.permutation(x.shape[0])
     _time_build("lattice 100^3, shuffled indices", x[perm], h, rf,
                 0.1 * 2.4 * dx, args.repeat)
+    # rebuild through update_neighbours (storage of idx reused)
+    nl = build_neighbours(x, h, rf, 0.24 * dx, 3)
+    best = np.inf
+    for k in range(args.repeat):
+        x1 = x + (0.2 * (k + 1)) * dx  # beyond the skin: forces a rebuild
+        t0 = time.perf_counter()
+        update_neighbours(nl, x1, h, 3)
+        best = min(best, time.perf_counter() - t0)
+    print(f"{'lattice 100^3, rebuild via update':<34s} N={x.shape[0]:>8d}  "
+          f"build {best:7.3f} s  (n_builds {nl.n_builds})")
 
 
 if __name__ == "__main__":

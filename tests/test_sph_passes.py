@@ -6,8 +6,8 @@ import pytest
 from sphdyn import kernels
 from sphdyn.geometry import box_lattice
 from sphdyn.neighbours import build_neighbours
-from sphdyn.sph.passes import (forces, update_density_and_h, velocity_gradient,
-                               xsph_velocity)
+from sphdyn.sph.passes import (forces, pair_gradients, particle_volumes, scaled_stress,
+                               update_density_and_h, velocity_gradient, xsph_velocity)
 
 
 def _cloud(dim, n_side=12, dx=0.01, hfac=1.3, kernel="cubic_spline", jitter=0.0,
@@ -38,13 +38,23 @@ def _interior(c, layers):
     return np.flatnonzero(ok)
 
 
+def _pair_factors(c):
+    nl = c["nl"]
+    F = np.zeros(nl.idx.size)
+    pair_gradients(c["x"], c["h"], nl.offsets, nl.idx, c["kid"], c["sigma"], c["dim"],
+                   1.0, F)
+    return F
+
+
 def _grad(c, v, correct):
     n = c["x"].shape[0]
     L = np.zeros((n, 3, 3))
     B = np.zeros((n, 3, 3))
+    vol = np.zeros(n)
+    particle_volumes(c["m"], c["rho"], vol)
     nl = c["nl"]
-    velocity_gradient(c["x"], v, c["m"], c["rho"], c["h"], nl.offsets, nl.idx, c["kid"],
-                      c["sigma"], c["dim"], 1.0, correct, L, B)
+    velocity_gradient(c["x"], v, vol, _pair_factors(c), nl.offsets, nl.idx, c["dim"],
+                      correct, L, B)
     return L, B
 
 
@@ -105,8 +115,10 @@ def _forces(c, sig, v=None, correct=False, alpha=0.0, beta=0.0, cs=1000.0):
     a = np.zeros((n, 3))
     dedt = np.zeros(n)
     nl = c["nl"]
-    forces(c["x"], v, c["m"], c["rho"], c["h"], np.full(n, cs), sig, B, nl.offsets,
-           nl.idx, c["kid"], c["sigma"], c["dim"], 1.0, correct, alpha, beta, a, dedt)
+    S = np.zeros((n, 3, 3))
+    scaled_stress(sig, c["rho"], S)
+    forces(c["x"], v, c["m"], c["rho"], c["h"], np.full(n, cs), S, B, _pair_factors(c),
+           nl.offsets, nl.idx, c["dim"], 1.0, correct, alpha, beta, a, dedt)
     return a, dedt
 
 

@@ -55,14 +55,19 @@ Algorithm
    order so that the candidate loop reads contiguous memory, and cells along
    x are contiguous so each (y, z) row of the stencil is one index range.
 5. Rows, two passes in ``prange`` over particles visited in cell order
-   (cache locality): (a) count the neighbours of ``i``; prefix sum ->
-   ``offsets``; (b) fill row ``i`` and sort it in place (shell sort, no
-   allocation). Particle ``i`` scans the grid cells within ``k_i`` cells of
-   its own cell, where ``k_i = 1`` for grid particles and
+   (cache locality). Particle ``i`` scans the grid cells within ``k_i``
+   cells of its own cell (``k_i = 1`` for grid particles,
    ``k_i = ceil(r_i / cs)`` with ``r_i = rf*0.5*(h_i + h_cut) + skin`` for
-   big particles, and then tests every big particle directly. Every pair is
-   therefore examined from both ends, each row is written only by its own
-   iteration (gather form, race free).
+   big particles), then tests every big particle directly.
+   (a) Count: branch-free, vectorised candidate loop -> ``counts``; prefix
+   sum -> ``offsets``. (b) Fill: candidates in blocks of 64 give a hit
+   bit mask (vectorised), set bits are visited with count-trailing-zeros and
+   the hits collected in a per-chunk scratch buffer, then stored sorted into
+   ``idx[offsets[i]:offsets[i+1]]`` (rank sort for rows <= 128 entries,
+   heap sort above). Every pair is examined from both ends; each row is
+   written only by its own iteration (gather form, race free). A row whose
+   length differed between the passes (impossible: identical expressions)
+   would raise ``RuntimeError`` rather than write out of bounds.
 
 Cost: ``O(N * (3^dim * n_per_cell + n_big))`` per build; memory ``O(N +
 n_cells + nnz)``.
@@ -78,9 +83,10 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
-from numba import njit, prange
+from llvmlite import ir
+from numba import njit, prange, types
+from numba.extending import intrinsic
 
 __all__ = [
     "NeighbourList",
@@ -97,14 +103,14 @@ __all__ = [
 # guarantees |c_i - c_j| <= k along each axis despite rounding in
 # floor((x - lo) / cs) for up to ~1e9 cells per axis.
 _MARGIN = 1e-6
-import os
-_CELLS_PER_RADIUS = int(os.environ.get('NB_C', '1'))
 # At most this many large-h particles are kept out of the grid.
 _BIG_MAX = 64
 # ... and only if it shrinks the grid pair radius by at least this factor.
 _BIG_RADIUS_RATIO = 1.5
-# Rows up to this length are sorted by rank sort, longer ones by quicksort.
+# Rows up to this length are sorted by rank sort, longer ones by heap sort.
 _RANK_SORT_MAX = 128
+# Spare capacity of a reallocated idx buffer (rebuilds reuse the storage).
+_IDX_HEADROOM = 0.1
 # Particles per prange chunk of the fill pass (one scratch buffer per chunk).
 _FILL_CHUNK = 1024
 
@@ -138,9 +144,6 @@ class NeighbourList:
     n_big : int
         Number of large-h particles kept out of the grid (diagnostic).
     """
-
-    __slots__ = ("offsets", "idx", "x_ref", "h_ref", "skin", "radius_factor",
-                 "dim", "active_ref", "n_builds", "cell_size", "n_big")
 
     def __init__(self, offsets, idx, x_ref, h_ref, skin, radius_factor, dim,
                  active_ref=None, n_builds=1, cell_size=0.0, n_big=0):
@@ -266,7 +269,7 @@ def _stencil(i, x, h, dim, half_rf, skin, r_grid, lo, inv_cs, nc, h_cut):
     """
     nx, ny, nz = nc[0], nc[1], nc[2]
     r_i = half_rf * (h[i] + h_cut) + skin
-    k = _CELLS_PER_RADIUS
+    k = 1
     if r_i > r_grid:
         k = max(1, int(math.ceil(r_i * (1.0 + 2.0 * _MARGIN) * inv_cs)))
     cx = _cell_coord(x[i, 0], lo[0], inv_cs, nx)
@@ -330,13 +333,28 @@ def _count_row(i, s_self, x, h, dim, half_rf, skin, r_grid, lo, inv_cs, nc,
     return n
 
 
+@intrinsic
+def _cttz(typingctx, v):
+    """Number of trailing zero bits of a nonzero uint64 (LLVM ``cttz``)."""
+    sig = types.uint64(types.uint64)
+
+    def codegen(context, builder, signature, args):
+        return builder.cttz(args[0], ir.Constant(ir.IntType(1), 1))
+
+    return sig, codegen
+
+
 @njit(cache=True)
 def _collect_row(i, s_self, buf, x, h, dim, half_rf, skin, r_grid, lo,
                  inv_cs, nc, cell_start, order, xs, ys, zs, hs, h_cut, big):
-    """Write the neighbours of ``i`` (unsorted) to ``buf``; return their number.
+    """Write the neighbours of ``i`` (unsorted) to ``buf``; return how many.
 
-    Branch-free: every candidate is stored at ``buf[n]`` and ``n`` advances
-    only on a hit, so ``buf`` needs one slot more than the row length.
+    Entries beyond ``buf.shape[0]`` are counted but not written.
+
+    Candidates are tested in blocks of 64: a branch-free (vectorisable) loop
+    sets bit ``k`` of a 64-bit mask for a hit at ``s = b0 + k``, then only
+    the set bits are visited (count-trailing-zeros), so the scalar part costs
+    O(hits) instead of O(candidates).
     """
     xi0 = x[i, 0]
     xi1 = x[i, 1]
@@ -346,26 +364,38 @@ def _collect_row(i, s_self, buf, x, h, dim, half_rf, skin, r_grid, lo,
     x0, x1, y0, y1, z0, z1 = _stencil(i, x, h, dim, half_rf, skin, r_grid,
                                       lo, inv_cs, nc, h_cut)
     n = 0
+    nbuf = buf.shape[0]
+    one = np.uint64(1)
     for zc in range(z0, z1 + 1):
         for yc in range(y0, y1 + 1):
             base = nx * (yc + ny * zc)
             s0 = cell_start[base + x0]
             s1 = cell_start[base + x1 + 1]
-            if dim == 3:
-                for s in range(s0, s1):
-                    d0 = xi0 - xs[s]
-                    d1 = xi1 - ys[s]
-                    d2 = xi2 - zs[s]
-                    r = half_rf * (hi + hs[s]) + skin
-                    buf[n] = order[s]
-                    n += (d0 * d0 + d1 * d1 + d2 * d2 < r * r) & (s != s_self)
-            else:
-                for s in range(s0, s1):
-                    d0 = xi0 - xs[s]
-                    d1 = xi1 - ys[s]
-                    r = half_rf * (hi + hs[s]) + skin
-                    buf[n] = order[s]
-                    n += (d0 * d0 + d1 * d1 < r * r) & (s != s_self)
+            for b0 in range(s0, s1, 64):
+                b1 = min(b0 + 64, s1)
+                m = np.uint64(0)
+                if dim == 3:
+                    for s in range(b0, b1):
+                        d0 = xi0 - xs[s]
+                        d1 = xi1 - ys[s]
+                        d2 = xi2 - zs[s]
+                        r = half_rf * (hi + hs[s]) + skin
+                        hit = d0 * d0 + d1 * d1 + d2 * d2 < r * r
+                        m |= np.uint64(hit) << np.uint64(s - b0)
+                else:
+                    for s in range(b0, b1):
+                        d0 = xi0 - xs[s]
+                        d1 = xi1 - ys[s]
+                        r = half_rf * (hi + hs[s]) + skin
+                        hit = d0 * d0 + d1 * d1 < r * r
+                        m |= np.uint64(hit) << np.uint64(s - b0)
+                while m != 0:
+                    s = b0 + np.int64(_cttz(m))
+                    if s != s_self:
+                        if n < nbuf:
+                            buf[n] = order[s]
+                        n += 1
+                    m &= m - one
     for b in range(big.shape[0]):
         j = big[b]
         d0 = xi0 - x[j, 0]
@@ -376,7 +406,8 @@ def _collect_row(i, s_self, buf, x, h, dim, half_rf, skin, r_grid, lo,
             d2 = d2 + dz * dz
         r = half_rf * (hi + h[j]) + skin
         if d2 < r * r and j != i:
-            buf[n] = j
+            if n < nbuf:
+                buf[n] = j
             n += 1
     return n
 
@@ -509,6 +540,18 @@ def _max_disp_dh(x, x_ref, h, h_ref, active, use_active, dim):
     return md2, mdh
 
 
+@njit(cache=True)
+def _mask_changed(active, active_ref):
+    """True if ``active != 0`` differs from the bool mask ``active_ref``."""
+    for i in range(active.shape[0]):
+        if (active[i] != 0) != active_ref[i]:
+            return True
+    return False
+
+
+_NO_MASK = np.empty(0, dtype=np.bool_)
+
+
 # ---------------------------------------------------------------------------
 # Python drivers
 # ---------------------------------------------------------------------------
@@ -562,7 +605,7 @@ def _grid_setup(xa, ha, rf, skin, dim):
     ext = np.zeros(3)
     lo[:dim] = xa[:, :dim].min(axis=0)
     ext[:dim] = xa[:, :dim].max(axis=0) - lo[:dim]
-    cs = r_grid * (1.0 + _MARGIN) / _CELLS_PER_RADIUS
+    cs = r_grid * (1.0 + _MARGIN)
     if not cs > 0.0:  # all h == 0 and skin == 0 among grid particles
         cs = float(ext.max()) if ext.max() > 0.0 else 1.0
     cap = 4.0 * n_grid + 64.0
@@ -577,21 +620,52 @@ def _grid_setup(xa, ha, rf, skin, dim):
     return cs, lo, nc, h_cut, r_grid, big_mask
 
 
-def _build_csr(x, h, act, rf, skin, dim):
-    """Return ``(offsets, idx, cell_size, n_big)`` for validated inputs."""
+def _idx_storage(idx):
+    """Writable int32 buffer whose leading part is ``idx`` (its base array if
+    ``idx`` is a leading view of one, else ``idx`` itself), or None."""
+    if not (isinstance(idx, np.ndarray) and idx.dtype == np.int32
+            and idx.ndim == 1 and idx.flags.c_contiguous
+            and idx.flags.writeable):
+        return None
+    b = idx.base
+    if (isinstance(b, np.ndarray) and b.dtype == np.int32 and b.ndim == 1
+            and b.flags.c_contiguous and b.flags.writeable
+            and b.ctypes.data == idx.ctypes.data):
+        return b
+    return idx
+
+
+def _build_csr(x, h, act, rf, skin, dim, offsets_buf=None, idx_buf=None):
+    """Return ``(offsets, idx, idx_buf, cell_size, n_big)`` for validated
+    inputs.
+
+    ``offsets_buf`` ((N + 1,) int64) and ``idx_buf`` (int32) are reused if
+    given and large enough; ``idx`` is then a leading view of ``idx_buf``.
+    A new ``idx_buf`` gets ``_IDX_HEADROOM`` spare capacity when it replaces
+    a too small one.
+    """
     n = x.shape[0]
     act_ids = (np.arange(n, dtype=np.int64) if act is None
                else np.flatnonzero(act).astype(np.int64))
     n_act = act_ids.shape[0]
-    offsets = np.zeros(n + 1, dtype=np.int64)
+    if n_act > 0:  # validate before touching the buffers of the old list
+        xa = x[act_ids]
+        ha = h[act_ids]
+        if not np.all(np.isfinite(xa[:, :dim])):
+            raise ValueError("non-finite position of an active particle")
+        if not np.all(np.isfinite(ha)) or ha.min() < 0.0:
+            raise ValueError("h of active particles must be finite and >= 0")
+    if (isinstance(offsets_buf, np.ndarray) and offsets_buf.shape == (n + 1,)
+            and offsets_buf.dtype == np.int64 and offsets_buf.flags.writeable
+            and offsets_buf.flags.c_contiguous):
+        offsets = offsets_buf
+        offsets[:] = 0
+    else:
+        offsets = np.zeros(n + 1, dtype=np.int64)
     if n_act == 0:
-        return offsets, np.empty(0, dtype=np.int32), 0.0, 0
-    xa = x[act_ids]
-    ha = h[act_ids]
-    if not np.all(np.isfinite(xa[:, :dim])):
-        raise ValueError("non-finite position of an active particle")
-    if not np.all(np.isfinite(ha)) or ha.min() < 0.0:
-        raise ValueError("h of active particles must be finite and >= 0")
+        if idx_buf is None:
+            idx_buf = np.empty(0, dtype=np.int32)
+        return offsets, idx_buf[:0], idx_buf, 0.0, 0
     cs, lo, nc, h_cut, r_grid, big_mask = _grid_setup(xa, ha, rf, skin, dim)
     if big_mask is None:
         grid_ids = act_ids
@@ -608,12 +682,17 @@ def _build_csr(x, h, act, rf, skin, dim):
     _count_rows(visit, n_grid, offsets, *args)
     max_row = int(offsets.max())
     np.cumsum(offsets, out=offsets)
-    idx = np.empty(int(offsets[-1]), dtype=np.int32)
+    nnz = int(offsets[-1])
+    if idx_buf is None:
+        idx_buf = np.empty(nnz, dtype=np.int32)
+    elif idx_buf.shape[0] < nnz:
+        idx_buf = np.empty(int(nnz * (1.0 + _IDX_HEADROOM)), dtype=np.int32)
+    idx = idx_buf[:nnz]
     bad = _fill_rows(visit, n_grid, offsets, idx, max_row, *args)
     if bad:
         raise RuntimeError(f"neighbour search: {bad} rows changed length "
                            "between count and fill passes")
-    return offsets, idx, cs, big.shape[0]
+    return offsets, idx, idx_buf, cs, big.shape[0]
 
 
 def build_neighbours(x, h, radius_factor, skin, dim, active=None):
@@ -648,8 +727,8 @@ def build_neighbours(x, h, radius_factor, skin, dim, active=None):
     exactly the radius are excluded (strict ``<`` on squared distances).
     """
     x, h, act = _check_inputs(x, h, radius_factor, skin, dim, active)
-    offsets, idx, cs, n_big = _build_csr(x, h, act, float(radius_factor),
-                                         float(skin), dim)
+    offsets, idx, idx_buf, cs, n_big = _build_csr(
+        x, h, act, float(radius_factor), float(skin), dim)
     return NeighbourList(offsets, idx, x.copy(), h.copy(), skin,
                          radius_factor, dim,
                          None if act is None else act.copy(), 1, cs, n_big)
@@ -672,7 +751,7 @@ def max_displacement(nl, x, h):
         the build. NaN gives +inf. Deterministic (max reduction).
     """
     use_active = nl.active_ref is not None
-    act = nl.active_ref if use_active else np.empty(0, dtype=np.bool_)
+    act = nl.active_ref if use_active else _NO_MASK
     d2, dh = _max_disp_dh(x, nl.x_ref, h, nl.h_ref, act, use_active, nl.dim)
     return math.sqrt(d2), dh
 
@@ -693,9 +772,13 @@ def needs_rebuild(nl, x, h):
     (h_ref_i + h_ref_j) + 2 d + rf * e <= ... + skin`` whenever ``2 d + rf e
     <= skin``: the pair satisfied the build criterion and is in the list.
     (Shrinking ``h`` only shrinks the current radius, so only the increase
-    counts.) The list may contain extra pairs beyond the current radius;
-    kernels must still test the distance. Changes of the active set are not
-    seen here; ``update_neighbours`` handles them.
+    counts.) The argument is exact in real arithmetic; floating-point
+    evaluation of the distances can only matter for pairs within a few ulps
+    of the radius. The list may contain extra pairs beyond the current
+    radius; kernels must still test the distance. Changes of the active set
+    are not seen here; ``update_neighbours`` handles them. Inactive
+    particles (at the build) are ignored in the maxima, so eroded particles
+    flying away do not trigger rebuilds.
 
     Parameters
     ----------
@@ -721,8 +804,12 @@ def update_neighbours(nl, x, h, dim, active=None):
     A rebuild happens when ``needs_rebuild(nl, x, h)``, or when the number of
     particles, ``dim`` or the active mask differ from those of the last build
     (an activated particle would otherwise be missing, a deactivated one
-    would remain). On rebuild the arrays of ``nl`` are replaced, ``x_ref``
-    and ``h_ref`` are refreshed and ``n_builds`` is incremented.
+    would remain). On rebuild ``offsets``, ``x_ref``, ``h_ref`` and the
+    storage of ``idx`` are overwritten in place when their size allows (no
+    allocation of the large arrays, lower peak memory; ``idx`` becomes a
+    view of a buffer with up to 10 % spare capacity when it has to grow),
+    and ``n_builds`` is incremented. Arrays obtained from ``nl`` before the
+    call must not be kept across it.
 
     Parameters
     ----------
@@ -739,16 +826,20 @@ def update_neighbours(nl, x, h, dim, active=None):
     NeighbourList
         ``nl`` itself (rebuilt or not).
     """
-    x, h, act = _check_inputs(x, h, nl.radius_factor, nl.skin, dim, active)
-    rebuild = (x.shape[0] != nl.n or dim != nl.dim
-               or (act is None) != (nl.active_ref is None)
-               or (act is not None and not np.array_equal(act, nl.active_ref)))
+    n = nl.n
+    rebuild = (x.shape[0] != n or h.shape[0] != n or dim != nl.dim
+               or (active is None) != (nl.active_ref is None))
+    if not rebuild and active is not None:
+        a = np.asarray(active)
+        rebuild = a.shape != (n,) or _mask_changed(a, nl.active_ref)
     if not rebuild:
         rebuild = needs_rebuild(nl, x, h)
     if not rebuild:
         return nl
-    offsets, idx, cs, n_big = _build_csr(x, h, act, nl.radius_factor,
-                                         nl.skin, dim)
+    x, h, act = _check_inputs(x, h, nl.radius_factor, nl.skin, dim, active)
+    offsets, idx, _, cs, n_big = _build_csr(
+        x, h, act, nl.radius_factor, nl.skin, dim, nl.offsets,
+        _idx_storage(nl.idx))
     nl.offsets = offsets
     nl.idx = idx
     if nl.x_ref.shape == x.shape:

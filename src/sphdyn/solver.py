@@ -24,7 +24,8 @@ from .guards import check_particles, check_time_step
 from .integrate import add_heat, cfl_time_step, drift, internal_energies, kick
 from .model import Model
 from .neighbours import build_neighbours, update_neighbours
-from .sph.passes import forces, update_density_and_h, velocity_gradient, xsph_velocity
+from .sph.passes import (forces, pair_gradients, particle_volumes, scaled_stress,
+                         update_density_and_h, velocity_gradient, xsph_velocity)
 
 
 class Solver:
@@ -56,6 +57,9 @@ class Solver:
         self.collapse_ratio = deck.time.collapse_ratio
         n = p.n
         self.B = np.zeros((n, 3, 3))
+        self.S = np.zeros((n, 3, 3))
+        self.vol = np.zeros(n)
+        self.F = np.zeros(0)
         self.dedt_av = np.zeros(n)
         self.a_contact = np.zeros((n, 3))
         self.vmean = np.zeros((n, 3))
@@ -79,9 +83,7 @@ class Solver:
         self.work_external = 0.0
         self.nl = build_neighbours(p.x, p.h, model.radius_factor, self.skin, self.dim)
         self.dt0, _ = self._cfl()
-        nl = self.nl
-        velocity_gradient(p.x, p.v, p.m, p.rho, p.h, nl.offsets, nl.idx, self.kid,
-                          self.sigma, self.dim, self.kscale, self.correct, p.L, self.B)
+        self._gradients()
         self._accelerations(self.dt0)
 
     # ------------------------------------------------------------------ parts
@@ -90,12 +92,28 @@ class Solver:
         dt, k = cfl_time_step(p.h, p.c, p.v, p.m, min(1.0, self.kscale), self.cfl)
         return min(dt, self.dt_max, self.dt_contact), k
 
-    def _accelerations(self, dt):
-        """Stress divergence, artificial viscosity and contact at the current state."""
+    def _gradients(self):
+        """Pair kernel gradients (once per step) and the velocity gradient L."""
         p, nl = self.p, self.nl
-        forces(p.x, p.v, p.m, p.rho, p.h, p.c, p.sig, self.B, nl.offsets, nl.idx,
-               self.kid, self.sigma, self.dim, self.kscale, self.correct, self.alpha,
-               self.beta, p.a, self.dedt_av)
+        if self.F.shape[0] != nl.idx.shape[0]:
+            self.F = np.empty(nl.idx.shape[0])  # only after a neighbour rebuild
+        pair_gradients(p.x, p.h, nl.offsets, nl.idx, self.kid, self.sigma, self.dim,
+                       self.kscale, self.F)
+        particle_volumes(p.m, p.rho, self.vol)
+        velocity_gradient(p.x, p.v, self.vol, self.F, nl.offsets, nl.idx, self.dim,
+                          self.correct, p.L, self.B)
+
+    def _accelerations(self, dt):
+        """Stress divergence, artificial viscosity and contact at the current state.
+
+        Uses the pair gradients of :meth:`_gradients` (smoothing length of the
+        start of the step; h changes slowly, by design of the Benz update).
+        """
+        p, nl = self.p, self.nl
+        scaled_stress(p.sig, p.rho, self.S)
+        forces(p.x, p.v, p.m, p.rho, p.h, p.c, self.S, self.B, self.F, nl.offsets,
+               nl.idx, self.dim, self.kscale, self.correct, self.alpha, self.beta, p.a,
+               self.dedt_av)
         self.a_contact[:] = 0.0
         for w in self.model.walls:
             cnt = wall_contact(p.x, p.v, p.m, p.vol0, p.rho, w.kbulk, self.dim, w.point,
@@ -134,9 +152,8 @@ class Solver:
         self.step_count += 1
         self.dt_prev = dt
 
-        nl = self.nl = update_neighbours(nl, p.x, p.h, self.dim)
-        velocity_gradient(p.x, p.v, p.m, p.rho, p.h, nl.offsets, nl.idx, self.kid,
-                          self.sigma, self.dim, self.kscale, self.correct, p.L, self.B)
+        self.nl = update_neighbours(nl, p.x, p.h, self.dim)
+        self._gradients()
         update_density_and_h(p.L, dt, self.dim, self.benz, p.h0, self.hmin, self.hmax,
                              p.rho, p.h)
         for g in model.groups:

@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ..kernels import grad_factor, kernel_value
+from ..kernels import dwdq_over_q, kernel_value, support_nb
 
 # Determinant below which the correction matrix is treated as singular
 # (isolated particle or a neighbourhood on a line); the raw gradient is used then.
@@ -33,8 +33,65 @@ _DET_TOL = 1e-6
 
 
 @njit(cache=True, parallel=True)
-def velocity_gradient(x, v, m, rho, h, offsets, idx, kid, sigma, dim, kscale,
-                      correct, L, B):
+def pair_gradients(x, h, offsets, idx, kid, sigma, dim, kscale, F):
+    r"""Kernel-gradient factor of every neighbour pair, evaluated once per step.
+
+    .. math:: \nabla_i W(\mathbf x_i - \mathbf x_j, h_{ij}) = F_{ij}\,
+              (\mathbf x_i - \mathbf x_j), \qquad
+              F_{ij} = \frac{1}{r}\frac{\partial W}{\partial r}
+
+    with :math:`h_{ij} = \kappa (h_i + h_j)/2` (see :func:`sphdyn.kernels.grad_factor`).
+    The velocity-gradient and force passes of the same step reuse ``F``
+    (shape ``(nnz,)``, aligned with ``idx``), so the kernel is evaluated once
+    per pair and step. ``F`` is 0 for pairs in the Verlet skin (tested on
+    ``r^2`` first, so they cost no square root or kernel evaluation).
+    """
+    n = x.shape[0]
+    qmax = support_nb(kid)
+    three = dim == 3
+    for i in prange(n):
+        xi0 = x[i, 0]
+        xi1 = x[i, 1]
+        xi2 = x[i, 2]
+        hi = h[i]
+        for k in range(offsets[i], offsets[i + 1]):
+            j = idx[k]
+            d0 = xi0 - x[j, 0]
+            d1 = xi1 - x[j, 1]
+            d2 = xi2 - x[j, 2]
+            r2 = d0 * d0 + d1 * d1 + d2 * d2
+            hij = kscale * 0.5 * (hi + h[j])
+            if r2 >= (qmax * hij) ** 2:
+                F[k] = 0.0
+            else:
+                # grad_factor with one division: sigma / h^(d+2) * w'(q)/q
+                ih = 1.0 / hij
+                ih2 = ih * ih
+                scale = sigma * ih2 * ih2
+                if three:
+                    scale *= ih
+                F[k] = scale * dwdq_over_q(kid, np.sqrt(r2) * ih)
+
+
+@njit(cache=True, parallel=True)
+def particle_volumes(m, rho, vol):
+    """``vol = m / rho`` [m^3] (N,), the particle volumes used as quadrature weights."""
+    for i in prange(m.shape[0]):
+        vol[i] = m[i] / rho[i]
+
+
+@njit(cache=True, parallel=True)
+def scaled_stress(sig, rho, S):
+    """``S = sigma / rho^2`` (N, 3, 3) [Pa m^6/kg^2], the stress term of the momentum sum."""
+    for i in prange(sig.shape[0]):
+        r2 = 1.0 / (rho[i] * rho[i])
+        for a in range(3):
+            for b in range(3):
+                S[i, a, b] = sig[i, a, b] * r2
+
+
+@njit(cache=True, parallel=True)
+def velocity_gradient(x, v, vol, F, offsets, idx, dim, correct, L, B):
     r"""Velocity gradient with optional Randles-Libersky renormalisation.
 
     .. math::
@@ -51,9 +108,10 @@ def velocity_gradient(x, v, m, rho, h, offsets, idx, kid, sigma, dim, kscale,
     Parameters
     ----------
     x, v : (N, 3) positions [m] and velocities [m/s].
-    m, rho, h : (N,) mass [kg], density [kg/m^3], smoothing length [m].
+    vol : (N,) particle volumes m/rho [m^3] (0 for zero-mass particles).
+    F : (nnz,) pair gradient factors from :func:`pair_gradients`.
     offsets, idx : CSR neighbour list.
-    kid, sigma, dim, kscale : kernel id, normalisation, dimension, support scale.
+    dim : spatial dimension (2: z terms skipped).
     correct : bool, apply the renormalisation.
     L : (N, 3, 3) out, velocity gradient [1/s].
     B : (N, 3, 3) out, correction matrix applied to kernel gradients
@@ -69,44 +127,41 @@ def velocity_gradient(x, v, m, rho, h, offsets, idx, kid, sigma, dim, kscale,
         vi0 = v[i, 0]
         vi1 = v[i, 1]
         vi2 = v[i, 2]
-        hi = h[i]
+        three = dim == 3
         for k in range(offsets[i], offsets[i + 1]):
             j = idx[k]
-            if m[j] == 0.0:
+            f = F[k] * vol[j]
+            if f == 0.0:
                 continue
             d0 = xi0 - x[j, 0]
             d1 = xi1 - x[j, 1]
-            d2 = xi2 - x[j, 2]
-            r = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-            hij = kscale * 0.5 * (hi + h[j])
-            f = grad_factor(kid, sigma, dim, r, hij) * m[j] / rho[j]
-            if f == 0.0:
-                continue
             g0 = f * d0
             g1 = f * d1
-            g2 = f * d2
             u0 = v[j, 0] - vi0
             u1 = v[j, 1] - vi1
-            u2 = v[j, 2] - vi2
             l00 += u0 * g0
             l01 += u0 * g1
-            l02 += u0 * g2
             l10 += u1 * g0
             l11 += u1 * g1
-            l12 += u1 * g2
-            l20 += u2 * g0
-            l21 += u2 * g1
-            l22 += u2 * g2
             # (x_j - x_i) = -d
             m00 -= d0 * g0
             m01 -= d0 * g1
-            m02 -= d0 * g2
             m10 -= d1 * g0
             m11 -= d1 * g1
-            m12 -= d1 * g2
-            m20 -= d2 * g0
-            m21 -= d2 * g1
-            m22 -= d2 * g2
+            if three:
+                d2 = xi2 - x[j, 2]
+                g2 = f * d2
+                u2 = v[j, 2] - vi2
+                l02 += u0 * g2
+                l12 += u1 * g2
+                l20 += u2 * g0
+                l21 += u2 * g1
+                l22 += u2 * g2
+                m02 -= d0 * g2
+                m12 -= d1 * g2
+                m20 -= d2 * g0
+                m21 -= d2 * g1
+                m22 -= d2 * g2
         # inverse of the moment matrix M (L_true = L_raw M^{-1}, B = M^{-T})
         q00 = 1.0
         q01 = q02 = q10 = q12 = q20 = q21 = 0.0
@@ -154,8 +209,8 @@ def velocity_gradient(x, v, m, rho, h, offsets, idx, kid, sigma, dim, kscale,
 
 
 @njit(cache=True, parallel=True)
-def forces(x, v, m, rho, h, c, sig, B, offsets, idx, kid, sigma, dim, kscale,
-           correct, alpha, beta, a, dedt_av):
+def forces(x, v, m, rho, h, c, S, B, F, offsets, idx, dim, kscale, correct, alpha,
+           beta, a, dedt_av):
     r"""Acceleration from the stress divergence and Monaghan artificial viscosity.
 
     Symmetric (momentum-conserving) form of Gray, Monaghan & Swift (2001),
@@ -183,21 +238,24 @@ def forces(x, v, m, rho, h, c, sig, B, offsets, idx, kid, sigma, dim, kscale,
 
     Parameters
     ----------
-    sig : (N, 3, 3) Cauchy stress [Pa], tension positive.
-    c : (N,) wave speed [m/s].
+    x, v : (N, 3) positions [m], velocities [m/s].
+    m, rho, h, c : (N,) mass [kg], density [kg/m^3], smoothing length [m],
+        wave speed [m/s].
+    S : (N, 3, 3) sigma / rho^2 from :func:`scaled_stress` (Cauchy, tension +).
     B : (N, 3, 3) correction matrices from :func:`velocity_gradient`.
+    F : (nnz,) pair gradient factors from :func:`pair_gradients`.
     a : (N, 3) out, acceleration [m/s^2].
     dedt_av : (N,) out, viscous heating rate [W/kg].
     """
     n = x.shape[0]
+    three = dim == 3
     for i in prange(n):
-        ri2 = 1.0 / (rho[i] * rho[i])
-        s00 = sig[i, 0, 0] * ri2
-        s01 = sig[i, 0, 1] * ri2
-        s02 = sig[i, 0, 2] * ri2
-        s11 = sig[i, 1, 1] * ri2
-        s12 = sig[i, 1, 2] * ri2
-        s22 = sig[i, 2, 2] * ri2
+        s00 = S[i, 0, 0]
+        s01 = S[i, 0, 1]
+        s02 = S[i, 0, 2]
+        s11 = S[i, 1, 1]
+        s12 = S[i, 1, 2]
+        s22 = S[i, 2, 2]
         if correct:
             # P_i = (sigma_i / rho_i^2) B_i, applied to g
             p00 = s00 * B[i, 0, 0] + s01 * B[i, 1, 0] + s02 * B[i, 2, 0]
@@ -232,28 +290,23 @@ def forces(x, v, m, rho, h, c, sig, B, offsets, idx, kid, sigma, dim, kscale,
         heat = 0.0
         for k in range(offsets[i], offsets[i + 1]):
             j = idx[k]
+            f = F[k]
             mj = m[j]
-            if mj == 0.0:
+            if f == 0.0 or mj == 0.0:
                 continue
             d0 = xi0 - x[j, 0]
             d1 = xi1 - x[j, 1]
-            d2 = xi2 - x[j, 2]
-            r2 = d0 * d0 + d1 * d1 + d2 * d2
-            r = np.sqrt(r2)
-            hij = kscale * 0.5 * (hi + h[j])
-            f = grad_factor(kid, sigma, dim, r, hij)
-            if f == 0.0:
-                continue
             g0 = f * d0
             g1 = f * d1
+            w0 = vi0 - v[j, 0]
+            w1 = vi1 - v[j, 1]
+            if three:
+                d2 = xi2 - x[j, 2]
+                w2 = vi2 - v[j, 2]
+            else:
+                d2 = 0.0
+                w2 = 0.0
             g2 = f * d2
-            rj2 = 1.0 / (rho[j] * rho[j])
-            t00 = sig[j, 0, 0] * rj2
-            t01 = sig[j, 0, 1] * rj2
-            t02 = sig[j, 0, 2] * rj2
-            t11 = sig[j, 1, 1] * rj2
-            t12 = sig[j, 1, 2] * rj2
-            t22 = sig[j, 2, 2] * rj2
             if correct:
                 b0 = B[j, 0, 0] * g0 + B[j, 0, 1] * g1 + B[j, 0, 2] * g2
                 b1 = B[j, 1, 0] * g0 + B[j, 1, 1] * g1 + B[j, 1, 2] * g2
@@ -262,15 +315,25 @@ def forces(x, v, m, rho, h, c, sig, B, offsets, idx, kid, sigma, dim, kscale,
                 b0 = g0
                 b1 = g1
                 b2 = g2
-            f0 = p00 * g0 + p01 * g1 + p02 * g2 + t00 * b0 + t01 * b1 + t02 * b2
-            f1 = p10 * g0 + p11 * g1 + p12 * g2 + t01 * b0 + t11 * b1 + t12 * b2
-            f2 = p20 * g0 + p21 * g1 + p22 * g2 + t02 * b0 + t12 * b1 + t22 * b2
+            t00 = S[j, 0, 0]
+            t01 = S[j, 0, 1]
+            t11 = S[j, 1, 1]
+            f0 = p00 * g0 + p01 * g1 + t00 * b0 + t01 * b1
+            f1 = p10 * g0 + p11 * g1 + t01 * b0 + t11 * b1
+            if three:
+                t02 = S[j, 0, 2]
+                t12 = S[j, 1, 2]
+                t22 = S[j, 2, 2]
+                f0 += p02 * g2 + t02 * b2
+                f1 += p12 * g2 + t12 * b2
+                f2 = p20 * g0 + p21 * g1 + p22 * g2 + t02 * b0 + t12 * b1 + t22 * b2
+            else:
+                f2 = 0.0
             # artificial viscosity, approaching pairs only
-            w0 = vi0 - v[j, 0]
-            w1 = vi1 - v[j, 1]
-            w2 = vi2 - v[j, 2]
             vx = w0 * d0 + w1 * d1 + w2 * d2
             if vx < 0.0:
+                hij = kscale * 0.5 * (hi + h[j])
+                r2 = d0 * d0 + d1 * d1 + d2 * d2
                 mu = hij * vx / (r2 + 0.01 * hij * hij)
                 pi_ij = (-alpha * 0.5 * (ci + c[j]) * mu + beta * mu * mu) / (
                     0.5 * (rhoi + rho[j]))
