@@ -639,3 +639,12 @@ def test_docgen_main_writes_file(tmp_path):
     out = tmp_path / "ref.md"
     assert docgen.main([str(out)]) == 0
     assert out.read_text(encoding="utf-8") == docgen.generate()
+
+
+def test_probe_quantity_is_checked_and_names_the_field():
+    text = MINIMAL + '[[set]]\nname = "s"\n[[probe]]\nset = "s"\nquantities = ["velocity_w"]\n'
+    with pytest.raises(DeckError) as err:
+        loads_deck(text)
+    assert "probe[0].quantities" in str(err.value) and "Fix:" in str(err.value)
+    ok = loads_deck(MINIMAL + '[[set]]\nname = "s"\n[[probe]]\nset = "s"\n')
+    assert ok.probe[0].reduce == "mean" and "velocity_x" in ok.probe[0].quantities

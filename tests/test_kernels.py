@@ -61,8 +61,9 @@ def test_bad_id_and_dim_rejected():
         K.normalisation(0, 4)
     with pytest.raises(ValueError):
         K.normalisation(-1, 2)
-    with pytest.raises(ValueError):
-        K.w(17, 0.5)
+    # compiled functions return NaN for an unknown id (raising inside them
+    # would block inlining in the hot loops); the Python entry points raise.
+    assert np.isnan(K.w(17, 0.5)) and np.isnan(K.dwdq_over_q(17, 0.5))
 
 
 @pytest.mark.parametrize("kid", KIDS)

@@ -171,3 +171,33 @@ EXAMPLES = sorted(Path(__file__).parent.parent.glob("examples/*.toml"))
 def test_every_example_deck_runs_two_steps(deck, tmp_path):
     assert main(["run", str(deck), "--out", str(tmp_path / deck.stem), "--max-steps",
                  "2", "-q"]) == 0
+
+
+def test_probes_record_set_histories(tmp_path):
+    # A probe on the whole disc records the mean velocity, which before the
+    # impact equals the initial -5 m/s exactly, and the max plastic strain,
+    # which grows once the contact zone yields.
+    text = SMALL.format(t_end="3 ms", ck=0) + """
+[[set]]
+name = "all"
+[[probe]]
+set = "all"
+quantities = ["velocity_y", "plastic_strain", "stress_yy"]
+reduce = "max"
+"""
+    sim = Simulation.from_deck(loads_deck(text), tmp_path / "probe")
+    sim.run()
+    h = read_history_csv(tmp_path / "probe/history.csv")
+    assert h["probe_all_velocity_y"][0] == -5.0
+    assert h["probe_all_plastic_strain"][0] == 0.0
+    assert h["probe_all_plastic_strain"][-1] > 0.0
+    assert h["probe_all_plastic_strain"][-1] == sim.solver.p.hist[:, 0].max()
+
+
+def test_probe_of_a_missing_history_variable_is_rejected_before_running(tmp_path):
+    text = SMALL.format(t_end="1 ms", ck=0).replace('model = "j2"', 'model = "elastic"')
+    text = text.replace("yield_stress = 2e5\nhardening_modulus = 1e6\n", "")
+    text += '[[set]]\nname = "all"\n[[probe]]\nset = "all"\nquantities = ["plastic_strain"]\n'
+    deck = tmp_path / "d.toml"
+    deck.write_text(text)
+    assert main(["check", str(deck)]) == 2

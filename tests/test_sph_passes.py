@@ -6,7 +6,7 @@ import pytest
 from sphdyn import kernels
 from sphdyn.geometry import box_lattice
 from sphdyn.neighbours import build_neighbours
-from sphdyn.sph.passes import (forces, pair_gradients, particle_volumes, scaled_stress,
+from sphdyn.sph.passes import (forces, particle_volumes, scaled_stress,
                                update_density_and_h, velocity_gradient, xsph_velocity)
 
 
@@ -38,24 +38,17 @@ def _interior(c, layers):
     return np.flatnonzero(ok)
 
 
-def _pair_factors(c):
-    nl = c["nl"]
-    F = np.zeros(nl.idx.size)
-    pair_gradients(c["x"], c["h"], nl.offsets, nl.idx, c["kid"], c["sigma"], c["dim"],
-                   1.0, F)
-    return F
-
-
-def _grad(c, v, correct):
+def _grad(c, v, correct, with_factors=False):
     n = c["x"].shape[0]
     L = np.zeros((n, 3, 3))
     B = np.zeros((n, 3, 3))
     vol = np.zeros(n)
     particle_volumes(c["m"], c["rho"], vol)
     nl = c["nl"]
-    velocity_gradient(c["x"], v, vol, _pair_factors(c), nl.offsets, nl.idx, c["dim"],
-                      correct, L, B)
-    return L, B
+    F = np.zeros(nl.idx.size)
+    velocity_gradient(c["x"], v, c["h"], vol, nl.offsets, nl.idx, c["kid"], c["sigma"],
+                      c["dim"], 1.0, correct, F, L, B)
+    return (L, B, F) if with_factors else (L, B)
 
 
 def _linear_field(dim, seed=1):
@@ -111,13 +104,13 @@ def test_boundary_gradient_is_wrong_without_correction(dim):
 def _forces(c, sig, v=None, correct=False, alpha=0.0, beta=0.0, cs=1000.0):
     n = c["x"].shape[0]
     v = np.zeros((n, 3)) if v is None else v
-    L, B = _grad(c, v, correct)
+    L, B, F = _grad(c, v, correct, with_factors=True)
     a = np.zeros((n, 3))
     dedt = np.zeros(n)
     nl = c["nl"]
     S = np.zeros((n, 3, 3))
     scaled_stress(sig, c["rho"], S)
-    forces(c["x"], v, c["m"], c["rho"], c["h"], np.full(n, cs), S, B, _pair_factors(c),
+    forces(c["x"], v, c["m"], c["rho"], c["h"], np.full(n, cs), S, B, F,
            nl.offsets, nl.idx, c["dim"], 1.0, correct, alpha, beta, a, dedt)
     return a, dedt
 

@@ -168,7 +168,7 @@ def support_nb(kid):
         return 3.0
     elif kid == 5:
         return 2.0
-    raise ValueError("unknown kernel id")
+    return math.nan  # unknown id: rejected in Python by kernel_id(); NaN is caught by the guards
 
 
 def normalisation(kid: int, dim: int) -> float:
@@ -253,7 +253,7 @@ def w(kid, q):
         if q < 2.0:
             return (3.0 / 16.0) * q * q - 0.75 * q + 0.75
         return 0.0
-    raise ValueError("unknown kernel id")
+    return math.nan  # unknown id: rejected in Python by kernel_id(); NaN is caught by the guards
 
 
 @njit(cache=True)
@@ -315,7 +315,7 @@ def dwdq(kid, q):
         if q < 2.0:
             return 0.375 * q - 0.75
         return 0.0
-    raise ValueError("unknown kernel id")
+    return math.nan  # unknown id: rejected in Python by kernel_id(); NaN is caught by the guards
 
 
 @njit(cache=True)
@@ -379,7 +379,7 @@ def d2wdq2(kid, q):
         if q < 2.0:
             return 0.375
         return 0.0
-    raise ValueError("unknown kernel id")
+    return math.nan  # unknown id: rejected in Python by kernel_id(); NaN is caught by the guards
 
 
 @njit(cache=True)
@@ -439,7 +439,7 @@ def dwdq_over_q(kid, q):
         elif q < 2.0:
             return 0.375 - 0.75 / q
         return 0.0
-    raise ValueError("unknown kernel id")
+    return math.nan  # unknown id: rejected in Python by kernel_id(); NaN is caught by the guards
 
 
 @njit(cache=True)

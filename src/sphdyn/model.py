@@ -14,6 +14,7 @@ from . import kernels
 from .contact.wall import STIFFNESS_BULK, STIFFNESS_MASS
 from .geometry import lattice_from_shape, select
 from .materials import get_model
+from .probes import Probe, quantity
 from .state import BC_FIXED, BC_VELOCITY, Particles
 
 
@@ -54,6 +55,7 @@ class Model:
     kernel_sigma: float
     radius_factor: float
     bulk_modulus: np.ndarray = field(repr=False, default=None)  # (N,) per particle
+    probes: list[Probe] = field(default_factory=list)
 
 
 def _material_params(mat) -> dict:
@@ -133,6 +135,16 @@ def build_model(deck) -> Model:
             particles.bc_v[idx] = np.asarray(bnd.velocity, dtype=float)
             particles.v[idx] = particles.bc_v[idx]
 
+    probes = []
+    for pr in deck.probe:
+        probe = Probe(pr.set, sets[pr.set], tuple(pr.quantities), pr.reduce)
+        for q in probe.quantities:
+            try:
+                quantity(particles, probe.idx, q)
+            except ValueError as exc:
+                raise ValueError(f"probe on set {pr.set!r}: {exc}") from None
+        probes.append(probe)
+
     walls = []
     for w in deck.wall:
         kbw = kb.copy() if w.bulk_modulus is None else np.full(particles.n, w.bulk_modulus)
@@ -158,4 +170,4 @@ def build_model(deck) -> Model:
         body_names=[b.name for b in deck.body], domain_lo=lo, domain_hi=hi,
         kernel_id=kid, kernel_sigma=kernels.normalisation(kid, dim),
         radius_factor=kernels.support(kid) * deck.sph.support_scale,
-        bulk_modulus=kb)
+        bulk_modulus=kb, probes=probes)

@@ -23,8 +23,9 @@ from .contact.wall import STIFFNESS_BULK, bulk_contact_time_step, wall_contact
 from .guards import check_particles, check_time_step
 from .integrate import add_heat, cfl_time_step, drift, internal_energies, kick
 from .model import Model
+from .probes import record as probe_record
 from .neighbours import build_neighbours, update_neighbours
-from .sph.passes import (forces, pair_gradients, particle_volumes, scaled_stress,
+from .sph.passes import (forces, particle_volumes, scaled_stress,
                          update_density_and_h, velocity_gradient, xsph_velocity)
 
 
@@ -97,11 +98,10 @@ class Solver:
         p, nl = self.p, self.nl
         if self.F.shape[0] != nl.idx.shape[0]:
             self.F = np.empty(nl.idx.shape[0])  # only after a neighbour rebuild
-        pair_gradients(p.x, p.h, nl.offsets, nl.idx, self.kid, self.sigma, self.dim,
-                       self.kscale, self.F)
         particle_volumes(p.m, p.rho, self.vol)
-        velocity_gradient(p.x, p.v, self.vol, self.F, nl.offsets, nl.idx, self.dim,
-                          self.correct, p.L, self.B)
+        velocity_gradient(p.x, p.v, p.h, self.vol, nl.offsets, nl.idx, self.kid,
+                          self.sigma, self.dim, self.kscale, self.correct, self.F, p.L,
+                          self.B)
 
     def _accelerations(self, dt):
         """Stress divergence, artificial viscosity and contact at the current state.
@@ -181,6 +181,7 @@ class Solver:
             rec[f"F_wall_{w.name}"] = fn
             rec[f"F_wall_{w.name}_t"] = float(np.linalg.norm(f - fn * w.normal))
             rec[f"contacts_{w.name}"] = float(self.wall_counts[w.name])
+        rec.update(probe_record(self.p, self.model.probes))
         return rec
 
     # ------------------------------------------------------------- checkpoint

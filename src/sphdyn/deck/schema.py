@@ -756,6 +756,30 @@ class Boundary(Section):
         return velocity
 
 
+PROBE_QUANTITIES = (
+    "velocity_x", "velocity_y", "velocity_z", "speed",
+    "displacement_x", "displacement_y", "displacement_z",
+    "stress_xx", "stress_yy", "stress_zz", "stress_xy", "stress_yz", "stress_xz",
+    "pressure", "von_mises", "density", "damage", "internal_energy",
+    "smoothing_length", "plastic_strain",
+)
+
+
+class Probe(Section):
+    """[[probe]]: time history of a quantity over a particle set."""
+
+    set: reference_to("set") = Field(description="Name of a [[set]].")
+    quantities: tuple[Literal[PROBE_QUANTITIES], ...] = Field(
+        ("displacement_x", "displacement_y", "displacement_z", "velocity_x",
+         "velocity_y", "velocity_z", "von_mises"),
+        description="Quantities recorded (stress tension positive, pressure "
+                    "positive in compression; plastic_strain needs a j2 "
+                    "material).")
+    reduce: Literal["mean", "min", "max"] = Field(
+        "mean", description="Reduction over the set's particles; history "
+                            "columns are named probe_<set>_<quantity>.")
+
+
 def _known_field(name: str) -> str:
     if name not in ALLOWED_FIELDS:
         raise problem(f"'{name}' is not an output field",
@@ -798,6 +822,8 @@ class Deck(Section):
     set: tuple[ParticleSet, ...] = Field((), description="Particle sets.")
     boundary: tuple[Boundary, ...] = Field((), description="Boundary "
                                                            "conditions.")
+    probe: tuple[Probe, ...] = Field((), description="Time histories of "
+                                                     "particle sets.")
     output: Output = Field(default_factory=Output, description="Output.")
 
     @model_validator(mode="wrap")

@@ -33,47 +33,6 @@ _DET_TOL = 1e-6
 
 
 @njit(cache=True, parallel=True)
-def pair_gradients(x, h, offsets, idx, kid, sigma, dim, kscale, F):
-    r"""Kernel-gradient factor of every neighbour pair, evaluated once per step.
-
-    .. math:: \nabla_i W(\mathbf x_i - \mathbf x_j, h_{ij}) = F_{ij}\,
-              (\mathbf x_i - \mathbf x_j), \qquad
-              F_{ij} = \frac{1}{r}\frac{\partial W}{\partial r}
-
-    with :math:`h_{ij} = \kappa (h_i + h_j)/2` (see :func:`sphdyn.kernels.grad_factor`).
-    The velocity-gradient and force passes of the same step reuse ``F``
-    (shape ``(nnz,)``, aligned with ``idx``), so the kernel is evaluated once
-    per pair and step. ``F`` is 0 for pairs in the Verlet skin (tested on
-    ``r^2`` first, so they cost no square root or kernel evaluation).
-    """
-    n = x.shape[0]
-    qmax = support_nb(kid)
-    three = dim == 3
-    for i in prange(n):
-        xi0 = x[i, 0]
-        xi1 = x[i, 1]
-        xi2 = x[i, 2]
-        hi = h[i]
-        for k in range(offsets[i], offsets[i + 1]):
-            j = idx[k]
-            d0 = xi0 - x[j, 0]
-            d1 = xi1 - x[j, 1]
-            d2 = xi2 - x[j, 2]
-            r2 = d0 * d0 + d1 * d1 + d2 * d2
-            hij = kscale * 0.5 * (hi + h[j])
-            if r2 >= (qmax * hij) ** 2:
-                F[k] = 0.0
-            else:
-                # grad_factor with one division: sigma / h^(d+2) * w'(q)/q
-                ih = 1.0 / hij
-                ih2 = ih * ih
-                scale = sigma * ih2 * ih2
-                if three:
-                    scale *= ih
-                F[k] = scale * dwdq_over_q(kid, np.sqrt(r2) * ih)
-
-
-@njit(cache=True, parallel=True)
 def particle_volumes(m, rho, vol):
     """``vol = m / rho`` [m^3] (N,), the particle volumes used as quadrature weights."""
     for i in prange(m.shape[0]):
@@ -91,7 +50,8 @@ def scaled_stress(sig, rho, S):
 
 
 @njit(cache=True, parallel=True)
-def velocity_gradient(x, v, vol, F, offsets, idx, dim, correct, L, B):
+def velocity_gradient(x, v, h, vol, offsets, idx, kid, sigma, dim, kscale, correct,
+                      F, L, B):
     r"""Velocity gradient with optional Randles-Libersky renormalisation.
 
     .. math::
@@ -105,19 +65,32 @@ def velocity_gradient(x, v, vol, F, offsets, idx, dim, correct, L, B):
     has a non-degenerate neighbourhood (Randles & Libersky 1996). In 2D the
     z row and column of the moment matrix are set to the identity.
 
+    The pass also stores the kernel-gradient factor of every pair,
+
+    .. math:: \nabla_i W(\mathbf x_i - \mathbf x_j, h_{ij}) = F_{ij}\,
+              (\mathbf x_i - \mathbf x_j), \qquad
+              F_{ij} = \frac{1}{r}\frac{\partial W}{\partial r}
+
+    (see :func:`sphdyn.kernels.grad_factor`), which :func:`forces` reuses, so the
+    kernel is evaluated once per pair and step. Pairs in the Verlet skin are
+    rejected on ``r^2`` (no square root or kernel call) and get ``F = 0``.
+
     Parameters
     ----------
     x, v : (N, 3) positions [m] and velocities [m/s].
+    h : (N,) smoothing length [m].
     vol : (N,) particle volumes m/rho [m^3] (0 for zero-mass particles).
-    F : (nnz,) pair gradient factors from :func:`pair_gradients`.
     offsets, idx : CSR neighbour list.
-    dim : spatial dimension (2: z terms skipped).
+    kid, sigma, dim, kscale : kernel id, normalisation, dimension (2: z
+        terms skipped), support scale kappa.
     correct : bool, apply the renormalisation.
+    F : (nnz,) out, pair gradient factors [1/m^(d+2)], aligned with ``idx``.
     L : (N, 3, 3) out, velocity gradient [1/s].
     B : (N, 3, 3) out, correction matrix applied to kernel gradients
         (identity when ``correct`` is False).
     """
     n = x.shape[0]
+    qmax = support_nb(kid)
     for i in prange(n):
         l00 = l01 = l02 = l10 = l11 = l12 = l20 = l21 = l22 = 0.0
         m00 = m01 = m02 = m10 = m11 = m12 = m20 = m21 = m22 = 0.0
@@ -128,13 +101,28 @@ def velocity_gradient(x, v, vol, F, offsets, idx, dim, correct, L, B):
         vi1 = v[i, 1]
         vi2 = v[i, 2]
         three = dim == 3
+        hi = h[i]
         for k in range(offsets[i], offsets[i + 1]):
             j = idx[k]
-            f = F[k] * vol[j]
-            if f == 0.0:
-                continue
             d0 = xi0 - x[j, 0]
             d1 = xi1 - x[j, 1]
+            d2 = xi2 - x[j, 2] if three else 0.0
+            r2 = d0 * d0 + d1 * d1 + d2 * d2
+            hij = kscale * 0.5 * (hi + h[j])
+            if r2 >= (qmax * hij) ** 2:
+                F[k] = 0.0
+                continue
+            # grad_factor with one division: sigma / h^(d+2) * w'(q)/q
+            ih = 1.0 / hij
+            ih2 = ih * ih
+            scale = sigma * ih2 * ih2
+            if three:
+                scale *= ih
+            fk = scale * dwdq_over_q(kid, np.sqrt(r2) * ih)
+            F[k] = fk
+            f = fk * vol[j]
+            if f == 0.0:
+                continue
             g0 = f * d0
             g1 = f * d1
             u0 = v[j, 0] - vi0
@@ -149,7 +137,6 @@ def velocity_gradient(x, v, vol, F, offsets, idx, dim, correct, L, B):
             m10 -= d1 * g0
             m11 -= d1 * g1
             if three:
-                d2 = xi2 - x[j, 2]
                 g2 = f * d2
                 u2 = v[j, 2] - vi2
                 l02 += u0 * g2
@@ -243,7 +230,7 @@ def forces(x, v, m, rho, h, c, S, B, F, offsets, idx, dim, kscale, correct, alph
         wave speed [m/s].
     S : (N, 3, 3) sigma / rho^2 from :func:`scaled_stress` (Cauchy, tension +).
     B : (N, 3, 3) correction matrices from :func:`velocity_gradient`.
-    F : (nnz,) pair gradient factors from :func:`pair_gradients`.
+    F : (nnz,) pair gradient factors from :func:`velocity_gradient`.
     a : (N, 3) out, acceleration [m/s^2].
     dedt_av : (N,) out, viscous heating rate [W/kg].
     """

@@ -1,0 +1,461 @@
+"""Snapshot panels: the particles of selected frames coloured by a field.
+
+:func:`plot_snapshots` draws one panel per selected frame of a run directory
+(``outdir/frames/frame_*.h5``), all on one colour scale with one colour bar,
+like the ring and disc figures of the thesis and the paper:
+
+* 2D runs: the particles at their x-y positions;
+* 3D runs: the particles of a slab around the mid-plane of ``slice_axis``,
+  in the other two coordinates.
+
+Each particle is drawn as a filled square whose side is the particle spacing
+(median nearest-neighbour distance in the first frame), in data units, so an
+intact body looks solid and cracks or separated particles show as gaps.
+Coordinates are shown in mm.
+
+Figures are drawn with Matplotlib's object-oriented API on the Agg canvas (no
+pyplot, no global state) and saved atomically.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+from .atomic import atomic_path
+from .frames import list_frames
+from .hdf5 import read_frame, read_frame_header
+
+__all__ = ["plot_snapshots", "select_frames", "slab_mask", "particle_spacing",
+           "field_values", "available_fields"]
+
+_AXES = {"x": 0, "y": 1, "z": 2}
+_TENSOR = ("xx", "xy", "xz", "yx", "yy", "yz", "zx", "zy", "zz")
+_TENSOR_RE = re.compile(r"^(.+)_(xx|xy|xz|yx|yy|yz|zx|zy|zz)$")
+_VECTOR_RE = re.compile(r"^(.+)_([xyz])$")
+
+#: SI unit of each output field (components and magnitudes share it).
+_UNITS = {
+    "position": "m", "velocity": "m/s", "speed": "m/s", "displacement": "m",
+    "stress": "Pa", "pressure": "Pa", "von_mises": "Pa",
+    "density": "kg/m^3", "mass": "kg", "smoothing_length": "m",
+    "damage": "-", "internal_energy": "J/kg", "plastic_strain": "-",
+}
+
+_DAMAGE_COLOURS = ((0.72, 0.72, 0.72), (0.0, 0.0, 0.0))  # intact grey, failed black
+
+
+# ------------------------------------------------------------------ selection
+
+def _axis_index(axis: str | int) -> int:
+    if isinstance(axis, str) and axis.lower() in _AXES:
+        return _AXES[axis.lower()]
+    if isinstance(axis, (int, np.integer)) and 0 <= int(axis) <= 2:
+        return int(axis)
+    raise ValueError(f"slice axis must be 'x', 'y' or 'z', not {axis!r}")
+
+
+def select_frames(frame_times, times=None, n: int = 4) -> list[int]:
+    """Indices of the frames to show, in increasing time.
+
+    Parameters
+    ----------
+    frame_times : array_like
+        Times [s] of the frames, in frame order (non-decreasing).
+    times : sequence of float, optional
+        Wanted times [s]: the frame nearest to each is taken (the earlier one
+        on a tie). Duplicates are dropped.
+    n : int, optional
+        Without ``times``: the number of frames, evenly spaced in time from
+        the first frame to the last, both included (``n = 1``: the last
+        frame). Fewer are returned if the run has fewer frames.
+
+    Returns
+    -------
+    list of int
+        Sorted, unique frame indices.
+    """
+    ft = np.asarray(frame_times, dtype=float)
+    if ft.size == 0:
+        raise ValueError("the run has no frames")
+    if times is None:
+        n = int(n)
+        if n < 1:
+            raise ValueError(f"n must be at least 1, not {n}")
+        targets = [ft[-1]] if n == 1 else np.linspace(ft[0], ft[-1], n)
+    else:
+        targets = np.atleast_1d(np.asarray(times, dtype=float))
+        if targets.size == 0:
+            raise ValueError("times is empty")
+        if not np.all(np.isfinite(targets)):
+            raise ValueError(f"times must be finite, got {list(targets)}")
+    picked = {int(np.argmin(np.abs(ft - t))) for t in targets}
+    return sorted(picked)
+
+
+def slab_mask(position: np.ndarray, axis: str | int = "z",
+              width: float | None = None, centre: float | None = None) -> np.ndarray:
+    """Particles within ``|x_axis - centre| <= width / 2``.
+
+    Parameters
+    ----------
+    position : ndarray, shape (N, 3)
+        Particle positions [m].
+    axis : {'x', 'y', 'z'} or int
+        Normal of the slab.
+    width : float
+        Slab thickness [m].
+    centre : float, optional
+        Slab mid-plane [m]; default the middle of the positions' extent along
+        ``axis``.
+
+    Returns
+    -------
+    ndarray of bool, shape (N,)
+    """
+    k = _axis_index(axis)
+    if width is None or not width > 0:
+        raise ValueError(f"slab width must be positive, not {width!r}")
+    c = np.asarray(position, dtype=float)[:, k]
+    if centre is None:
+        centre = 0.5 * (c.min() + c.max()) if c.size else 0.0
+    # A relative tolerance keeps lattice planes exactly on the boundary inside.
+    return np.abs(c - centre) <= 0.5 * width * (1.0 + 1e-9)
+
+
+def particle_spacing(position: np.ndarray, dimension: int = 3) -> float:
+    """Median nearest-neighbour distance [m] (the lattice spacing dx).
+
+    In 2D only the x-y coordinates are used.
+    """
+    from scipy.spatial import cKDTree
+
+    x = np.asarray(position, dtype=float)[:, :dimension]
+    if x.shape[0] < 2:
+        raise ValueError("need at least two particles to measure their spacing")
+    d, _ = cKDTree(x).query(x, k=2)
+    nn = d[:, 1]
+    nn = nn[nn > 0]
+    if nn.size == 0:
+        raise ValueError("all particles are at the same position")
+    return float(np.median(nn))
+
+
+# --------------------------------------------------------------------- fields
+
+def available_fields(fields: dict[str, np.ndarray]) -> list[str]:
+    """Names :func:`field_values` accepts for a frame's ``fields``."""
+    names: list[str] = []
+    for name, data in fields.items():
+        data = np.asarray(data)
+        cols = data.reshape(data.shape[0], -1).shape[1] if data.ndim else 0
+        if data.ndim == 1:
+            names.append(name)
+        elif cols == 3:
+            names += [name] + [f"{name}_{c}" for c in "xyz"]
+        elif cols == 9:
+            names += [f"{name}_{c}" for c in _TENSOR]
+    if "velocity" in fields and "speed" not in fields:
+        names.append("speed")
+    return names
+
+
+def field_values(fields: dict[str, np.ndarray], name: str) -> tuple[np.ndarray, str]:
+    """Scalar values of ``name`` for every particle of a frame.
+
+    Accepted names: a scalar field of the frame (``von_mises``, ``damage``,
+    ``plastic_strain``, ...); a vector field (its magnitude) or one of its
+    components ``<vector>_x|y|z``; a tensor component ``<tensor>_xx ... _zz``
+    (``stress_yy``: row-major index 4 of the 9 components, tension positive);
+    ``speed`` (``|velocity|``).
+
+    Returns
+    -------
+    values : ndarray, shape (N,)
+    unit : str
+        SI unit ("" if unknown, "-" if dimensionless).
+
+    Raises
+    ------
+    ValueError
+        If the name is not available; the message lists the names that are.
+    """
+    def unit(base: str) -> str:
+        return _UNITS.get(base, "")
+
+    data = fields.get(name)
+    if data is not None:
+        data = np.asarray(data)
+        if data.ndim == 1:
+            return data.astype(float), unit(name)
+        flat = data.reshape(data.shape[0], -1)
+        if flat.shape[1] == 3:
+            return np.linalg.norm(flat.astype(float), axis=1), unit(name)
+        if flat.shape[1] == 9:
+            raise ValueError(f"{name!r} is a tensor: give a component such as "
+                             f"'{name}_xx' or '{name}_yy' (or a scalar such as "
+                             "'von_mises')")
+    if name == "speed" and "velocity" in fields:
+        v = np.asarray(fields["velocity"], dtype=float)
+        return np.linalg.norm(v.reshape(v.shape[0], -1), axis=1), unit("speed")
+    m = _TENSOR_RE.match(name)
+    if m and m.group(1) in fields:
+        t = np.asarray(fields[m.group(1)])
+        t = t.reshape(t.shape[0], -1)
+        if t.shape[1] == 9:
+            return t[:, _TENSOR.index(m.group(2))].astype(float), unit(m.group(1))
+    m = _VECTOR_RE.match(name)
+    if m and m.group(1) in fields:
+        v = np.asarray(fields[m.group(1)])
+        v = v.reshape(v.shape[0], -1)
+        if v.shape[1] == 3:
+            return v[:, "xyz".index(m.group(2))].astype(float), unit(m.group(1))
+    raise ValueError(f"field {name!r} is not in the frames; available: "
+                     f"{available_fields(fields)}")
+
+
+# --------------------------------------------------------------------- drawing
+
+def _display_scale(unit: str, magnitude: float) -> tuple[float, str]:
+    """Factor and unit in which values of ``unit`` are shown."""
+    if unit == "Pa":
+        for factor, name in ((1e-9, "GPa"), (1e-6, "MPa"), (1e-3, "kPa")):
+            if magnitude * factor >= 1.0:
+                return factor, name
+        return 1.0, "Pa"
+    if unit == "m":
+        return 1e3, "mm"
+    return 1.0, unit
+
+
+def _time_label(t: float, t_max: float) -> str:
+    if t_max < 1e-3:
+        return f"t = {t * 1e6:.4g} µs"
+    if t_max < 1.0:
+        return f"t = {t * 1e3:.4g} ms"
+    return f"t = {t:.4g} s"
+
+
+def _run_info(outdir: Path) -> tuple[int | None, str]:
+    """Dimension and title from ``deck.resolved.toml`` (None, "" if absent)."""
+    try:
+        with open(outdir / "deck.resolved.toml", "rb") as f:
+            run = tomllib.load(f).get("run", {})
+    except (OSError, tomllib.TOMLDecodeError):
+        return None, ""
+    dim = run.get("dimension")
+    return (int(dim) if dim in (2, 3) else None), str(run.get("title", "") or "")
+
+
+def _grid(n_panels: int, box_w: float, box_h: float) -> tuple[int, int]:
+    """(rows, cols) making a figure about twice as wide as high, few empty cells."""
+    best, best_score = (1, n_panels), math.inf
+    for ncols in range(1, n_panels + 1):
+        nrows = math.ceil(n_panels / ncols)
+        if (nrows - 1) * ncols >= n_panels:
+            continue
+        ratio = (nrows * box_h) / (ncols * box_w)
+        score = abs(math.log(ratio / 0.5)) + 0.5 * (nrows * ncols - n_panels)
+        if score < best_score - 1e-12:
+            best, best_score = (nrows, ncols), score
+    return best
+
+
+def _squares(xy: np.ndarray, side: float) -> np.ndarray:
+    """Vertices ``(N, 4, 2)`` of axis-aligned squares centred on ``xy``."""
+    h = 0.5 * side
+    corners = np.array([[-h, -h], [h, -h], [h, h], [-h, h]])
+    return xy[:, None, :] + corners[None, :, :]
+
+
+def plot_snapshots(outdir: str | os.PathLike, field: str = "von_mises",
+                   times=None, n: int = 4, out: str | os.PathLike | None = None,
+                   slice_axis: str = "z", slice_width: float | None = None,
+                   cmap=None, vmin: float | None = None, vmax: float | None = None,
+                   marker_size: float | None = None, dpi: int = 110) -> Path:
+    """Panel figure of the particles of selected frames coloured by a field.
+
+    Parameters
+    ----------
+    outdir : str or os.PathLike
+        Output directory of a run (with ``frames/frame_*.h5``).
+    field : str, optional
+        What to colour by: any scalar field in the frames (``von_mises``,
+        ``pressure``, ``damage``, ``plastic_strain``, ...), a vector field
+        (its magnitude) or component (``velocity_y``), a tensor component
+        (``stress_xx`` ... ``stress_zz``, tension positive) or ``speed``
+        (``|velocity|``). See :func:`field_values`.
+    times : sequence of float, optional
+        Times [s]; the frame nearest to each is shown.
+    n : int, optional
+        Without ``times``: this many frames evenly spaced in time, first and
+        last included (default 4).
+    out : str or os.PathLike, optional
+        PNG to write; default ``outdir/plots/snapshots_<field>.png``.
+    slice_axis : {'x', 'y', 'z'}, optional
+        3D runs: normal of the slab shown (default ``z``: x-y view; ``y``:
+        x-z view; ``x``: y-z view). Ignored in 2D.
+    slice_width : float, optional
+        3D runs: slab thickness [m] around the mid-plane of the first frame's
+        extent along ``slice_axis``; default 1.5 x the particle spacing.
+        Particles are selected by their current position in each frame.
+    cmap : str or matplotlib colormap, optional
+        Default: grey (intact) to black (failed) for ``damage``; ``RdBu_r``
+        centred on zero for fields with both signs; ``viridis`` otherwise.
+    vmin, vmax : float, optional
+        Colour-scale limits in SI units; default the range over all panels
+        (symmetric about zero for fields with both signs; 0..1 for damage).
+    marker_size : float, optional
+        Side of the square drawn per particle [m]; default the particle
+        spacing (median nearest-neighbour distance in the first frame).
+    dpi : int, optional
+        Resolution of the PNG.
+
+    Returns
+    -------
+    pathlib.Path
+        The PNG written.
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``outdir`` has no frames.
+    ValueError
+        If ``field`` is not available (the message lists what is), or for
+        bad ``times``, ``n``, ``slice_axis`` or ``slice_width``.
+    """
+    outdir = Path(outdir)
+    frame_files = list_frames(outdir)
+    if not frame_files:
+        raise FileNotFoundError(f"no frames in {outdir / 'frames'}")
+    k_slice = _axis_index(slice_axis)
+    frame_times = [read_frame_header(f)[0] for f in frame_files]
+    chosen = select_frames(frame_times, times=times, n=n)
+
+    # Spacing and slab from the first frame of the run.
+    _, _, first, _ = read_frame(frame_files[0])
+    x0 = np.asarray(first["position"], dtype=float)
+    dimension, title = _run_info(outdir)
+    if dimension is None:
+        dimension = 2 if np.ptp(x0[:, 2]) == 0.0 else 3
+    spacing = particle_spacing(x0, dimension)
+    side = float(marker_size) if marker_size is not None else spacing
+    if dimension == 2:
+        plane = (0, 1)
+        slab = None
+    else:
+        plane = tuple(k for k in range(3) if k != k_slice)
+        width = 1.5 * spacing if slice_width is None else float(slice_width)
+        c = x0[:, k_slice]
+        slab = (width, 0.5 * (c.min() + c.max()))
+
+    panels = []  # (time, xy [m], values [SI])
+    unit = ""
+    for i in chosen:
+        t, _, fields, _ = read_frame(frame_files[i])
+        values, unit = field_values(fields, field)
+        x = np.asarray(fields["position"], dtype=float)
+        if slab is not None:
+            keep = slab_mask(x, k_slice, slab[0], slab[1])
+            x, values = x[keep], values[keep]
+        panels.append((t, x[:, plane], values))
+
+    # Shared colour scale.
+    finite = np.concatenate([v[np.isfinite(v)] for _, _, v in panels])
+    lo = float(finite.min()) if finite.size else 0.0
+    hi = float(finite.max()) if finite.size else 1.0
+    is_damage = field == "damage"
+    signed = lo < 0.0 < hi and not is_damage
+    if is_damage:
+        dlo, dhi = 0.0, 1.0
+    elif signed:
+        dhi = max(-lo, hi)
+        dlo = -dhi
+    else:
+        dlo, dhi = lo, hi
+    vlo = dlo if vmin is None else float(vmin)
+    vhi = dhi if vmax is None else float(vmax)
+    if not vhi > vlo:
+        vhi = vlo + (abs(vlo) * 1e-6 or 1.0)
+    factor, shown_unit = _display_scale(unit, max(abs(vlo), abs(vhi)))
+    extend = {(False, False): "neither", (True, False): "min",
+              (False, True): "max", (True, True): "both"}[(lo < vlo, hi > vhi)]
+
+    from matplotlib import colormaps
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.collections import PolyCollection
+    from matplotlib.colors import LinearSegmentedColormap, Normalize
+    from matplotlib.figure import Figure
+
+    if cmap is None:
+        if is_damage:
+            cmap = LinearSegmentedColormap.from_list("sphdyn_damage", _DAMAGE_COLOURS)
+        else:
+            cmap = "RdBu_r" if signed else "viridis"
+    if isinstance(cmap, str):
+        cmap = colormaps[cmap]
+    norm = Normalize(vlo * factor, vhi * factor)
+
+    # Shared limits [mm]: everything shown, plus half a square.
+    allxy = np.concatenate([xy for _, xy, _ in panels]) * 1e3
+    pad = 0.5 * side * 1e3 + 0.02 * max(np.ptp(allxy[:, 0]), np.ptp(allxy[:, 1]),
+                                       spacing * 1e3)
+    if allxy.size:
+        xlim = (allxy[:, 0].min() - pad, allxy[:, 0].max() + pad)
+        ylim = (allxy[:, 1].min() - pad, allxy[:, 1].max() + pad)
+    else:  # empty slab
+        xlim = ylim = (-1.0, 1.0)
+    box_w, box_h = xlim[1] - xlim[0], ylim[1] - ylim[0]
+    nrows, ncols = _grid(len(panels), box_w, box_h)
+
+    # Figure size [in] from the panels' aspect: room for the y labels and
+    # colour bar on the side, panel titles and tick labels on each row.
+    fig_w = 10.0
+    panel_w = (fig_w - 1.9 - 0.2 * (ncols - 1)) / ncols
+    panel_h = panel_w * box_h / box_w
+    fig_h = min(max(nrows * (panel_h + 0.45) + 0.75, 2.5), 14.0)
+    fig = Figure(figsize=(fig_w, fig_h), layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(nrows, ncols, sharex=True, sharey=True, squeeze=False)
+    t_max = max(t for t, _, _ in panels)
+    names = "xyz"
+    collection = None
+    for idx, ax in enumerate(axes.flat):
+        if idx >= len(panels):
+            ax.set_visible(False)
+            continue
+        t, xy, values = panels[idx]
+        collection = PolyCollection(_squares(xy * 1e3, side * 1e3), cmap=cmap,
+                                    norm=norm, edgecolors="face", linewidths=0.5,
+                                    antialiaseds=True)
+        collection.set_array(values * factor)
+        ax.add_collection(collection)
+        ax.set_xlim(*xlim)
+        ax.set_ylim(*ylim)
+        ax.set_aspect("equal")
+        ax.set_title(_time_label(t, t_max), fontsize=10)
+        row, col = divmod(idx, ncols)
+        if row == nrows - 1 or idx + ncols >= len(panels):
+            ax.set_xlabel(f"{names[plane[0]]} [mm]")
+            ax.xaxis.set_tick_params(labelbottom=True)
+        if col == 0:
+            ax.set_ylabel(f"{names[plane[1]]} [mm]")
+    label = field if not shown_unit else f"{field} [{shown_unit}]"
+    if collection is not None:
+        fig.colorbar(collection, ax=axes.ravel().tolist(), label=label,
+                     extend=extend, shrink=0.9)
+    heading = f"{field}: {title}" if title else f"{field}: {outdir.name}"
+    if slab is not None:
+        heading += (f"  (slab |{names[k_slice]} - {slab[1] * 1e3:.3g} mm| "
+                    f"<= {0.5 * slab[0] * 1e3:.3g} mm)")
+    fig.suptitle(heading, fontsize=11)
+
+    dest = Path(out) if out is not None else outdir / "plots" / f"snapshots_{field}.png"
+    with atomic_path(dest) as tmp:
+        fig.savefig(tmp, format="png", dpi=dpi)
+    return dest
