@@ -71,11 +71,32 @@ def cmd_check(args) -> int:
 
 
 def cmd_plot(args) -> int:
-    from .io import plot_history
+    if not args.snapshots:
+        from .io import plot_history
 
-    paths = plot_history(Path(args.dir) / "history.csv", Path(args.dir) / "plots")
-    for p in paths:
-        print(p)
+        paths = plot_history(Path(args.dir) / "history.csv", Path(args.dir) / "plots")
+        for p in paths:
+            print(p)
+        return 0
+
+    from .deck.units import TIME, to_si
+    from .io import plot_snapshots
+
+    fields = [f.strip() for item in args.snapshots for f in item.split(",") if f.strip()]
+    times = None
+    if args.times is not None:  # "1e-4,0.5 ms": plain numbers are seconds
+        items = [t.strip() for t in args.times.split(",") if t.strip()]
+        if not items:
+            raise ValueError(f"--times {args.times!r} gives no time")
+        times = []
+        for item in items:
+            try:
+                times.append(float(item))
+            except ValueError:
+                times.append(to_si(item, TIME))
+    for field in dict.fromkeys(fields):
+        print(plot_snapshots(args.dir, field, times=times, n=args.n,
+                             vmin=args.vmin, vmax=args.vmax))
     return 0
 
 
@@ -149,8 +170,22 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("-q", "--quiet", action="store_true")
     s.set_defaults(func=cmd_restart)
 
-    p = sub.add_parser("plot", help="plot DIR/history.csv into DIR/plots")
+    p = sub.add_parser("plot", help="plot DIR/history.csv (or particle snapshots) "
+                       "into DIR/plots")
     p.add_argument("dir")
+    p.add_argument("--snapshots", action="append", metavar="FIELD",
+                   help="instead of the history plots, panels of the particles coloured "
+                   "by FIELD (von_mises, damage, speed, stress_yy, ...) into "
+                   "DIR/plots/snapshots_FIELD.png; repeatable or a comma list")
+    p.add_argument("--times", metavar="T1,T2,...",
+                   help="snapshot times (the nearest frames), seconds or with units, "
+                   "e.g. 1e-4,2e-4 or '0.1 ms,0.2 ms'")
+    p.add_argument("--n", type=int, default=4,
+                   help="without --times: N frames evenly spaced from first to last "
+                   "(default 4)")
+    p.add_argument("--vmin", type=float,
+                   help="snapshot colour-scale minimum, SI (negative: --vmin=-1e6)")
+    p.add_argument("--vmax", type=float, help="snapshot colour-scale maximum, SI")
     p.set_defaults(func=cmd_plot)
 
     e = sub.add_parser("export", help="convert native frames (VTK series or CSV)")

@@ -10,7 +10,8 @@ directory and atomically renamed onto its destination
 * :mod:`~sphdyn.io.frames` -- numbered frames of a run directory, restart,
   VTK/CSV export,
 * :mod:`~sphdyn.io.history` -- global time histories (CSV),
-* :mod:`~sphdyn.io.plots` -- figures of a history (Matplotlib, Agg).
+* :mod:`~sphdyn.io.plots` -- figures of a history (Matplotlib, Agg),
+* :mod:`~sphdyn.io.snapshots` -- panels of particle frames coloured by a field.
 """
 
 from .atomic import atomic_path, atomic_write_bytes, atomic_write_text
@@ -20,6 +21,7 @@ from .hdf5 import (read_checkpoint, read_frame, read_frame_header,
                    write_checkpoint, write_frame)
 from .history import History, read_history_csv
 from .plots import plot_history  # imports Matplotlib only when called
+from .snapshots import plot_snapshots  # likewise
 from .vtk import read_pvd, write_pvd, write_vtu
 
 
@@ -31,5 +33,5 @@ __all__ = [
     "write_checkpoint", "write_frame",
     "History", "read_history_csv",
     "read_pvd", "write_pvd", "write_vtu",
-    "plot_history",
+    "plot_history", "plot_snapshots",
 ]

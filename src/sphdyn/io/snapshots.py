@@ -253,14 +253,14 @@ def _run_info(outdir: Path) -> tuple[int | None, str]:
 
 
 def _grid(n_panels: int, box_w: float, box_h: float) -> tuple[int, int]:
-    """(rows, cols) making a figure about twice as wide as high, few empty cells."""
+    """(rows, cols) making a figure about 2.5 times as wide as high, few empty cells."""
     best, best_score = (1, n_panels), math.inf
     for ncols in range(1, n_panels + 1):
         nrows = math.ceil(n_panels / ncols)
         if (nrows - 1) * ncols >= n_panels:
             continue
         ratio = (nrows * box_h) / (ncols * box_w)
-        score = abs(math.log(ratio / 0.5)) + 0.5 * (nrows * ncols - n_panels)
+        score = abs(math.log(ratio / 0.4)) + 0.5 * (nrows * ncols - n_panels)
         if score < best_score - 1e-12:
             best, best_score = (nrows, ncols), score
     return best
@@ -378,6 +378,8 @@ def plot_snapshots(outdir: str | os.PathLike, field: str = "von_mises",
         dlo = -dhi
     else:
         dlo, dhi = lo, hi
+    if vmin is not None and vmax is not None and not float(vmax) > float(vmin):
+        raise ValueError(f"vmax ({vmax}) must be greater than vmin ({vmin})")
     vlo = dlo if vmin is None else float(vmin)
     vhi = dhi if vmax is None else float(vmax)
     if not vhi > vlo:
@@ -403,9 +405,9 @@ def plot_snapshots(outdir: str | os.PathLike, field: str = "von_mises",
 
     # Shared limits [mm]: everything shown, plus half a square.
     allxy = np.concatenate([xy for _, xy, _ in panels]) * 1e3
-    pad = 0.5 * side * 1e3 + 0.02 * max(np.ptp(allxy[:, 0]), np.ptp(allxy[:, 1]),
-                                       spacing * 1e3)
     if allxy.size:
+        pad = 0.5 * side * 1e3 + 0.02 * max(np.ptp(allxy[:, 0]), np.ptp(allxy[:, 1]),
+                                           spacing * 1e3)
         xlim = (allxy[:, 0].min() - pad, allxy[:, 0].max() + pad)
         ylim = (allxy[:, 1].min() - pad, allxy[:, 1].max() + pad)
     else:  # empty slab
@@ -452,7 +454,7 @@ def plot_snapshots(outdir: str | os.PathLike, field: str = "von_mises",
     heading = f"{field}: {title}" if title else f"{field}: {outdir.name}"
     if slab is not None:
         heading += (f"  (slab |{names[k_slice]} - {slab[1] * 1e3:.3g} mm| "
-                    f"<= {0.5 * slab[0] * 1e3:.3g} mm)")
+                    f"≤ {0.5 * slab[0] * 1e3:.3g} mm)")
     fig.suptitle(heading, fontsize=11)
 
     dest = Path(out) if out is not None else outdir / "plots" / f"snapshots_{field}.png"
