@@ -70,7 +70,7 @@ def kernel_arrays(n, nh=1):
 
 def call(model, params, idx, L, dt, a):
     model.update(idx, L, dt, a["rho"], a["sig"], a["e"], a["c"], a["damage"],
-                 a["hist"], params)
+                 a["hist"], params, np.full(a["rho"].shape[0], 1e-3))
 
 
 # --------------------------------------------------------------------------

@@ -74,6 +74,12 @@ def build_model(deck) -> Model:
     models = {m.name: get_model(m.model) for m in deck.material}
     params = {name: models[name].pack(_material_params(m)) for name, m in mats.items()}
     n_hist = max([len(models[n].history_names) for n in mats] + [0])
+    layouts = {models[n].history_names for n in mats} - {()}
+    if len(layouts) > 1:
+        raise ValueError(
+            "materials with different history variables cannot share a model yet "
+            f"({' vs '.join(str(list(h)) for h in sorted(layouts))}): history columns "
+            "are stored by position; use materials of one model family per run")
 
     parts = []
     for b, body in enumerate(deck.body):
@@ -100,12 +106,7 @@ def build_model(deck) -> Model:
         p.hist_names = list(models[body.material].history_names)
         parts.append(p)
     particles = Particles.concatenate(parts)
-    hist_names: list[str] = []
-    for name in mats:
-        for hn in models[name].history_names:
-            if hn not in hist_names:
-                hist_names.append(hn)
-    particles.hist_names = hist_names[: particles.hist.shape[1]]
+    particles.hist_names = list(next(iter(layouts), ()))
 
     groups = []
     for name, m in mats.items():

@@ -60,6 +60,7 @@ class Solver:
         self.B = np.zeros((n, 3, 3))
         self.S = np.zeros((n, 3, 3))
         self.vol = np.zeros(n)
+        self.size = p.vol0 ** (1.0 / p.dim)  # particle size for regularisation [m]
         self.F = np.zeros(0)
         self.dedt_av = np.zeros(n)
         self.a_contact = np.zeros((n, 3))
@@ -158,7 +159,7 @@ class Solver:
                              p.rho, p.h)
         for g in model.groups:
             g.model.update(g.idx, p.L, dt, p.rho, p.sig, p.e, p.c, p.damage, p.hist,
-                           g.params)
+                           g.params, self.size)
         self._accelerations(dt)
         add_heat(p.e, p.e_av, self.dedt_av, dt)
         check_particles(p, model.domain_lo, model.domain_hi, self.t, self.step_count,

@@ -41,7 +41,7 @@ P_G = 2
 N_COMMON = 3
 
 KERNEL_SIGNATURE_DOC = """\
-update(idx, L, dt, rho, sig, e, c, damage, hist, params) -> None
+update(idx, L, dt, rho, sig, e, c, damage, hist, params, size) -> None
 
 idx    : int64[:]            particles to update (unique indices)
 L      : float64[:, :, :]    (N, 3, 3) velocity gradient dv_a/dx_b [1/s]
@@ -53,6 +53,8 @@ c      : float64[:]          (N,) wave speed sqrt((K + 4G/3)/rho) [m/s], out
 damage : float64[:]          (N,) scalar damage, in/out
 hist   : float64[:, :]       (N, nh) history variables, in/out
 params : float64[:]          packed parameters (``MaterialModel.pack``)
+size   : float64[:]          (N,) particle size V0^(1/dim) [m] (fracture-energy
+                             regularisation; unused by elastic and j2)
 """
 
 

@@ -85,7 +85,7 @@ def elastic_point(sig, deps, K, G):
 
 
 @njit(cache=True, parallel=True)
-def elastic_update(idx, L, dt, rho, sig, e, c, damage, hist, params):
+def elastic_update(idx, L, dt, rho, sig, e, c, damage, hist, params, size):
     """Group kernel of the hypoelastic model (common kernel signature).
 
     For each ``i`` in ``idx``: ``D, W`` from ``L[i]``; Jaumann rotation

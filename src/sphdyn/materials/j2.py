@@ -129,7 +129,7 @@ def j2_point(sig, deps, K, G, sigma_y, H, eps_p):
 
 
 @njit(cache=True, parallel=True)
-def j2_update(idx, L, dt, rho, sig, e, c, damage, hist, params):
+def j2_update(idx, L, dt, rho, sig, e, c, damage, hist, params, size):
     """Group kernel of the J2 model (common kernel signature).
 
     For each ``i`` in ``idx``: Jaumann rotation, :func:`j2_return` with
