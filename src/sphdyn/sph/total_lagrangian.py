@@ -1,0 +1,292 @@
+r"""Total-Lagrangian SPH passes (the thesis's "Lagrangian kernel", sec. 2.2.1).
+
+Neighbours and kernel gradients are fixed in the reference configuration
+:math:`\mathbf X` (the initial positions), so the kernel deforms with the
+material and the tensile instability of the updated-Lagrangian kernel cannot
+occur (thesis sec. 3.2; Belytschko et al. 2000; Ganzenmüller 2015).
+Notation: :math:`\mathbf g_{ij} = \nabla_{X_i} W(\mathbf X_i - \mathbf X_j,
+h_{ij})`, reference volumes :math:`V_j = m_j / \rho_{0j}` and the reference
+correction matrix
+
+.. math:: B_i = \Big[\sum_j V_j (\mathbf X_j - \mathbf X_i) \otimes
+          \mathbf g_{ij}\Big]^{-T},
+
+so that :math:`\tilde{\mathbf g}_{ij} = B_i \mathbf g_{ij}` differentiates
+linear fields exactly. Everything reference-related is computed once by
+:func:`reference_gradients`.
+
+References
+----------
+Ganzenmüller (2015), An hourglass control algorithm for Lagrangian Smooth
+Particle Hydrodynamics, CMAME 286, 87-106.
+Bonet & Lok (1999), CMAME 180, 97-115 (corrected gradients).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from ..kernels import dwdq_over_q, kernel_value, support_nb
+
+_DET_TOL = 1e-12
+
+
+@njit(cache=True)
+def _inverse3(a00, a01, a02, a10, a11, a12, a20, a21, a22, out):
+    """Inverse of a 3x3 matrix into ``out`` (3, 3); identity if singular."""
+    c00 = a11 * a22 - a12 * a21
+    c01 = a02 * a21 - a01 * a22
+    c02 = a01 * a12 - a02 * a11
+    det = a00 * c00 + a10 * c01 + a20 * c02
+    if abs(det) < _DET_TOL:
+        for r in range(3):
+            for s in range(3):
+                out[r, s] = 1.0 if r == s else 0.0
+        return 0.0
+    inv = 1.0 / det
+    out[0, 0] = c00 * inv
+    out[0, 1] = c01 * inv
+    out[0, 2] = c02 * inv
+    out[1, 0] = (a12 * a20 - a10 * a22) * inv
+    out[1, 1] = (a00 * a22 - a02 * a20) * inv
+    out[1, 2] = (a02 * a10 - a00 * a12) * inv
+    out[2, 0] = (a10 * a21 - a11 * a20) * inv
+    out[2, 1] = (a01 * a20 - a00 * a21) * inv
+    out[2, 2] = (a00 * a11 - a01 * a10) * inv
+    return det
+
+
+@njit(cache=True, parallel=True)
+def reference_gradients(X, h0, vol, offsets, idx, kid, sigma, dim, kscale, g, w, B0):
+    r"""Reference kernel gradients, kernel values and correction matrices.
+
+    Parameters
+    ----------
+    X : (N, 3) reference positions [m].
+    h0 : (N,) reference smoothing lengths [m].
+    vol : (N,) reference volumes m / rho0 [m^dim] (0 for zero-mass particles).
+    offsets, idx : the fixed (reference) CSR neighbour list.
+    kid, sigma, dim, kscale : kernel id, normalisation, dimension, support scale.
+    g : (nnz, 3) out, :math:`\nabla_{X_i} W_{ij}` [1/m^(d+1)].
+    w : (nnz,) out, :math:`W_{ij}` [1/m^d] (for hourglass control).
+    B0 : (N, 3, 3) out, correction matrices :math:`B_i` (identity where the
+        neighbourhood is degenerate; z row/column identity in 2D).
+    """
+    n = X.shape[0]
+    qmax = support_nb(kid)
+    for i in prange(n):
+        m00 = m01 = m02 = m10 = m11 = m12 = m20 = m21 = m22 = 0.0
+        for k in range(offsets[i], offsets[i + 1]):
+            j = idx[k]
+            d0 = X[i, 0] - X[j, 0]
+            d1 = X[i, 1] - X[j, 1]
+            d2 = X[i, 2] - X[j, 2]
+            r = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            hij = kscale * 0.5 * (h0[i] + h0[j])
+            if r >= qmax * hij:
+                g[k, 0] = g[k, 1] = g[k, 2] = 0.0
+                w[k] = 0.0
+                continue
+            ih = 1.0 / hij
+            f = sigma * ih ** (dim + 2) * dwdq_over_q(kid, r * ih)
+            g[k, 0] = f * d0
+            g[k, 1] = f * d1
+            g[k, 2] = f * d2
+            w[k] = kernel_value(kid, sigma, dim, r, hij)
+            vj = vol[j]
+            # (X_j - X_i) = -d
+            m00 -= vj * d0 * g[k, 0]
+            m01 -= vj * d0 * g[k, 1]
+            m02 -= vj * d0 * g[k, 2]
+            m10 -= vj * d1 * g[k, 0]
+            m11 -= vj * d1 * g[k, 1]
+            m12 -= vj * d1 * g[k, 2]
+            m20 -= vj * d2 * g[k, 0]
+            m21 -= vj * d2 * g[k, 1]
+            m22 -= vj * d2 * g[k, 2]
+        if dim == 2:
+            m02 = m12 = m20 = m21 = 0.0
+            m22 = 1.0
+        inv = np.empty((3, 3))
+        _inverse3(m00, m01, m02, m10, m11, m12, m20, m21, m22, inv)
+        for a in range(3):
+            for b in range(3):
+                B0[i, a, b] = inv[b, a]  # B = M^{-T}
+
+
+@njit(cache=True, parallel=True)
+def deformation_gradient(x, v, vol, offsets, idx, g, B0, dim, Fdef, Finv, L):
+    r"""Deformation gradient and velocity gradient from the reference kernel.
+
+    .. math::
+        F_i = \sum_j V_j (\mathbf x_j - \mathbf x_i) \otimes \tilde{\mathbf g}_{ij},
+        \qquad
+        \dot F_i = \sum_j V_j (\mathbf v_j - \mathbf v_i) \otimes
+                   \tilde{\mathbf g}_{ij},
+        \qquad L_i = \dot F_i F_i^{-1}
+
+    (exact for linear motions thanks to :math:`B_i`). ``Fdef``, ``Finv``
+    (its inverse) and ``L`` (N, 3, 3) out; in 2D ``F_zz = 1``. ``L`` feeds the
+    same material kernels as the updated-Lagrangian scheme (Jaumann update of
+    the Cauchy stress). No allocation: ``L`` holds :math:`\dot F` until the
+    product is formed row by row.
+    """
+    n = x.shape[0]
+    for i in prange(n):
+        for a in range(3):
+            for b in range(3):
+                Fdef[i, a, b] = 0.0
+                L[i, a, b] = 0.0
+        for k in range(offsets[i], offsets[i + 1]):
+            j = idx[k]
+            vj = vol[j]
+            if vj == 0.0:
+                continue
+            gt0 = B0[i, 0, 0] * g[k, 0] + B0[i, 0, 1] * g[k, 1] + B0[i, 0, 2] * g[k, 2]
+            gt1 = B0[i, 1, 0] * g[k, 0] + B0[i, 1, 1] * g[k, 1] + B0[i, 1, 2] * g[k, 2]
+            gt2 = B0[i, 2, 0] * g[k, 0] + B0[i, 2, 1] * g[k, 1] + B0[i, 2, 2] * g[k, 2]
+            for a in range(3):
+                dx = vj * (x[j, a] - x[i, a])
+                dv = vj * (v[j, a] - v[i, a])
+                Fdef[i, a, 0] += dx * gt0
+                Fdef[i, a, 1] += dx * gt1
+                Fdef[i, a, 2] += dx * gt2
+                L[i, a, 0] += dv * gt0
+                L[i, a, 1] += dv * gt1
+                L[i, a, 2] += dv * gt2
+        if dim == 2:
+            Fdef[i, 0, 2] = Fdef[i, 1, 2] = Fdef[i, 2, 0] = Fdef[i, 2, 1] = 0.0
+            Fdef[i, 2, 2] = 1.0
+            L[i, 0, 2] = L[i, 1, 2] = L[i, 2, 0] = L[i, 2, 1] = L[i, 2, 2] = 0.0
+        det = _inverse3(Fdef[i, 0, 0], Fdef[i, 0, 1], Fdef[i, 0, 2], Fdef[i, 1, 0],
+                        Fdef[i, 1, 1], Fdef[i, 1, 2], Fdef[i, 2, 0], Fdef[i, 2, 1],
+                        Fdef[i, 2, 2], Finv[i])
+        for a in range(3):
+            t0 = L[i, a, 0]
+            t1 = L[i, a, 1]
+            t2 = L[i, a, 2]
+            for b in range(3):
+                if det != 0.0:
+                    L[i, a, b] = t0 * Finv[i, 0, b] + t1 * Finv[i, 1, b] + t2 * Finv[i, 2, b]
+                else:
+                    L[i, a, b] = 0.0
+
+
+@njit(cache=True, parallel=True)
+def piola_stress(Fdef, Finv, sig, P):
+    r"""First Piola-Kirchhoff stress :math:`P = J \sigma F^{-T}`, :math:`J = \det F`.
+
+    ``Fdef``, ``Finv`` (from :func:`deformation_gradient`), ``sig`` (Cauchy,
+    tension positive), ``P`` (N, 3, 3) [Pa].
+    """
+    for i in prange(Fdef.shape[0]):
+        det = (Fdef[i, 0, 0] * (Fdef[i, 1, 1] * Fdef[i, 2, 2] - Fdef[i, 1, 2] * Fdef[i, 2, 1])
+               - Fdef[i, 0, 1] * (Fdef[i, 1, 0] * Fdef[i, 2, 2] - Fdef[i, 1, 2] * Fdef[i, 2, 0])
+               + Fdef[i, 0, 2] * (Fdef[i, 1, 0] * Fdef[i, 2, 1] - Fdef[i, 1, 1] * Fdef[i, 2, 0]))
+        for a in range(3):
+            for b in range(3):
+                P[i, a, b] = det * (sig[i, a, 0] * Finv[i, b, 0] + sig[i, a, 1] * Finv[i, b, 1]
+                                    + sig[i, a, 2] * Finv[i, b, 2])
+
+
+@njit(cache=True, parallel=True)
+def tl_forces(x, X, m, rho0, vol, offsets, idx, g, w, B0, P, Fdef, young, hg_alpha,
+              a):
+    r"""Acceleration of the total-Lagrangian scheme with hourglass control.
+
+    Momentum balance :math:`\rho_0 \dot{\mathbf v} = \nabla_X\cdot P` in the
+    antisymmetric (momentum-conserving) pair form
+
+    .. math::
+        \dot{\mathbf v}_i = \frac{1}{\rho_{0i}} \sum_j V_j
+            \big(P_i B_i + P_j B_j\big)\, \mathbf g_{ij}
+            + \frac{\mathbf f^{hg}_i}{m_i},
+
+    and Ganzenmüller's (2015) hourglass force, which penalises the part of the
+    pair separation not predicted by the particles' own deformation gradients:
+    with :math:`\mathbf X_{ij} = \mathbf X_j - \mathbf X_i`,
+    :math:`\mathbf x_{ij} = \mathbf x_j - \mathbf x_i`,
+    :math:`\delta^i_{ij} = (F_i \mathbf X_{ij} - \mathbf x_{ij})\cdot\hat{\mathbf x}_{ij}`
+    and :math:`\delta^j_{ij} = (F_j \mathbf X_{ij} - \mathbf x_{ij})\cdot\hat{\mathbf x}_{ij}`,
+
+    .. math::
+        \mathbf f^{hg}_i = -\frac{\alpha}{2} \sum_j
+            \frac{V_i V_j W_{ij} \bar E_{ij}}{|\mathbf X_{ij}|^2}
+            (\delta^i_{ij} + \delta^j_{ij})\, \hat{\mathbf x}_{ij}.
+
+    It vanishes for every linear deformation and is antisymmetric in the pair.
+
+    Parameters
+    ----------
+    x, X : (N, 3) current and reference positions [m].
+    m, rho0, vol : (N,) mass [kg], reference density, reference volume m/rho0.
+    g, w, B0 : from :func:`reference_gradients`.
+    P, Fdef : (N, 3, 3) first Piola-Kirchhoff stress [Pa], deformation gradient.
+    young : (N,) Young's modulus for the hourglass stiffness [Pa].
+    hg_alpha : float, hourglass coefficient (0 = off; Ganzenmüller uses 10-50).
+    a : (N, 3) out, acceleration [m/s^2].
+    """
+    n = x.shape[0]
+    for i in prange(n):
+        a0 = a1 = a2 = 0.0
+        h0 = h1 = h2 = 0.0
+        for k in range(offsets[i], offsets[i + 1]):
+            j = idx[k]
+            vj = vol[j]
+            if vj == 0.0:
+                continue
+            gk0 = g[k, 0]
+            gk1 = g[k, 1]
+            gk2 = g[k, 2]
+            if gk0 == 0.0 and gk1 == 0.0 and gk2 == 0.0:
+                continue
+            # c = (P_i B_i + P_j B_j) g
+            for r in range(3):
+                s = 0.0
+                for c in range(3):
+                    bi = B0[i, c, 0] * gk0 + B0[i, c, 1] * gk1 + B0[i, c, 2] * gk2
+                    bj = B0[j, c, 0] * gk0 + B0[j, c, 1] * gk1 + B0[j, c, 2] * gk2
+                    s += P[i, r, c] * bi + P[j, r, c] * bj
+                if r == 0:
+                    a0 += vj * s
+                elif r == 1:
+                    a1 += vj * s
+                else:
+                    a2 += vj * s
+            if hg_alpha > 0.0:
+                X0 = X[j, 0] - X[i, 0]
+                X1 = X[j, 1] - X[i, 1]
+                X2 = X[j, 2] - X[i, 2]
+                x0 = x[j, 0] - x[i, 0]
+                x1 = x[j, 1] - x[i, 1]
+                x2 = x[j, 2] - x[i, 2]
+                rx = np.sqrt(x0 * x0 + x1 * x1 + x2 * x2)
+                rX2 = X0 * X0 + X1 * X1 + X2 * X2
+                if rx == 0.0 or rX2 == 0.0:
+                    continue
+                e0 = x0 / rx
+                e1 = x1 / rx
+                e2 = x2 / rx
+                di = 0.0
+                dj = 0.0
+                for r in range(3):
+                    er = e0 if r == 0 else (e1 if r == 1 else e2)
+                    xr = x0 if r == 0 else (x1 if r == 1 else x2)
+                    pi = Fdef[i, r, 0] * X0 + Fdef[i, r, 1] * X1 + Fdef[i, r, 2] * X2
+                    pj = Fdef[j, r, 0] * X0 + Fdef[j, r, 1] * X1 + Fdef[j, r, 2] * X2
+                    di += (pi - xr) * er
+                    dj += (pj - xr) * er
+                coef = -0.5 * hg_alpha * vol[i] * vj * w[k] * 0.5 * (
+                    young[i] + young[j]) / rX2 * (di + dj)
+                h0 += coef * e0
+                h1 += coef * e1
+                h2 += coef * e2
+        inv_rho0 = 1.0 / rho0[i]
+        a[i, 0] = a0 * inv_rho0
+        a[i, 1] = a1 * inv_rho0
+        a[i, 2] = a2 * inv_rho0
+        if m[i] > 0.0:
+            a[i, 0] += h0 / m[i]
+            a[i, 1] += h1 / m[i]
+            a[i, 2] += h2 / m[i]
