@@ -149,3 +149,19 @@ def test_uniform_stress_gives_zero_interior_force():
     scale = 2e6 / (2000.0 * 0.01)
     assert np.abs(a[inner]).max() < 1e-9 * scale
     assert np.abs(a).max() > 0.1 * scale
+
+
+def test_same_body_pairs_keeps_only_pairs_inside_each_body():
+    from sphdyn.neighbours import brute_force_neighbours
+    from sphdyn.sph.tl_scheme import same_body_pairs
+
+    rng = np.random.default_rng(2)
+    x = rng.uniform(0, 1, (200, 3))
+    x[:, 2] = 0
+    body = (x[:, 0] > 0.5).astype(np.int32)
+    h = np.full(200, 0.05)
+    off, idx = brute_force_neighbours(x, h, 2.0, 0.0, 2)
+    o2, i2 = same_body_pairs(off, idx, body)
+    for i in range(200):
+        row = idx[off[i]:off[i + 1]]
+        assert np.array_equal(i2[o2[i]:o2[i + 1]], row[body[row] == body[i]])
