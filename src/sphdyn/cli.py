@@ -1,4 +1,4 @@
-"""Command line: ``sphdyn run|check|restart|plot|export|info|bench``.
+"""Command line: ``sphdyn run|check|restart|plot|export|info|bench|material-test``.
 
 Each subcommand is a thin function over the Python API. Exit codes: 0 success,
 1 a failed run (guard stopped it; all output kept), 2 bad input (deck or
@@ -142,6 +142,55 @@ def cmd_bench(args) -> int:
     return 0
 
 
+def _param_value(text: str):
+    """``true``/``false`` -> bool, else a float (SI units)."""
+    low = text.strip().lower()
+    if low in ("true", "false"):
+        return low == "true"
+    return float(text)
+
+
+def cmd_material_test(args) -> int:
+    from .materials import get_model  # noqa: F401  (registers the models)
+    from .materials.driver import drive
+
+    _threads(args.threads or 1)
+    params = {}
+    name = args.model
+    if args.deck:
+        from .deck import load_deck
+
+        deck = load_deck(args.deck, None)
+        mats = {m.name: m for m in deck.material}
+        if args.material not in mats:
+            raise ValueError(f"--material: the deck has no material {args.material!r}; "
+                             f"materials: {', '.join(mats)}")
+        mat = mats[args.material]
+        params = {k: v for k, v in mat.model_dump().items()
+                  if k not in ("name", "model") and v is not None}
+        if name and name != mat.model:
+            raise ValueError(f"MODEL {name!r} differs from the deck material's "
+                             f"model {mat.model!r}")
+        name = mat.model
+    if not name:
+        raise ValueError("give MODEL or --deck DECK --material NAME")
+    for item in args.param or []:
+        key, sep, value = item.partition("=")
+        if not sep:
+            raise ValueError(f"--param {item!r}: write KEY=VALUE (SI units)")
+        params[key.strip()] = _param_value(value)
+    res = drive(name, params, args.path, strain=args.strain, rate=args.rate,
+                n_steps=args.steps, confinement=args.confinement, size=args.size,
+                out=args.out)
+    y = res["y"]
+    k = int(abs(y).argmax())
+    print(json.dumps({"model": name, "path": args.path, "peak_stress_Pa": float(y[k]),
+                      "at_strain": float(res["x"][k]),
+                      "final_damage": float(res["damage"][-1]),
+                      "files": [str(f) for f in res["files"]]}))
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="sphdyn", description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="command", required=True)
@@ -203,6 +252,29 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--threads", type=int, default=0)
     b.add_argument("--particles", type=int, help="block3d: approximate particle count")
     b.set_defaults(func=cmd_bench)
+    mt = sub.add_parser("material-test", help="drive one material point along a load "
+                        "path; CSV + plot into --out")
+    mt.add_argument("model", nargs="?", help="registered model (elastic, j2, cscm, ...)")
+    mt.add_argument("--param", action="append", metavar="KEY=VALUE",
+                    help="material value in SI units (repeatable), e.g. density=2400 "
+                    "fc=43.1e6 aggregate_size=0.008 rate_effects=true")
+    mt.add_argument("--deck", help="take the material from this deck ...")
+    mt.add_argument("--material", help="... with this name")
+    mt.add_argument("--path", default="uniaxial-compression",
+                    choices=("uniaxial-compression", "uniaxial-tension", "hydrostatic",
+                             "triaxial", "shear", "cyclic"))
+    mt.add_argument("--rate", type=float, default=1e-5,
+                    help="controlling strain rate [1/s] (default 1e-5)")
+    mt.add_argument("--strain", type=float, help="controlling strain magnitude "
+                    "(default per path)")
+    mt.add_argument("--steps", type=int, default=400, help="load steps (default 400)")
+    mt.add_argument("--confinement", type=float, default=0.0,
+                    help="triaxial confining pressure [Pa]")
+    mt.add_argument("--size", type=float, default=0.01,
+                    help="particle size for fracture-energy regularisation [m]")
+    mt.add_argument("--out", default="out/material-test", help="output directory")
+    mt.add_argument("--threads", type=int, default=1)
+    mt.set_defaults(func=cmd_material_test)
     return ap
 
 

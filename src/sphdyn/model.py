@@ -117,6 +117,9 @@ def build_model(deck) -> Model:
     kb = np.zeros(particles.n)
     for g in groups:
         kb[g.idx] = g.model.bulk_modulus(g.params)
+        h0 = g.model.initial_history(g.params)
+        if len(h0):
+            particles.hist[np.ix_(g.idx, np.arange(len(h0)))] = h0
 
     body_index = {b.name: k for k, b in enumerate(deck.body)}
     sets: dict[str, np.ndarray] = {}

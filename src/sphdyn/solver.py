@@ -11,8 +11,12 @@ v^{n-1/2},\\ \\sigma^n,\\ \\mathbf a^n`):
 4. neighbour list update (only when the Verlet skin is exhausted);
 5. velocity gradient, density and smoothing length, material update
    (:math:`\\sigma^{n+1}`, internal energy);
-6. stress divergence and artificial viscosity, then contact, giving
-   :math:`\\mathbf a^{n+1}`.
+6. stress divergence and artificial viscosity (plus the artificial stress
+   of :mod:`sphdyn.sph.artificial_stress` when ``epsilon > 0``), then
+   contact, giving :math:`\\mathbf a^{n+1}`;
+7. Swegle indicator of the new state (:mod:`sphdyn.sph.swegle`), reported
+   as the output field ``swegle`` and the history column
+   ``swegle_unstable``.
 """
 
 from __future__ import annotations
@@ -25,8 +29,11 @@ from .integrate import add_heat, cfl_time_step, drift, internal_energies, kick
 from .model import Model
 from .probes import record as probe_record
 from .neighbours import build_neighbours, update_neighbours
+from .sph.artificial_stress import artificial_stress_forces, artificial_stress_tensor
 from .sph.passes import (forces, particle_volumes, scaled_stress,
                          update_density_and_h, velocity_gradient, xsph_velocity)
+from .sph.swegle import (FLAG_FRACTION, REL_STRESS_TOL, count_unstable, stress_scale,
+                         swegle_indicator)
 
 
 class Solver:
@@ -58,6 +65,20 @@ class Solver:
         self.collapse_ratio = deck.time.collapse_ratio
         n = p.n
         self.B = np.zeros((n, 3, 3))
+        # artificial stress (Monaghan 2000): R/rho^2 and principal-axis work array
+        self.as_eps = sph.artificial_stress.epsilon
+        self.as_n = sph.artificial_stress.n
+        self.R = np.zeros((n, 3, 3)) if self.as_eps > 0 else None
+        self.Q = np.zeros((n, 3, 3)) if self.as_eps > 0 else None
+        self.spacing = p.vol0 ** (1.0 / p.dim) if n else np.zeros(0)  # initial dx [m]
+        # Swegle indicator per particle, evaluated on demand (history records
+        # kept by the Simulation, output frames); the particles get a handle
+        # so that sphdyn.io.fields can write the field ``swegle``
+        self.history_every = deck.output.history_every
+        self.swegle = np.zeros(n)
+        self.swegle_unstable = 0
+        self._swegle_step = -1
+        p.swegle_indicator = self.swegle_field
         self.S = np.zeros((n, 3, 3))
         self.vol = np.zeros(n)
         self.size = p.vol0 ** (1.0 / p.dim)  # particle size for regularisation [m]
@@ -115,6 +136,11 @@ class Solver:
         forces(p.x, p.v, p.m, p.rho, p.h, p.c, self.S, self.B, self.F, nl.offsets,
                nl.idx, self.dim, self.kscale, self.correct, self.alpha, self.beta, p.a,
                self.dedt_av)
+        if self.R is not None:
+            artificial_stress_tensor(p.sig, p.rho, self.as_eps, self.R, self.Q)
+            artificial_stress_forces(p.x, p.m, p.h, self.R, self.F, nl.offsets, nl.idx,
+                                     self.kid, self.dim, self.kscale, self.spacing,
+                                     self.as_n, p.a)
         self.a_contact[:] = 0.0
         for w in self.model.walls:
             cnt = wall_contact(p.x, p.v, p.m, p.vol0, p.rho, w.kbulk, self.dim, w.point,
@@ -123,6 +149,22 @@ class Solver:
             self.wall_counts[w.name] = int(cnt)
             self.wall_totals[w.name] = self.wall_force.sum(axis=0)
         p.a += self.a_contact
+
+    def swegle_field(self) -> np.ndarray:
+        """Swegle indicator (N,) of the current state (see :mod:`sphdyn.sph.swegle`).
+
+        Computed at most once per step; also updates ``swegle_unstable``, the
+        number of particles with more than ``FLAG_FRACTION`` unstable pairs.
+        Returns the solver's array (not a copy).
+        """
+        if self._swegle_step != self.step_count:
+            p, nl = self.p, self.nl
+            tol = REL_STRESS_TOL * stress_scale(p.sig, p.m)
+            swegle_indicator(p.x, p.m, p.h, p.sig, nl.offsets, nl.idx, self.kid,
+                             self.sigma, self.dim, self.kscale, tol, self.swegle)
+            self.swegle_unstable = int(count_unstable(self.swegle, p.m, FLAG_FRACTION))
+            self._swegle_step = self.step_count
+        return self.swegle
 
     # ------------------------------------------------------------------- step
     def step(self, t_stop: float | None = None) -> dict:
@@ -140,7 +182,9 @@ class Solver:
                           self.vmean)
         self.work_contact += wc
         self.work_external += we
-        record = self.energies(ke, dt)
+        # the Simulation keeps the records of steps 0, every, 2 every, ...
+        record = self.energies(ke, dt,
+                               swegle=self.step_count % self.history_every == 0)
 
         nl = self.nl
         if self.vs is not None:
@@ -166,8 +210,15 @@ class Solver:
                         self.guard_work)
         return record
 
-    def energies(self, kinetic: float, dt: float) -> dict:
-        """Energy balance at the last kick (J, J/m in 2D) and the step ``dt`` [s]."""
+    def energies(self, kinetic: float, dt: float, swegle: bool = True) -> dict:
+        """Energy balance at the last kick (J, J/m in 2D) and the step ``dt`` [s].
+
+        ``swegle_unstable`` is the number of particles flagged by the Swegle
+        criterion in the current state (re-evaluated only if ``swegle``; else
+        the last value).
+        """
+        if swegle:
+            self.swegle_field()
         ie, iav = internal_energies(self.p.m, self.p.e, self.p.e_av)
         e_contact = -self.work_contact
         rec = {
@@ -175,6 +226,7 @@ class Solver:
             "E_kinetic": kinetic, "E_internal": ie, "E_viscous": iav,
             "E_contact": e_contact, "W_external": self.work_external,
             "E_total": kinetic + ie + e_contact - self.work_external,
+            "swegle_unstable": float(self.swegle_unstable),
         }
         for w in self.model.walls:
             f = self.wall_totals[w.name]
@@ -214,6 +266,7 @@ class Solver:
         self.nl.idx = arrays["nl_idx"].copy()
         self.nl.x_ref = arrays["nl_x_ref"].copy()
         self.nl.h_ref = arrays["nl_h_ref"].copy()
+        self._swegle_step = -1
         # wall totals at the restored state (forces depend on x, v, dt only)
         for w in self.model.walls:
             self.wall_force[:] = 0.0

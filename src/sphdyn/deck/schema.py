@@ -34,7 +34,7 @@ from .units import (DENSITY, LENGTH, PRESSURE, TIME, VELOCITY, Dimension,
 ALLOWED_FIELDS: list[str] = [
     "velocity", "displacement", "stress", "pressure", "von_mises", "density",
     "mass", "smoothing_length", "damage", "internal_energy", "plastic_strain",
-    "bc", "body", "material", "neighbours",
+    "bc", "body", "material", "neighbours", "swegle",
 ]
 
 DEFAULT_FIELDS = ("velocity", "displacement", "stress", "pressure", "von_mises",
@@ -397,6 +397,18 @@ class Neighbours(Section):
                           "moved half the skin.")
 
 
+class ArtificialStress(Section):
+    """[sph.artificial_stress]: Monaghan (2000) artificial stress."""
+
+    epsilon: real("artificial-stress factor", lo=0) = Field(
+        0.0, description="epsilon: the repulsive stress is -epsilon times the "
+                         "tensile principal stresses (0 = off; Gray et al. "
+                         "2001 use 0.3). See docs/tensile-instability.md.")
+    n: real("artificial-stress exponent", lo=0, lo_open=True) = Field(
+        4.0, description="Exponent n of f = W(r)/W(dx) (Gray et al. 2001 "
+                         "use 4).")
+
+
 class Sph(Section):
     """[sph]: discretisation."""
 
@@ -426,6 +438,9 @@ class Sph(Section):
         description="Evolution of the smoothing length.")
     neighbours: Neighbours = Field(default_factory=Neighbours,
                                    description="Neighbour search.")
+    artificial_stress: ArtificialStress = Field(
+        default_factory=ArtificialStress,
+        description="Artificial stress against the tensile instability.")
 
 
 class Time(Section):
@@ -539,7 +554,124 @@ class J2(Elastic):
                          "(0 = perfect plasticity).")
 
 
-Material = Annotated[Union[Elastic, J2], Field(discriminator="model")]
+def _cscm_override(noun: str, dim: Any = None, **bounds: Any) -> Any:
+    """Optional CSCM override: a quantity (with ``dim``) or a plain SI number."""
+    kind = quantity(dim, noun, **bounds) if dim is not None else real(noun, **bounds)
+    return Optional[kind]
+
+
+class Cscm(Section):
+    """[[material]] model = "cscm": concrete, Continuous Surface Cap Model.
+
+    Re-implementation of LS-DYNA *MAT_CSCM_CONCRETE (MAT_159, Murray 2007,
+    FHWA-HRT-05-062); every parameter is generated from fc and
+    aggregate_size (the "short form") unless given explicitly. Numbers
+    without units are SI (pascals, metres, J/m^2, seconds); see
+    docs/cscm.md for the equations and the parameter table.
+    """
+
+    name: name_of("material") = Field(
+        description="Name that bodies use to refer to the material.")
+    model: Literal["cscm"] = Field(description="Constitutive model.")
+    density: quantity(DENSITY, lo=0, lo_open=True) = Field(
+        description="Initial mass density (never generated).")
+    fc: PositivePressure = Field(
+        30e6, description="Unconfined compression strength f'c (LS-DYNA "
+                          "FPC; defaults are fitted for 20-58 MPa).")
+    aggregate_size: PositiveLength = Field(
+        0.019, description="Maximum aggregate size (LS-DYNA DAGG); enters "
+                           "the default fracture energies.")
+    K: Optional[PositivePressure] = Field(
+        None, description="Bulk modulus (default from fc, nu = 0.15).")
+    G: Optional[PositivePressure] = Field(
+        None, description="Shear modulus (default from fc, nu = 0.15).")
+    alpha: _cscm_override("TXC constant", PRESSURE) = Field(
+        None, description="TXC shear surface: constant term alpha.")
+    theta: _cscm_override("TXC linear term") = Field(
+        None, description="TXC shear surface: linear term theta [-].")
+    lamda: _cscm_override("TXC exponential term", PRESSURE) = Field(
+        None, description="TXC shear surface: exponential term lambda.")
+    beta: _cscm_override("TXC exponent", lo=0) = Field(
+        None, description="TXC shear surface: exponent beta [1/Pa].")
+    alpha1: _cscm_override("Q1 constant") = Field(
+        None, description="TOR/TXC ratio Q1: constant term [-].")
+    theta1: _cscm_override("Q1 linear term") = Field(
+        None, description="TOR/TXC ratio Q1: linear term [1/Pa].")
+    lamda1: _cscm_override("Q1 exponential term") = Field(
+        None, description="TOR/TXC ratio Q1: exponential term [-].")
+    beta1: _cscm_override("Q1 exponent", lo=0) = Field(
+        None, description="TOR/TXC ratio Q1: exponent [1/Pa].")
+    alpha2: _cscm_override("Q2 constant") = Field(
+        None, description="TXE/TXC ratio Q2: constant term [-].")
+    theta2: _cscm_override("Q2 linear term") = Field(
+        None, description="TXE/TXC ratio Q2: linear term [1/Pa].")
+    lamda2: _cscm_override("Q2 exponential term") = Field(
+        None, description="TXE/TXC ratio Q2: exponential term [-].")
+    beta2: _cscm_override("Q2 exponent", lo=0) = Field(
+        None, description="TXE/TXC ratio Q2: exponent [1/Pa].")
+    R: _cscm_override("cap aspect ratio", lo=0, lo_open=True) = Field(
+        None, description="Cap aspect ratio R [-].")
+    X0: _cscm_override("cap location", PRESSURE, lo=0, lo_open=True) = Field(
+        None, description="Initial cap location X0 (J1, compression positive).")
+    W: _cscm_override("compaction", lo=0, lo_open=True) = Field(
+        None, description="Maximum plastic volume compaction W [-].")
+    D1: _cscm_override("compaction shape", lo=0, lo_open=True) = Field(
+        None, description="Compaction law linear shape D1 [1/Pa].")
+    D2: _cscm_override("compaction shape", lo=0) = Field(
+        None, description="Compaction law quadratic shape D2 [1/Pa^2].")
+    B: _cscm_override("softening shape", lo=0, lo_open=True) = Field(
+        None, description="Ductile softening shape B [-] (default 100).")
+    D: _cscm_override("softening shape", lo=0, lo_open=True) = Field(
+        None, description="Brittle softening shape D [-] (default 0.1).")
+    GFC: _cscm_override("fracture energy", lo=0, lo_open=True) = Field(
+        None, description="Fracture energy in uniaxial compression [J/m^2] "
+                          "(default 100 GFT).")
+    GFT: _cscm_override("fracture energy", lo=0, lo_open=True) = Field(
+        None, description="Fracture energy in uniaxial tension [J/m^2] "
+                          "(default: CEB-type fit of fc and aggregate_size, "
+                          "unconfirmed, see docs/cscm.md).")
+    GFS: _cscm_override("fracture energy", lo=0, lo_open=True) = Field(
+        None, description="Fracture energy in pure shear [J/m^2] (default GFT).")
+    pwrc: _cscm_override("transition power", lo=0) = Field(
+        None, description="Shear-to-compression transition power (default 5).")
+    pwrt: _cscm_override("transition power", lo=0) = Field(
+        None, description="Shear-to-tension transition power (default 1).")
+    eta0c: _cscm_override("fluidity", lo=0) = Field(
+        None, description="Compression fluidity eta0c [s^(1-nc)].")
+    nc: _cscm_override("rate exponent", lo=0) = Field(
+        None, description="Compression fluidity exponent nc [-].")
+    eta0t: _cscm_override("fluidity", lo=0) = Field(
+        None, description="Tension fluidity eta0t [s^(1-nt)].")
+    nt: _cscm_override("rate exponent", lo=0) = Field(
+        None, description="Tension fluidity exponent nt [-].")
+    overc: _cscm_override("overstress", PRESSURE, lo=0) = Field(
+        None, description="Maximum overstress in compression.")
+    overt: _cscm_override("overstress", PRESSURE, lo=0) = Field(
+        None, description="Maximum overstress in tension.")
+    srate: _cscm_override("fluidity ratio", lo=0) = Field(
+        None, description="Shear-to-tension fluidity ratio (default 1).")
+    repow: _cscm_override("power", lo=0) = Field(
+        None, description="Power of the rate increase of fracture energy "
+                          "(default 1).")
+    rate_effects: StrictBool = Field(
+        False, description="Viscoplastic rate effects (LS-DYNA IRATE = 1); "
+                           "off by default as in LS-DYNA.")
+    erode: StrictBool = Field(
+        False, description="Erosion: a point with damage > 0.99 and maximum "
+                           "principal strain > erode_strain keeps its mass "
+                           "but carries no deviatoric or tensile stress.")
+    erode_strain: real("strain", lo=0) = Field(
+        0.05, description="Maximum principal strain for erosion (LS-DYNA "
+                          "ERODE - 1).")
+    recovery: real("recovery factor", lo=0, hi=1) = Field(
+        0.0, description="RECOV: 0 = modulus recovered in compression, 1 = "
+                         "brittle damage kept in compression.")
+    incre: Optional[real("strain increment", lo=0, lo_open=True)] = Field(
+        None, description="Maximum strain sub-increment (default a quarter "
+                          "of the zero-pressure shear yield strain).")
+
+
+Material = Annotated[Union[Elastic, J2, Cscm], Field(discriminator="model")]
 
 
 # Shapes ------------------------------------------------------------------

@@ -36,6 +36,9 @@ DERIVED_FIELDS: dict[str, str] = {
     "bc": "boundary-condition flag (int8), (N,)",
     "body": "body index (int32), (N,)",
     "material": "material index (int32), (N,)",
+    "swegle": "Swegle tensile-instability indicator: fraction of neighbour "
+              "pairs with W''(r) sigma_n > 0 (tension positive), in [0, 1]; "
+              "NaN without a solver; see docs/tensile-instability.md, (N,)",
 }
 
 
@@ -64,6 +67,11 @@ def _compute(p: "Particles", name: str) -> np.ndarray:
         return pressure(p.sig)
     if name == "von_mises":
         return von_mises(p.sig)
+    if name == "swegle":
+        # evaluated by the Solver advancing these particles
+        # (sphdyn.solver.Solver.swegle_field, attached as p.swegle_indicator)
+        fn = getattr(p, "swegle_indicator", None)
+        return fn().copy() if fn is not None else np.full(p.n, np.nan)
     simple = {"density": "rho", "mass": "m", "smoothing_length": "h",
               "damage": "damage", "internal_energy": "e", "bc": "bc",
               "body": "body", "material": "mat"}

@@ -3,7 +3,8 @@
 Every model provides a point function and a group kernel with the common
 signature ``update(idx, L, dt, rho, sig, e, c, damage, hist, params)``
 (see :mod:`sphdyn.materials.base`). Importing this package registers the
-built-in models ``"elastic"`` and ``"j2"``.
+built-in models ``"elastic"``, ``"j2"`` and ``"cscm"`` (concrete, LS-DYNA
+MAT_159 re-implementation, :mod:`sphdyn.materials.cscm`).
 """
 
 from .base import (
@@ -20,6 +21,7 @@ from .base import (
 )
 from .elastic import ELASTIC, elastic_point, elastic_update
 from .j2 import J2, j2_point, j2_update
+from .cscm import CSCM, cscm_point, cscm_update
 
 __all__ = [
     "KERNEL_SIGNATURE_DOC",
@@ -38,4 +40,7 @@ __all__ = [
     "J2",
     "j2_point",
     "j2_update",
+    "CSCM",
+    "cscm_point",
+    "cscm_update",
 ]

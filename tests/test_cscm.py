@@ -1,0 +1,364 @@
+"""CSCM concrete model (LS-DYNA MAT_159 re-implementation): defaults,
+surfaces, single-point paths, regularisation, rate effects, robustness.
+
+Reference values come from ``cscm-notes.md`` (sections cited per test) and
+the paper's Table 1 (f'c 43.10 MPa, G 12.92 GPa, K 14.15 GPa, GF 83.25 J/m2,
+dagg 8 mm). Stresses are tension positive; CSCM's J1 is compression positive.
+Tolerances are stated per test with the reason.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+import pytest
+
+from sphdyn.materials import cscm, get_model
+from sphdyn.materials.cscm_params import default_parameters, elastic_moduli
+from sphdyn.materials.driver import drive
+
+numba.set_num_threads(1)
+
+MPA = 1e6
+BASE = dict(density=2400.0, fc=43.1e6, aggregate_size=0.008)
+
+
+def packed(**kw):
+    return cscm.pack_cscm({**BASE, **kw})
+
+
+def post_peak_area(res):
+    """Area under |stress| vs |strain| from the peak on [Pa]."""
+    x, y = np.abs(res["x"]), np.abs(res["y"])
+    i = int(np.argmax(y))
+    return float(np.trapezoid(y[i:], x[i:]))
+
+
+# --------------------------------------------------------------------------
+# Defaults (notes sec. 2)
+# --------------------------------------------------------------------------
+
+
+def test_table1_moduli_within_0p2_percent():
+    # Table 1: G = 12.92 GPa, K = 14.15 GPa; the MAT_159 rule gives 12.931 /
+    # 14.162 (notes sec. 2.3: +0.08 %). 0.2 % is the brief's tolerance.
+    K, G = elastic_moduli(43.1e6)
+    assert abs(G / 12.92e9 - 1) < 2e-3
+    assert abs(K / 14.15e9 - 1) < 2e-3
+    E = 9 * K * G / (3 * K + G)
+    assert E == pytest.approx(18.275e9 * 4.31 ** (1 / 3), rel=1e-12)
+    assert (3 * K - 2 * G) / (2 * (3 * K + G)) == pytest.approx(0.15, rel=1e-12)
+
+
+def test_fracture_energy_default_as_in_notes():
+    # The notes (sec. 2.3) say the reconstructed CEB rule gives 69.51 J/m2 at
+    # dagg = 8 mm, NOT the paper's 83.25; the paper's value is reproduced
+    # (+0.2 %) with dagg = 16 mm. Both facts are checked; 0.05 % / 0.3 %
+    # cover the 4-5 digits quoted in the notes.
+    p8 = default_parameters(43.1e6, 0.008)
+    p16 = default_parameters(43.1e6, 0.016)
+    assert p8["GFT"] == pytest.approx(69.5143, rel=5e-4)
+    assert p16["GFT"] == pytest.approx(83.25, rel=3e-3)
+    assert abs(p8["GFT"] / 83.25 - 1) > 0.15
+    assert p8["GFS"] == p8["GFT"] and p8["GFC"] == pytest.approx(100 * p8["GFT"])
+
+
+def test_default_fits_match_notes_table():
+    # notes sec. 2.4 column fc = 43.1 (values printed with 5-6 digits).
+    p = default_parameters(43.1e6, 0.008)
+    assert p["alpha"] == pytest.approx(15.7935e6, rel=1e-5)
+    assert p["theta"] == pytest.approx(0.340048, rel=1e-5)
+    assert p["X0"] == pytest.approx(97.9804e6, rel=1e-5)
+    assert p["beta1"] == pytest.approx(0.0544121e-6, rel=1e-5)
+    assert p["eta0c"] == pytest.approx(0.000155972, rel=1e-4)
+    assert p["eta0t"] == pytest.approx(7.61419e-05, rel=1e-4)
+    assert p["overc"] == pytest.approx(28.8502e6, rel=1e-5)
+    assert cscm.kappa0(packed()) == pytest.approx(20.208e6, rel=1e-4)
+
+
+def test_overrides_and_unknown_names():
+    p = cscm.cscm_parameters({**BASE, "G": 10e9, "GFT": 100.0})
+    assert p["G"] == 10e9 and p["GFT"] == 100.0 and p["GFS"] == pytest.approx(69.5143, rel=5e-4)
+    with pytest.raises(ValueError, match="unknown parameter"):
+        default_parameters(43.1e6, 0.008, bogus=1.0)
+    with pytest.raises(ValueError, match="density"):
+        cscm.pack_cscm({"fc": 30e6})
+
+
+# --------------------------------------------------------------------------
+# Surfaces (notes sec. 1.4-1.7)
+# --------------------------------------------------------------------------
+
+
+def test_rubin_identities():
+    # notes sec. 1.6: R(TXC) = 1, R(TOR) = Q1, R(TXE) = Q2; at J1 = 30 MPa
+    # Q1 = 0.736563, Q2 = 0.656536. Closed-form algebra: 1e-12.
+    p = packed()
+    q1, q2 = cscm.rubin_q(30e6, p)
+    assert q1 == pytest.approx(0.736563, abs=1e-6)
+    assert q2 == pytest.approx(0.656536, abs=1e-6)
+    assert cscm.rubin_factor(q1, q2, math.pi / 6) == pytest.approx(1.0, abs=1e-12)
+    assert cscm.rubin_factor(q1, q2, 0.0) == pytest.approx(q1, abs=1e-12)
+    assert cscm.rubin_factor(q1, q2, -math.pi / 6) == pytest.approx(q2, abs=1e-12)
+    # tensile-pressure clamp: Q1 = 1/sqrt(3), Q2 = 1/2 for J1 <= 0
+    q1t, q2t = cscm.rubin_q(-5e6, p)
+    assert q1t == pytest.approx(1 / math.sqrt(3), abs=1e-4)
+    assert q2t == pytest.approx(0.5, abs=1e-12)
+
+
+def test_lode_angle_sign_convention():
+    # tension-positive uniaxial compression is TXC (+pi/6), tension TXE.
+    J1, r, b, _ = cscm.invariants((-10e6, 0.0, 0.0, 0.0, 0.0, 0.0))
+    assert J1 == pytest.approx(10e6) and b == pytest.approx(math.pi / 6, abs=1e-7)
+    J1, r, b, _ = cscm.invariants((10e6, 0.0, 0.0, 0.0, 0.0, 0.0))
+    assert J1 == pytest.approx(-10e6) and b == pytest.approx(-math.pi / 6, abs=1e-7)
+    J1, r, b, _ = cscm.invariants((0.0, 0.0, 0.0, 5e6, 0.0, 0.0))
+    assert b == pytest.approx(0.0, abs=1e-12) and r == pytest.approx(5e6)
+
+
+def test_dilogarithm():
+    # Li2(-1) = -pi^2/12; Li2(-100) from the inversion formula vs direct
+    # numerical integral -int_0^inf x/(e^x/B + 1) dx. 1e-10 / 1e-8.
+    assert cscm.dilog_neg(1.0) == pytest.approx(-math.pi ** 2 / 12, abs=1e-10)
+    x = np.linspace(0, 60, 200001)
+    ref = -np.trapezoid(x / (np.exp(x) / 100 + 1), x)
+    assert cscm.dilog_neg(100.0) == pytest.approx(ref, rel=1e-8)
+
+
+# --------------------------------------------------------------------------
+# Single-point paths
+# --------------------------------------------------------------------------
+
+
+def test_hydrostatic_compaction_law():
+    # notes sec. 1.7 / 3: elastic until P = X0/3, then
+    # ev = W [1 - exp(-D1 (X - X0) - D2 (X - X0)^2)] with X = 3P, -> W.
+    p = packed()
+    res = drive("cscm", BASE, "hydrostatic", strain=0.1, n_steps=1000)
+    P = res["y"]
+    ev = res["history"][:, res["history_names"].index("plastic_vol_strain")]
+    i = int(np.argmax(ev > 0))
+    # onset bracketed by the last elastic and first plastic sample
+    assert P[i - 1] <= p[cscm.P_X0] / 3 <= P[i]
+    # elastic part: P = K eps_v exactly (linear algebra, 1e-9)
+    assert P[i - 1] == pytest.approx(p[cscm.P_K] * res["x"][i - 1], rel=1e-9)
+    X = 3 * P[i:]
+    y = X - p[cscm.P_X0]
+    law = p[cscm.P_W] * (1 - np.exp(-p[cscm.P_D1] * y - p[cscm.P_D2] * y * y))
+    # explicit cap update: the cap lags one sub-increment (<= incre in
+    # strain, i.e. <= 3K incre in J1); 1e-4 absolute = 0.2 % of W covers it
+    assert np.max(np.abs(ev[i:] - law)) < 1e-4
+    assert 0.85 * p[cscm.P_W] < ev[-1] < p[cscm.P_W]
+    assert res["damage"].max() < 1e-6   # no damage on the hydrostat
+
+
+@pytest.mark.parametrize("fc, expected", [(28e6, 28.009e6), (43.1e6, 42.529e6)])
+def test_uniaxial_compression_peak(fc, expected):
+    # peak = first yield (no pre-peak hardening); notes sec. 2.4 f_uc:
+    # 28.009 / 42.529 MPa. Brief: within 2 % of f'c; the notes' first-yield
+    # value itself is checked to 0.1 % (driver step 2.5e-5 strain).
+    res = drive("cscm", {**BASE, "fc": fc}, "uniaxial-compression", strain=0.006,
+                n_steps=240)
+    peak = -res["y"].min()
+    assert abs(peak / fc - 1) < 0.02
+    assert peak == pytest.approx(expected, rel=1e-3)
+    # lateral stresses held at zero by the mixed control (tolerance 1e-9 K)
+    assert np.max(np.abs(res["stress"][:, 1:3])) < 1e-8 * 14.2e9
+
+
+def test_uniaxial_tension_peak_is_model_tensile_strength():
+    # f_ut from the yield surface along the UT line (bisection), notes sec.
+    # 2.4: 3.1074 MPa at 43.1. Driver step 1.5e-6 strain ~ 0.05 MPa, but the
+    # peak sample is the yield point itself (onset inside the step): 0.5 %.
+    p = packed()
+    lo, hi = 0.0, 10e6
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if cscm.yield_function((mid, 0, 0, 0, 0, 0), p[cscm.P_KAPPA0], p) > 0:
+            hi = mid
+        else:
+            lo = mid
+    assert lo == pytest.approx(3.1074e6, rel=1e-4)
+    res = drive("cscm", BASE, "uniaxial-tension", strain=4e-4, n_steps=270)
+    assert res["y"].max() == pytest.approx(lo, rel=5e-3)
+
+
+def test_pure_shear_peak():
+    # notes sec. 2.4 tau_sh = Q1(0) Ff(0) = 3.0562 MPa; 0.5 % (step size).
+    res = drive("cscm", BASE, "shear", strain=1e-3, n_steps=200)
+    assert np.max(np.abs(res["y"])) == pytest.approx(3.0562e6, rel=5e-3)
+
+
+@pytest.mark.parametrize("size", [0.005, 0.02])
+def test_tension_fracture_energy_regularised(size):
+    # L * area under the post-peak stress-strain curve = GFT within 5 % for
+    # two sizes 4x apart (notes sec. 1.10: C is derived for exactly this;
+    # the 0.1 % residual stress of d = 0.999 and sampling add ~1-2 %).
+    p = packed()
+    res = drive("cscm", BASE, "uniaxial-tension", strain=3e-4 / size, n_steps=2000,
+                size=size)
+    assert res["damage"][-1] > 0.998
+    assert size * post_peak_area(res) == pytest.approx(p[cscm.P_GFT], rel=0.05)
+
+
+@pytest.mark.parametrize("size", [0.005, 0.02])
+def test_compression_fracture_energy_regularised(size):
+    # same with GFC = 100 GFT in uniaxial compression (ductile law, A from
+    # the quadratic of notes sec. 1.10); 5 %.
+    p = packed()
+    res = drive("cscm", BASE, "uniaxial-compression", strain=1e-3 / size,
+                n_steps=1500, size=size)
+    assert res["damage"][-1] > 0.998
+    assert size * post_peak_area(res) == pytest.approx(p[cscm.P_GFC], rel=0.05)
+
+
+def test_softening_scales_with_size():
+    # C and A are proportional to L: a 2x larger particle softens over half
+    # the post-peak strain. Compare the strain beyond the peak at which
+    # d = 0.5 in tension (5 %: sampling of the peak strain).
+    s = []
+    for size in (0.01, 0.02):
+        r = drive("cscm", BASE, "uniaxial-tension", strain=0.01, n_steps=2000, size=size)
+        s.append(np.interp(0.5, r["damage"], r["x"]) - r["x"][np.argmax(r["y"])])
+    assert s[0] / s[1] == pytest.approx(2.0, rel=0.05)
+
+
+# --------------------------------------------------------------------------
+# Rate effects (notes sec. 1.11)
+# --------------------------------------------------------------------------
+
+
+def _shear_only_uc(p):
+    # uniaxial-compression strength of the fully expanded cap (Fc = 1):
+    # sigma/sqrt(3) = Ff(J1 = sigma), bisection.
+    lo, hi = 1e6, 500e6
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        if mid / math.sqrt(3) > cscm.shear_surface(mid, p):
+            hi = mid
+        else:
+            lo = mid
+    return lo
+
+
+@pytest.mark.parametrize("path", ["uniaxial-compression", "uniaxial-tension"])
+def test_rate_effects(path):
+    p = packed()
+    strain = 0.006 if path == "uniaxial-compression" else 0.002
+    rates = (1.0, 10.0, 100.0, 1000.0)
+    static = np.max(np.abs(drive("cscm", BASE, path, strain=strain, n_steps=300)["y"]))
+    # off by default: the rate does not matter (1e-6: only the round-off of
+    # L = deps/dt differs; the mixed-control tolerance is 1e-9 K ~ 3e-7 peak)
+    off = np.max(np.abs(drive("cscm", BASE, path, strain=strain, n_steps=300,
+                              rate=1000.0)["y"]))
+    assert off == pytest.approx(static, rel=1e-6)
+    peaks = [np.max(np.abs(drive("cscm", {**BASE, "rate_effects": True}, path,
+                                 strain=strain, n_steps=300, rate=r)["y"]))
+             for r in rates]
+    assert peaks[0] > static * 1.01
+    assert all(b > a for a, b in zip(peaks, peaks[1:]))
+    # overstress bound: |s_vp - s_P| <= OVER and the inviscid stress is at
+    # most the shear-surface strength (tension: the static f_ut, no cap)
+    bound = (_shear_only_uc(p) if path == "uniaxial-compression" else static) \
+        + p[cscm.P_OVERC]
+    assert max(peaks) <= bound * (1 + 1e-9)
+
+
+# --------------------------------------------------------------------------
+# Robustness
+# --------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("path, strain, probes", [
+    ("uniaxial-compression", 0.01, (0.002, 0.004, 0.008)),
+    ("uniaxial-tension", 0.03, (0.0005, 0.001, 0.003)),
+])
+def test_ten_times_larger_increments_agree(path, strain, probes):
+    # stress at fixed strains and the fracture energy within 1 % (of the
+    # peak stress / of GF) between 2000 and 200 driver steps.
+    fine = drive("cscm", BASE, path, strain=strain, n_steps=2000)
+    coarse = drive("cscm", BASE, path, strain=strain, n_steps=200)
+    peak = np.max(np.abs(fine["y"]))
+    for e in probes:
+        a = np.interp(e, np.abs(fine["x"]), np.abs(fine["y"]))
+        b = np.interp(e, np.abs(coarse["x"]), np.abs(coarse["y"]))
+        assert abs(a - b) < 0.01 * peak
+    assert post_peak_area(coarse) == pytest.approx(post_peak_area(fine), rel=0.01)
+
+
+@pytest.mark.parametrize("path", ["uniaxial-compression", "uniaxial-tension",
+                                  "hydrostatic", "triaxial", "shear", "cyclic"])
+def test_no_nan_on_any_path(path):
+    strain = {"uniaxial-compression": 0.05, "uniaxial-tension": 0.05,
+              "hydrostatic": 0.2, "triaxial": 0.05, "shear": 0.05, "cyclic": 0.05}[path]
+    for extra in ({}, {"rate_effects": True}):
+        res = drive("cscm", {**BASE, **extra}, path, strain=strain, n_steps=300,
+                    confinement=10e6, rate=100.0)
+        for key in ("stress", "strain", "damage", "history"):
+            assert np.all(np.isfinite(res[key])), key
+        assert np.all((res["damage"] >= 0) & (res["damage"] <= 1))
+    if path in ("uniaxial-compression", "uniaxial-tension"):
+        assert res["damage"][-1] > 0.99   # full damage reached
+
+
+def test_triaxial_confinement_raises_strength():
+    # notes sec. 2.4: first yield at 10 MPa confinement TXC@10 = 56.905 MPa
+    # (axial stress); 0.5 % (driver step). Unconfined: 42.53.
+    res = drive("cscm", BASE, "triaxial", strain=0.004, n_steps=400, confinement=10e6)
+    s = res["stress"]
+    assert np.allclose(s[-1, 1:3], -10e6, atol=1e-3 * 10e6)
+    ax = -s[:, 0]
+    i = int(np.argmax(res["history"][:, 1] != 0))  # first plastic sample
+    assert ax[i] == pytest.approx(56.905e6, rel=5e-3)
+
+
+def test_recovery_and_erosion():
+    # brittle damage from tension is recovered in compression with RECOV = 0
+    # (modulus back), kept with RECOV = 1 (notes sec. 1.9 RECOV text).
+    m = get_model("cscm")
+    out = {}
+    for recov in (0.0, 1.0):
+        p = cscm.pack_cscm({**BASE, "recovery": recov})
+        h = m.initial_history(p)
+        for _ in range(500):   # uniaxial strain in tension to heavy damage
+            s, d = cscm.cscm_point(h, (2e-5, 0, 0, 0, 0, 0), 1.0, p, 0.01)
+        assert d > 0.9
+        for _ in range(12):   # unload into (elastic) compression
+            s, d = cscm.cscm_point(h, (-2e-5, 0, 0, 0, 0, 0), 1.0, p, 0.01)
+        out[recov] = (s, d)
+    assert out[0.0][1] < 0.05 and out[1.0][1] > 0.9
+    # erosion: failed point keeps no deviatoric / tensile stress
+    p = cscm.pack_cscm({**BASE, "erode": True, "erode_strain": 0.01})
+    h = m.initial_history(p)
+    for _ in range(2000):
+        s, d = cscm.cscm_point(h, (2e-5, 0, 0, 0, 0, 0), 1.0, p, 0.01)
+    assert h[cscm.H_ERODED] == 1.0 and d == 1.0 and s == (0, 0, 0, 0, 0, 0)
+    s, d = cscm.cscm_point(h, (-0.1, -0.1, -0.1, 1e-3, 0, 0), 1.0, p, 0.01)
+    assert s[0] < 0 and s[0] == s[1] == s[2] and s[3] == 0.0
+
+
+def test_group_kernel_matches_point_function_and_wave_speed():
+    # kernel with zero spin = point function; c from the damaged moduli.
+    m = get_model("cscm")
+    p = m.pack(BASE)
+    n = 3
+    hist = np.tile(m.initial_history(p), (n, 1))
+    sig = np.zeros((n, 3, 3))
+    L = np.zeros((n, 3, 3))
+    L[:, 0, 0] = [2e-4, -3e-3, 1e-6]
+    rho = np.full(n, 2400.0)
+    e, c, dmg = np.zeros(n), np.zeros(n), np.zeros(n)
+    size = np.full(n, 0.01)
+    for _ in range(10):
+        m.update(np.arange(n), L, 1.0, rho, sig, e, c, dmg, hist, p, size)
+    h = m.initial_history(p)
+    for _ in range(10):
+        s, d = cscm.cscm_point(h, (L[0, 0, 0], 0, 0, 0, 0, 0), 1.0, p, 0.01)
+    assert np.allclose(hist[0], h, rtol=1e-12, atol=0)
+    assert sig[0, 0, 0] == pytest.approx(s[0], rel=1e-12)
+    assert dmg[0] > 0.5 and dmg[2] == 0.0
+    K, G = p[1], p[2]
+    assert c[0] == pytest.approx(math.sqrt((1 - dmg[0]) * (K + 4 * G / 3) / 2400), rel=1e-12)
+    assert c[2] == pytest.approx(math.sqrt((K + 4 * G / 3) / 2400), rel=1e-12)
