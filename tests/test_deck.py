@@ -157,7 +157,7 @@ velocity = [0, 0, "-1 m/s"]
 [output]
 every = "10 us"
 vtk = false
-fields = ["velocity", "stress", "plastic_strain", "neighbours"]
+fields = ["velocity", "stress", "plastic_strain", "bc"]
 history_every = 5
 checkpoint_every = 1000
 progress = false
@@ -234,7 +234,7 @@ def test_full_deck():
     assert deck.set[4].region is None and deck.set[4].body is None
     assert deck.boundary[1].velocity == (0.0, 0.0, -1.0)
     assert deck.output.fields == ("velocity", "stress", "plastic_strain",
-                                  "neighbours")
+                                  "bc")
     assert deck.frame_interval() == pytest.approx(1e-5)
 
 

@@ -19,7 +19,7 @@ from sphdyn.materials.driver import PATHS, drive
 
 numba.set_num_threads(1)
 
-DECK = Path(__file__).resolve().parents[1] / "examples" / "disc_impact_cscm.toml"
+DECK = Path(__file__).resolve().parents[1] / "examples" / "disc_impact.toml"
 
 E, NU, SY, H = 200e9, 0.3, 250e6, 2e9
 K = E / (3 * (1 - 2 * NU))

@@ -14,9 +14,10 @@ v^{n-1/2},\\ \\sigma^n,\\ \\mathbf a^n`):
 6. stress divergence and artificial viscosity (plus the artificial stress
    of :mod:`sphdyn.sph.artificial_stress` when ``epsilon > 0``), then
    contact, giving :math:`\\mathbf a^{n+1}`;
-7. Swegle indicator of the new state (:mod:`sphdyn.sph.swegle`), reported
-   as the output field ``swegle`` and the history column
-   ``swegle_unstable``.
+7. (on demand, not every step) the Swegle indicator of the current state
+   (:mod:`sphdyn.sph.swegle`): the output field ``swegle`` when a frame is
+   written and the history column ``swegle_unstable`` for the records the
+   Simulation keeps (every ``output.history_every`` steps).
 """
 
 from __future__ import annotations

@@ -34,7 +34,7 @@ from .units import (DENSITY, LENGTH, PRESSURE, TIME, VELOCITY, Dimension,
 ALLOWED_FIELDS: list[str] = [
     "velocity", "displacement", "stress", "pressure", "von_mises", "density",
     "mass", "smoothing_length", "damage", "internal_energy", "plastic_strain",
-    "bc", "body", "material", "neighbours", "swegle",
+    "bc", "body", "material", "swegle",
 ]
 
 DEFAULT_FIELDS = ("velocity", "displacement", "stress", "pressure", "von_mises",
