@@ -137,7 +137,7 @@ def test_solver_output_field_and_history_column():
     d = loads_deck(DECK)
     s = Solver(build_model(d), d)
     s.p.sig[:] = _uniform(s.p.n, sxx=S)
-    f = particle_fields(s.p, ["swegle"])["swegle"]
+    f = particle_fields(s.p, ["swegle"], s.output_fields())["swegle"]
     assert f.shape == (s.p.n,)
     assert np.all(f > FLAG_FRACTION)
     rec = s.energies(0.0, 0.0)
@@ -148,5 +148,5 @@ def test_solver_output_field_and_history_column():
     s.p.v[:] = 0.0
     s.step()
     s.p.sig[:] = 0.0
-    assert np.all(particle_fields(s.p, ["swegle"])["swegle"] == 0.0)
+    assert np.all(particle_fields(s.p, ["swegle"], s.output_fields())["swegle"] == 0.0)
     assert s.energies(0.0, 0.0)["swegle_unstable"] == 0.0

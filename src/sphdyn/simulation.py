@@ -153,7 +153,7 @@ class Simulation:
 
     def _write_frame(self):
         s = self.solver
-        fields = particle_fields(s.p, self.fields)
+        fields = particle_fields(s.p, self.fields, s.output_fields())
         self.frames.write(s.t, s.step_count, fields)
         k = math.floor(s.t / self.frame_every + 1e-9) + 1
         self.next_frame = k * self.frame_every

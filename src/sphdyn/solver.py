@@ -73,13 +73,11 @@ class Solver:
         self.Q = np.zeros((n, 3, 3)) if self.as_eps > 0 else None
         self.spacing = p.vol0 ** (1.0 / p.dim) if n else np.zeros(0)  # initial dx [m]
         # Swegle indicator per particle, evaluated on demand (history records
-        # kept by the Simulation, output frames); the particles get a handle
-        # so that sphdyn.io.fields can write the field ``swegle``
+        # kept by the Simulation, output frames; see output_fields)
         self.history_every = deck.output.history_every
         self.swegle = np.zeros(n)
         self.swegle_unstable = 0
         self._swegle_step = -1
-        p.swegle_indicator = self.swegle_field
         self.S = np.zeros((n, 3, 3))
         self.vol = np.zeros(n)
         self.size = p.vol0 ** (1.0 / p.dim)  # particle size for regularisation [m]
@@ -150,6 +148,10 @@ class Solver:
             self.wall_counts[w.name] = int(cnt)
             self.wall_totals[w.name] = self.wall_force.sum(axis=0)
         p.a += self.a_contact
+
+    def output_fields(self) -> dict:
+        """Output fields the solver evaluates on demand, for ``particle_fields``."""
+        return {"swegle": self.swegle_field}
 
     def swegle_field(self) -> np.ndarray:
         """Swegle indicator (N,) of the current state (see :mod:`sphdyn.sph.swegle`).

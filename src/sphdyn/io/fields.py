@@ -54,7 +54,7 @@ def von_mises(sig: np.ndarray) -> np.ndarray:
     return np.sqrt(1.5 * np.einsum("nij,nij->n", s, s))
 
 
-def _compute(p: "Particles", name: str) -> np.ndarray:
+def _compute(p: "Particles", name: str, computed) -> np.ndarray:
     if name == "position":
         return p.x.copy()
     if name == "velocity":
@@ -67,11 +67,11 @@ def _compute(p: "Particles", name: str) -> np.ndarray:
         return pressure(p.sig)
     if name == "von_mises":
         return von_mises(p.sig)
+    if name in computed:
+        # fields evaluated by the solver on demand (e.g. the Swegle indicator)
+        return np.array(computed[name](), copy=True)
     if name == "swegle":
-        # evaluated by the Solver advancing these particles
-        # (sphdyn.solver.Solver.swegle_field, attached as p.swegle_indicator)
-        fn = getattr(p, "swegle_indicator", None)
-        return fn().copy() if fn is not None else np.full(p.n, np.nan)
+        return np.full(p.n, np.nan)  # no solver supplied it
     simple = {"density": "rho", "mass": "m", "smoothing_length": "h",
               "damage": "damage", "internal_energy": "e", "bc": "bc",
               "body": "body", "material": "mat"}
@@ -81,7 +81,8 @@ def _compute(p: "Particles", name: str) -> np.ndarray:
     return p.hist[:, p.hist_names.index(name)].copy()
 
 
-def particle_fields(p: "Particles", names: list[str]) -> dict[str, np.ndarray]:
+def particle_fields(p: "Particles", names: list[str],
+                    computed=None) -> dict[str, np.ndarray]:
     """Compute output fields from the particle state.
 
     Parameters
@@ -92,6 +93,9 @@ def particle_fields(p: "Particles", names: list[str]) -> dict[str, np.ndarray]:
         Field names from :data:`DERIVED_FIELDS` or ``p.hist_names`` (a history
         column). Built-in names take precedence over history names.
         Duplicates are ignored.
+    computed : mapping of str to callable, optional
+        Fields the solver evaluates on demand (``Solver.output_fields()``,
+        e.g. ``"swegle"``); each callable returns an (N,) array.
 
     Returns
     -------
@@ -112,5 +116,5 @@ def particle_fields(p: "Particles", names: list[str]) -> dict[str, np.ndarray]:
     out: dict[str, np.ndarray] = {}
     for name in ["position", *names]:
         if name not in out:
-            out[name] = _compute(p, name)
+            out[name] = _compute(p, name, computed or {})
     return out
