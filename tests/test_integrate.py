@@ -59,5 +59,5 @@ def test_cfl_time_step_picks_the_controlling_particle():
     c = np.array([1000.0, 1000.0, 3000.0])
     v = np.zeros((3, 3))
     v[0, 0] = 1000.0
-    dt, k = cfl_time_step(h, c, v, np.ones(3), 1.0, 0.3)
+    dt, k = cfl_time_step(h, c, v, 1.0, 0.3)
     assert k == 2 and np.isclose(dt, 0.3 * 1e-3 / 3000.0)

@@ -95,24 +95,27 @@ def drift(x, v, dt):
         x[i, 2] += dt * v[i, 2]
 
 
-@njit(cache=True, parallel=True)
-def cfl_time_step(h, c, v, m, scale, cfl):
+@njit(cache=True)
+def cfl_time_step(h, c, v, scale, cfl):
     r"""CFL-limited time step.
 
     .. math:: \Delta t = C \min_i \frac{s\,h_i}{c_i + |\mathbf v_i|},
               \quad s = \min(1, \kappa)
 
     (Monaghan 1992; LS-DYNA SPH time step). Zero-mass particles are included
-    (they move with the body). ``h``, ``c``, ``m`` (N,), ``v`` (N, 3).
+    (they move with the body). ``h``, ``c`` (N,), ``v`` (N, 3). A serial
+    O(N) loop without allocation (its cost is far below one pair pass).
     Returns the step [s] and the index of the controlling particle.
     """
-    n = h.shape[0]
-    best = np.empty(n)
-    for i in prange(n):
+    best = np.inf
+    k = 0
+    for i in range(h.shape[0]):
         sp = np.sqrt(v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2)
-        best[i] = scale * h[i] / (c[i] + sp + 1e-300)
-    k = np.argmin(best)
-    return cfl * best[k], k
+        t = scale * h[i] / (c[i] + sp + 1e-300)
+        if t < best:
+            best = t
+            k = i
+    return cfl * best, k
 
 
 @njit(cache=True)

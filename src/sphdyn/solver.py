@@ -111,7 +111,7 @@ class Solver:
     # ------------------------------------------------------------------ parts
     def _cfl(self):
         p = self.p
-        dt, k = cfl_time_step(p.h, p.c, p.v, p.m, min(1.0, self.kscale), self.cfl)
+        dt, k = cfl_time_step(p.h, p.c, p.v, min(1.0, self.kscale), self.cfl)
         return min(dt, self.dt_max, self.dt_contact), k
 
     def _gradients(self):
