@@ -13,6 +13,8 @@ import numpy as np
 from . import kernels
 from .contact.wall import STIFFNESS_BULK, STIFFNESS_MASS
 from .geometry import lattice_from_shape, select
+from .heterogeneity.cracks import crack_mask
+from .heterogeneity.mass import body_rng, mass_field
 from .materials import get_model
 from .probes import Probe, quantity
 from .state import BC_FIXED, BC_VELOCITY, Particles
@@ -97,7 +99,13 @@ def build_model(deck) -> Model:
         p.vol0[:] = vol
         p.rho[:] = mat.density
         p.rho0[:] = mat.density
-        p.m[:] = mat.density * vol
+        # numerical heterogeneity (paper sec. 4, 5.2): crack particles get zero
+        # mass, the others a random mass field of the homogeneous total
+        cracks = [c.model_dump() for c in body.crack]
+        solid = ~crack_mask(x, cracks, body.dx, body.name)
+        spec = None if body.mass is None else body.mass.model_dump()
+        p.m[:], _ = mass_field(mat.density * vol, spec, solid,
+                               body_rng(deck.run.seed, b))
         p.h[:] = deck.sph.h_factor * body.dx
         p.h0[:] = p.h
         p.body[:] = b

@@ -805,6 +805,147 @@ Region = Annotated[Union[RegionBox, Sphere, HalfSpace, CylinderRegion],
                    Field(discriminator="shape")]
 
 
+# Numerical heterogeneity (sphdyn.heterogeneity, docs/heterogeneity.md) ----
+
+#: Parameters of each mass law (the others must be absent).
+_MASS_PARAMS = {"uniform": ("low", "high"), "normal": ("mean", "std"),
+                "lognormal": ("sigma",), "poisson": ("lam",),
+                "histogram": ("edges", "weights")}
+
+
+class MassField(Section):
+    """[body.mass]: random particle masses (Husek et al. 2017, sec. 4).
+
+    Mass factors f >= 0 (multiples of the homogeneous particle mass rho
+    dx^d) are drawn from the distribution and rescaled so that the body's
+    total mass is exactly the homogeneous one; density, lattice and
+    smoothing length stay those of the homogeneous body, so the particle
+    volume m/rho varies. Give exactly the parameters of the chosen
+    distribution. The draw is seeded by run.seed and the body's index.
+    """
+
+    distribution: Literal["uniform", "normal", "lognormal", "poisson",
+                          "histogram"] = Field(
+        description="Law of the mass factors: uniform U[low, high]; normal "
+                    "N(mean, std^2) truncated at 0; lognormal with ln f ~ "
+                    "N(-sigma^2/2, sigma^2); poisson k/lam with k ~ "
+                    "Poisson(lam); histogram: piecewise-constant density.")
+    low: Optional[real("mass factor", lo=0)] = Field(
+        None, description="uniform: lower bound (0 allows massless "
+                          "particles, as in the paper).")
+    high: Optional[real("mass factor", lo=0)] = Field(
+        None, description="uniform: upper bound, at least low (low = high "
+                          "gives the homogeneous body).")
+    mean: Optional[real("mass factor", lo=0, lo_open=True)] = Field(
+        None, description="normal: mean before truncation.")
+    std: Optional[real("standard deviation", lo=0)] = Field(
+        None, description="normal: standard deviation before truncation "
+                          "(0 = homogeneous).")
+    sigma: Optional[real("standard deviation", lo=0)] = Field(
+        None, description="lognormal: standard deviation of ln f "
+                          "(0 = homogeneous).")
+    lam: Optional[real("Poisson mean", lo=0, lo_open=True)] = Field(
+        None, description="poisson: mean count lambda; f = k/lambda, so "
+                          "the coefficient of variation is lambda^-1/2.")
+    edges: Optional[tuple[real("mass factor", lo=0), ...]] = Field(
+        None, description="histogram: increasing bin edges of f.")
+    weights: Optional[tuple[real("weight", lo=0), ...]] = Field(
+        None, description="histogram: relative frequency of each bin "
+                          "(one fewer than edges, not all zero).")
+
+    @model_validator(mode="after")
+    def _parameters_of_the_law(self):
+        law = self.distribution
+        need = _MASS_PARAMS[law]
+        missing = [k for k in need if getattr(self, k) is None]
+        extra = [k for p in _MASS_PARAMS.values() for k in p
+                 if k not in need and getattr(self, k) is not None]
+        if missing or extra:
+            raise problem(
+                f"distribution = \"{law}\" takes {' and '.join(need)}"
+                + (f"; missing {', '.join(missing)}" if missing else "")
+                + (f"; not used: {', '.join(extra)}" if extra else ""),
+                f"give exactly {', '.join(need)} for a {law} distribution")
+        if law == "uniform" and self.high < self.low:
+            raise problem(f"high = {_num(self.high)} is below low = "
+                          f"{_num(self.low)}", "give high >= low")
+        if law == "histogram":
+            e, w = self.edges, self.weights
+            if len(e) < 2 or any(b <= a for a, b in zip(e[:-1], e[1:])):
+                raise problem("the histogram edges are not an increasing list "
+                              "of at least 2 values",
+                              "give edges = [0, 0.5, 1, 1.5, 2] (increasing)")
+            if len(w) != len(e) - 1 or sum(w) <= 0:
+                raise problem(f"{len(w)} weights for {len(e) - 1} bins, or all "
+                              "weights zero",
+                              "give one non-negative weight per bin, not all zero")
+        return self
+
+
+class CrackPlane(Section):
+    """[[body.crack]] shape = "plane": a planar crack (zero-mass particles).
+
+    Particles closer than rows*dx/2 to the plane get zero mass (Husek et
+    al. 2017, sec. 5.2); with radius, only those within radius of point.
+    """
+
+    shape: Literal["plane"] = Field(description="Kind of crack.")
+    point: Position = Field(description="A point on the crack plane.")
+    normal: Direction = Field(description="Normal of the crack plane.")
+    rows: integer("row count", lo=1) = Field(
+        1, description="Thickness in particle rows (half-width rows*dx/2).")
+    radius: Optional[PositiveLength] = Field(
+        None, description="Extent around point within the plane (absent: "
+                          "the whole plane).")
+
+
+class CrackPolyline(Section):
+    """[[body.crack]] shape = "polyline": a crack along a polyline.
+
+    Particles closer than rows*dx/2 to the polyline (distance measured in
+    the plane normal to axis) get zero mass; in 3D the crack runs through
+    the body along axis.
+    """
+
+    shape: Literal["polyline"] = Field(description="Kind of crack.")
+    points: tuple[Position, ...] = Field(
+        description="Corner points, at least 2 (their axis component is "
+                    "ignored).")
+    rows: integer("row count", lo=1) = Field(
+        1, description="Thickness in particle rows (half-width rows*dx/2).")
+    axis: PlanarAxis = Field("z", description="Direction along which the "
+                                              "crack is extruded; z in 2D.")
+
+    @field_validator("points")
+    @classmethod
+    def _two_points(cls, points):
+        if len(points) < 2:
+            raise problem(f"the polyline has {len(points)} point(s)",
+                          "give at least 2 points")
+        return points
+
+
+class CrackBox(Section):
+    """[[body.crack]] shape = "box": pre-fractured material in a box.
+
+    Every particle inside the axis-aligned box gets zero mass.
+    """
+
+    shape: Literal["box"] = Field(description="Kind of crack.")
+    lo: Corner = Field(description="Lower corner.")
+    hi: Corner = Field(description="Upper corner, above lo.")
+
+    @field_validator("hi")
+    @classmethod
+    def _above_lo(cls, hi, info: ValidationInfo):
+        _check_corners(info.data.get("lo"), hi, "lo")
+        return hi
+
+
+Crack = Annotated[Union[CrackPlane, CrackPolyline, CrackBox],
+                  Field(discriminator="shape")]
+
+
 # Bodies, walls, sets, boundaries ----------------------------------------
 
 class Body(Section):
@@ -818,6 +959,12 @@ class Body(Section):
     velocity: VelocityVector = Field(
         (0.0, 0.0, 0.0), description="Initial velocity.")
     geometry: Geometry = Field(description="Shape filled with particles.")
+    mass: Optional[MassField] = Field(
+        None, description="Random particle masses (absent: homogeneous, "
+                          "m = rho dx^d); see docs/heterogeneity.md.")
+    crack: tuple[Crack, ...] = Field(
+        (), description="Initial cracks: their particles get zero mass; "
+                        "use a wall with stiffness = \"bulk\".")
 
 
 class Wall(Section):
