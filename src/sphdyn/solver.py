@@ -10,10 +10,14 @@ v^{n-1/2},\\ \\sigma^n,\\ \\mathbf a^n`):
 3. drift to :math:`\\mathbf x^{n+1}` (XSPH-smoothed velocity if enabled);
 4. neighbour list update (only when the Verlet skin is exhausted);
 5. velocity gradient, density and smoothing length, material update
-   (:math:`\\sigma^{n+1}`, internal energy);
+   (:math:`\\sigma^{n+1}`, internal energy); bodies with the
+   total-Lagrangian formulation take L and the density from their
+   deformation gradient (:mod:`sphdyn.sph.tl_scheme`) instead;
 6. stress divergence and artificial viscosity (plus the artificial stress
-   of :mod:`sphdyn.sph.artificial_stress` when ``epsilon > 0``), then
-   contact, giving :math:`\\mathbf a^{n+1}`;
+   of :mod:`sphdyn.sph.artificial_stress` when ``epsilon > 0``; the
+   first Piola-Kirchhoff form with hourglass control on total-Lagrangian
+   bodies), then contact between bodies (:mod:`sphdyn.contact.particles`)
+   and with rigid walls, giving :math:`\\mathbf a^{n+1}`;
 7. (on demand, not every step) the Swegle indicator of the current state
    (:mod:`sphdyn.sph.swegle`): the output field ``swegle`` when a frame is
    written and the history column ``swegle_unstable`` for the records the
@@ -24,6 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .contact.particles import contact_time_step, particle_contact
 from .contact.wall import STIFFNESS_BULK, bulk_contact_time_step, wall_contact
 from .guards import check_particles, check_time_step
 from .integrate import add_heat, cfl_time_step, drift, internal_energies, kick
@@ -35,6 +40,17 @@ from .sph.passes import (forces, particle_volumes, scaled_stress,
                          update_density_and_h, velocity_gradient, xsph_velocity)
 from .sph.swegle import (FLAG_FRACTION, REL_STRESS_TOL, count_unstable, stress_scale,
                          swegle_indicator)
+from .sph.tl_scheme import TotalLagrangian
+
+
+def total_lagrangian_mask(deck, body: np.ndarray) -> np.ndarray:
+    """(N,) bool: particles of bodies using the total-Lagrangian formulation.
+
+    A body's ``formulation`` overrides ``[sph] formulation``.
+    """
+    tl_bodies = [k for k, b in enumerate(deck.body)
+                 if (b.formulation or deck.sph.formulation) == "total_lagrangian"]
+    return np.isin(body, tl_bodies)
 
 
 class Solver:
@@ -98,12 +114,40 @@ class Solver:
                     p.m, p.vol0, p.rho, w.kbulk, self.dim, w.alpha))
         r0 = model.radius_factor * float(p.h.max()) if n else 0.0
         self.skin = sph.neighbours.skin_factor * r0
+        # total-Lagrangian bodies: fixed reference neighbours; the updated-
+        # Lagrangian list then holds the other particles only
+        tl = total_lagrangian_mask(deck, p.body)
+        self.ul_active = ~tl if tl.any() else None
+        self.tl = None
+        if tl.any():
+            young = np.zeros(n)
+            for g in model.groups:
+                k, mu = g.model.bulk_modulus(g.params), g.model.shear_modulus(g.params)
+                young[g.idx] = 9.0 * k * mu / (3.0 * k + mu)
+            self.tl = TotalLagrangian(p, np.flatnonzero(tl), self.kid, self.sigma,
+                                      model.radius_factor, self.kscale, young,
+                                      sph.hourglass, self.alpha, self.beta)
+        # particle-particle contact between bodies
+        c = deck.contact
+        n_bodies = len(np.unique(p.body)) if n else 0
+        self.contact_on = bool(c.enabled) if c.enabled is not None else bool(
+            n_bodies >= 2 and tl.any())
+        self.contact_factor = c.distance_factor
+        self.contact_alpha = c.alpha
+        self.contact_count = 0
+        self.cnl = None
+        if self.contact_on and n:
+            self.dt_contact = min(self.dt_contact, 0.5 * contact_time_step(
+                p.m, self.size, model.bulk_modulus, self.dim, c.alpha))
+            cskin = sph.neighbours.skin_factor * c.distance_factor * float(self.size.max())
+            self.cnl = build_neighbours(p.x, self.size, c.distance_factor, cskin, self.dim)
         self.t = 0.0
         self.step_count = 0
         self.dt_prev = 0.0  # 0 before the first kick (half kick)
         self.work_contact = 0.0
         self.work_external = 0.0
-        self.nl = build_neighbours(p.x, p.h, model.radius_factor, self.skin, self.dim)
+        self.nl = build_neighbours(p.x, p.h, model.radius_factor, self.skin, self.dim,
+                                   active=self.ul_active)
         self.dt0, _ = self._cfl()
         self._gradients()
         self._accelerations(self.dt0)
@@ -123,6 +167,8 @@ class Solver:
         velocity_gradient(p.x, p.v, p.h, self.vol, nl.offsets, nl.idx, self.kid,
                           self.sigma, self.dim, self.kscale, self.correct, self.F, p.L,
                           self.B)
+        if self.tl is not None:
+            self.tl.velocity_gradient(p)
 
     def _accelerations(self, dt):
         """Stress divergence, artificial viscosity and contact at the current state.
@@ -140,7 +186,14 @@ class Solver:
             artificial_stress_forces(p.x, p.m, p.h, self.R, self.F, nl.offsets, nl.idx,
                                      self.kid, self.dim, self.kscale, self.spacing,
                                      self.as_n, p.a)
+        if self.tl is not None:
+            self.tl.accelerations(p, self.dedt_av)
         self.a_contact[:] = 0.0
+        if self.cnl is not None:
+            self.contact_count = int(particle_contact(
+                p.x, p.m, self.size, self.model.bulk_modulus, p.body, self.dim,
+                self.cnl.offsets, self.cnl.idx, self.contact_alpha, self.contact_factor,
+                self.a_contact))
         for w in self.model.walls:
             cnt = wall_contact(p.x, p.v, p.m, p.vol0, p.rho, w.kbulk, self.dim, w.point,
                                w.normal, w.thickness_factor, w.method, w.alpha,
@@ -200,10 +253,14 @@ class Solver:
         self.step_count += 1
         self.dt_prev = dt
 
-        self.nl = update_neighbours(nl, p.x, p.h, self.dim)
+        self.nl = update_neighbours(nl, p.x, p.h, self.dim, self.ul_active)
+        if self.cnl is not None:
+            self.cnl = update_neighbours(self.cnl, p.x, self.size, self.dim)
         self._gradients()
         update_density_and_h(p.L, dt, self.dim, self.benz, p.h0, self.hmin, self.hmax,
                              p.rho, p.h)
+        if self.tl is not None:
+            self.tl.density(p)
         for g in model.groups:
             g.model.update(g.idx, p.L, dt, p.rho, p.sig, p.e, p.c, p.damage, p.hist,
                            g.params, self.size)
@@ -231,6 +288,8 @@ class Solver:
             "E_total": kinetic + ie + e_contact - self.work_external,
             "swegle_unstable": float(self.swegle_unstable),
         }
+        if self.cnl is not None:
+            rec["contacts_bodies"] = float(self.contact_count)
         for w in self.model.walls:
             f = self.wall_totals[w.name]
             fn = float(f @ w.normal)
@@ -247,10 +306,12 @@ class Solver:
                 "work_external": self.work_external}
 
     def state_arrays(self) -> dict:
-        nl = self.nl
-        return {"a_contact": self.a_contact, "B": self.B, "dedt_av": self.dedt_av,
-                "nl_offsets": nl.offsets, "nl_idx": nl.idx, "nl_x_ref": nl.x_ref,
-                "nl_h_ref": nl.h_ref}
+        out = {"a_contact": self.a_contact, "B": self.B, "dedt_av": self.dedt_av}
+        lists = {"nl": self.nl} if self.cnl is None else {"nl": self.nl, "cnl": self.cnl}
+        for key, nl in lists.items():
+            out.update({f"{key}_offsets": nl.offsets, f"{key}_idx": nl.idx,
+                        f"{key}_x_ref": nl.x_ref, f"{key}_h_ref": nl.h_ref})
+        return out
 
     def restore(self, scalars: dict, arrays: dict, particle_arrays: dict) -> None:
         """Continue from a checkpoint (bitwise identical continuation)."""
@@ -265,10 +326,20 @@ class Solver:
         self.a_contact[...] = arrays["a_contact"]
         self.B[...] = arrays["B"]
         self.dedt_av[...] = arrays["dedt_av"]
-        self.nl.offsets = arrays["nl_offsets"].copy()
-        self.nl.idx = arrays["nl_idx"].copy()
-        self.nl.x_ref = arrays["nl_x_ref"].copy()
-        self.nl.h_ref = arrays["nl_h_ref"].copy()
+        for key in ("nl", "cnl"):
+            nl = getattr(self, key)
+            if nl is not None:
+                nl.offsets = arrays[f"{key}_offsets"].copy()
+                nl.idx = arrays[f"{key}_idx"].copy()
+                nl.x_ref = arrays[f"{key}_x_ref"].copy()
+                nl.h_ref = arrays[f"{key}_h_ref"].copy()
+        if self.tl is not None:
+            self.tl.velocity_gradient(self.p)  # F of the restored state
+        if self.cnl is not None:  # contact count of the restored state
+            self.contact_count = int(particle_contact(
+                self.p.x, self.p.m, self.size, self.model.bulk_modulus, self.p.body,
+                self.dim, self.cnl.offsets, self.cnl.idx, self.contact_alpha,
+                self.contact_factor, np.zeros_like(self.a_contact)))
         self._swegle_step = -1
         # wall totals at the restored state (forces depend on x, v, dt only)
         for w in self.model.walls:

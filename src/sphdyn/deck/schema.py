@@ -412,10 +412,18 @@ class ArtificialStress(Section):
 class Sph(Section):
     """[sph]: discretisation."""
 
-    formulation: Literal["updated_lagrangian"] = Field(
-        "updated_lagrangian", description="Kernel formulation; "
-        "updated_lagrangian is the 'Eulerian kernel' (neighbours and kernel "
-        "gradients from current positions).")
+    formulation: Literal["updated_lagrangian", "total_lagrangian"] = Field(
+        "updated_lagrangian", description="Kernel formulation of every body "
+        "that does not set its own: updated_lagrangian is the thesis's "
+        "'Eulerian kernel' (neighbours and kernel gradients from current "
+        "positions); total_lagrangian fixes neighbours and corrected kernel "
+        "gradients in the initial configuration (no tensile instability; "
+        "separate bodies then interact only through [contact]). See "
+        "docs/tensile-instability.md.")
+    hourglass: real("hourglass coefficient", lo=0) = Field(
+        10.0, description="Ganzenmueller (2015) hourglass coefficient alpha "
+                          "of total-Lagrangian bodies (0 = off; 10-50 "
+                          "recommended). Unused by updated-Lagrangian bodies.")
     kernel: Literal["cubic_spline", "quintic_spline", "wendland_c2",
                     "wendland_c4", "gaussian", "quadratic"] = Field(
         "cubic_spline", description="Smoothing kernel.")
@@ -441,6 +449,21 @@ class Sph(Section):
     artificial_stress: ArtificialStress = Field(
         default_factory=ArtificialStress,
         description="Artificial stress against the tensile instability.")
+
+
+class Contact(Section):
+    """[contact]: penalty contact between particles of different bodies."""
+
+    enabled: Optional[StrictBool] = Field(
+        None, description="Particle-particle contact between bodies; default: "
+        "on when the model has two or more bodies and one of them is "
+        "total-Lagrangian (those see no other body through the SPH sums).")
+    distance_factor: real("contact distance factor", lo=0, lo_open=True) = Field(
+        1.0, description="Particles of different bodies touch below "
+        "distance_factor * (s_i + s_j)/2, s = initial particle size V0^(1/dim).")
+    alpha: real("penalty factor", lo=0, lo_open=True) = Field(
+        1.0, description="Penalty factor of the spring stiffness "
+        "k = alpha * K * s^(dim-2) (K the pair's mean bulk modulus).")
 
 
 class Time(Section):
@@ -959,6 +982,9 @@ class Body(Section):
     velocity: VelocityVector = Field(
         (0.0, 0.0, 0.0), description="Initial velocity.")
     geometry: Geometry = Field(description="Shape filled with particles.")
+    formulation: Optional[Literal["updated_lagrangian", "total_lagrangian"]] = \
+        Field(None, description="Kernel formulation of this body; default: "
+                                "[sph] formulation.")
     mass: Optional[MassField] = Field(
         None, description="Random particle masses (absent: homogeneous, "
                           "m = rho dx^d); see docs/heterogeneity.md.")
@@ -1097,6 +1123,8 @@ class Deck(Section):
         Field(description="Materials (at least one).")
     body: Annotated[tuple[Body, ...], BeforeValidator(NonEmpty("body"))] = Field(
         description="Bodies (at least one).")
+    contact: Contact = Field(default_factory=Contact,
+                             description="Contact between bodies.")
     wall: tuple[Wall, ...] = Field((), description="Rigid walls.")
     set: tuple[ParticleSet, ...] = Field((), description="Particle sets.")
     boundary: tuple[Boundary, ...] = Field((), description="Boundary "

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..neighbours import build_neighbours
 from .total_lagrangian import (deformation_gradient, piola_stress, reference_gradients,
-                               tl_forces)
+                               tl_density, tl_forces)
 
 
 def same_body_pairs(offsets: np.ndarray, idx: np.ndarray, body: np.ndarray):
@@ -31,21 +31,31 @@ def same_body_pairs(offsets: np.ndarray, idx: np.ndarray, body: np.ndarray):
 
 
 class TotalLagrangian:
-    """Reference neighbours, gradients and work arrays of the particles ``p``.
+    """Reference neighbours, gradients and work arrays of the total-Lagrangian bodies.
 
     Parameters
     ----------
     p : Particles (reference configuration ``p.x0``, ``p.h0``, ``p.rho0``).
+    rows : (n_tl,) int64, the particles of total-Lagrangian bodies.
     kid, sigma, radius_factor, kscale : kernel id, normalisation, support
         radius factor (q_max * kappa) and support scale kappa.
     young : (N,) Young's modulus per particle for the hourglass stiffness [Pa].
     hourglass : hourglass coefficient alpha (Ganzenmueller 2015; 0 = off).
+    alpha, beta : artificial viscosity coefficients (Monaghan 1992).
+
+    Only pairs of particles within one body and both in ``rows`` are kept;
+    rows of other particles are empty, so the arrays are (N, ...) and all
+    passes write the ``rows`` only.
     """
 
-    def __init__(self, p, kid, sigma, radius_factor, kscale, young, hourglass):
+    def __init__(self, p, rows, kid, sigma, radius_factor, kscale, young, hourglass,
+                 alpha=0.0, beta=0.0):
         n, dim = p.n, p.dim
         self.dim = dim
-        full = build_neighbours(p.x0, p.h0, radius_factor, 0.0, dim)
+        self.rows = np.ascontiguousarray(rows, dtype=np.int64)
+        active = np.zeros(n, dtype=bool)
+        active[self.rows] = True
+        full = build_neighbours(p.x0, p.h0, radius_factor, 0.0, dim, active=active)
         self.offsets, self.idx = same_body_pairs(full.offsets, full.idx, p.body)
         self.vol = np.divide(p.m, p.rho0, out=np.zeros(n), where=p.rho0 > 0)
         self.g = np.zeros((self.idx.size, 3))
@@ -58,20 +68,28 @@ class TotalLagrangian:
         self.P = np.zeros((n, 3, 3))
         self.young = np.ascontiguousarray(young, dtype=float)
         self.hourglass = float(hourglass)
+        self.alpha = float(alpha)
+        self.beta = float(beta)
+        self.kscale = float(kscale)
 
     def velocity_gradient(self, p) -> None:
-        """Fill ``p.L`` and set ``p.rho = rho0 / det F`` for the current state."""
-        deformation_gradient(p.x, p.v, self.vol, self.offsets, self.idx, self.g,
-                             self.B0, self.dim, self.F, self.Finv, p.L)
-        det = np.linalg.det(self.F)
-        np.divide(p.rho0, det, out=p.rho, where=det > 0)
+        """Fill ``p.L`` (and ``F``) of the total-Lagrangian rows."""
+        deformation_gradient(self.rows, p.x, p.v, self.vol, self.offsets, self.idx,
+                             self.g, self.B0, self.dim, self.F, self.Finv, p.L)
 
-    def accelerations(self, p) -> None:
-        """Overwrite ``p.a`` with the stress and hourglass accelerations."""
-        piola_stress(self.F, self.Finv, p.sig, self.P)
-        tl_forces(p.x, p.x0, p.m, p.rho0, self.vol, self.offsets, self.idx, self.g,
-                  self.w, self.B0, self.P, self.F, self.young, self.hourglass, p.a)
+    def density(self, p) -> None:
+        """``rho = rho0 / det F`` and ``h = h0`` on the total-Lagrangian rows."""
+        tl_density(self.rows, self.F, p.rho0, p.h0, p.rho, p.h)
+
+    def accelerations(self, p, dedt_av) -> None:
+        """Overwrite ``p.a`` and ``dedt_av`` rows with the TL stress, viscosity
+        and hourglass terms."""
+        piola_stress(self.rows, self.F, self.Finv, p.sig, self.P)
+        tl_forces(self.rows, p.x, p.v, p.x0, p.m, p.rho, p.rho0, p.c, p.h0, self.vol,
+                  self.offsets, self.idx, self.g, self.w, self.B0, self.P, self.F,
+                  self.young, self.hourglass, self.alpha, self.beta, self.kscale, p.a,
+                  dedt_av)
 
     @property
     def mean_neighbours(self) -> float:
-        return self.idx.size / max(self.offsets.size - 1, 1)
+        return self.idx.size / max(self.rows.size, 1)

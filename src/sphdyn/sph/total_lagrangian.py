@@ -116,7 +116,7 @@ def reference_gradients(X, h0, vol, offsets, idx, kid, sigma, dim, kscale, g, w,
 
 
 @njit(cache=True, parallel=True)
-def deformation_gradient(x, v, vol, offsets, idx, g, B0, dim, Fdef, Finv, L):
+def deformation_gradient(rows, x, v, vol, offsets, idx, g, B0, dim, Fdef, Finv, L):
     r"""Deformation gradient and velocity gradient from the reference kernel.
 
     .. math::
@@ -126,14 +126,15 @@ def deformation_gradient(x, v, vol, offsets, idx, g, B0, dim, Fdef, Finv, L):
                    \tilde{\mathbf g}_{ij},
         \qquad L_i = \dot F_i F_i^{-1}
 
-    (exact for linear motions thanks to :math:`B_i`). ``Fdef``, ``Finv``
-    (its inverse) and ``L`` (N, 3, 3) out; in 2D ``F_zz = 1``. ``L`` feeds the
-    same material kernels as the updated-Lagrangian scheme (Jaumann update of
-    the Cauchy stress). No allocation: ``L`` holds :math:`\dot F` until the
-    product is formed row by row.
+    (exact for linear motions thanks to :math:`B_i`). Only the particles
+    ``rows`` (int64 indices) are evaluated; ``Fdef``, ``Finv`` (its inverse)
+    and ``L`` (N, 3, 3) are written in those rows only; in 2D ``F_zz = 1``.
+    ``L`` feeds the same material kernels as the updated-Lagrangian scheme
+    (Jaumann update of the Cauchy stress). No allocation: ``L`` holds
+    :math:`\dot F` until the product is formed row by row.
     """
-    n = x.shape[0]
-    for i in prange(n):
+    for t in prange(rows.shape[0]):
+        i = rows[t]
         for a in range(3):
             for b in range(3):
                 Fdef[i, a, b] = 0.0
@@ -173,17 +174,41 @@ def deformation_gradient(x, v, vol, offsets, idx, g, B0, dim, Fdef, Finv, L):
                     L[i, a, b] = 0.0
 
 
+@njit(cache=True)
+def _det(F, i):
+    """Determinant of ``F[i]`` (3, 3)."""
+    return (F[i, 0, 0] * (F[i, 1, 1] * F[i, 2, 2] - F[i, 1, 2] * F[i, 2, 1])
+            - F[i, 0, 1] * (F[i, 1, 0] * F[i, 2, 2] - F[i, 1, 2] * F[i, 2, 0])
+            + F[i, 0, 2] * (F[i, 1, 0] * F[i, 2, 1] - F[i, 1, 1] * F[i, 2, 0]))
+
+
 @njit(cache=True, parallel=True)
-def piola_stress(Fdef, Finv, sig, P):
+def tl_density(rows, Fdef, rho0, h0, rho, h):
+    r"""Mass balance of the total-Lagrangian scheme, :math:`\rho = \rho_0 / \det F`.
+
+    Rows ``rows`` of ``rho`` (N,) [kg/m^3] are overwritten (left unchanged
+    where :math:`\det F \le 0`, i.e. an inverted neighbourhood the guards
+    report); the smoothing length stays the reference one, ``h = h0`` (the
+    kernel lives in the reference configuration).
+    """
+    for t in prange(rows.shape[0]):
+        i = rows[t]
+        det = _det(Fdef, i)
+        if det > 0.0:
+            rho[i] = rho0[i] / det
+        h[i] = h0[i]
+
+
+@njit(cache=True, parallel=True)
+def piola_stress(rows, Fdef, Finv, sig, P):
     r"""First Piola-Kirchhoff stress :math:`P = J \sigma F^{-T}`, :math:`J = \det F`.
 
     ``Fdef``, ``Finv`` (from :func:`deformation_gradient`), ``sig`` (Cauchy,
-    tension positive), ``P`` (N, 3, 3) [Pa].
+    tension positive), ``P`` (N, 3, 3) [Pa]; rows ``rows`` are evaluated.
     """
-    for i in prange(Fdef.shape[0]):
-        det = (Fdef[i, 0, 0] * (Fdef[i, 1, 1] * Fdef[i, 2, 2] - Fdef[i, 1, 2] * Fdef[i, 2, 1])
-               - Fdef[i, 0, 1] * (Fdef[i, 1, 0] * Fdef[i, 2, 2] - Fdef[i, 1, 2] * Fdef[i, 2, 0])
-               + Fdef[i, 0, 2] * (Fdef[i, 1, 0] * Fdef[i, 2, 1] - Fdef[i, 1, 1] * Fdef[i, 2, 0]))
+    for t in prange(rows.shape[0]):
+        i = rows[t]
+        det = _det(Fdef, i)
         for a in range(3):
             for b in range(3):
                 P[i, a, b] = det * (sig[i, a, 0] * Finv[i, b, 0] + sig[i, a, 1] * Finv[i, b, 1]
@@ -191,8 +216,8 @@ def piola_stress(Fdef, Finv, sig, P):
 
 
 @njit(cache=True, parallel=True)
-def tl_forces(x, X, m, rho0, vol, offsets, idx, g, w, B0, P, Fdef, young, hg_alpha,
-              a):
+def tl_forces(rows, x, v, X, m, rho, rho0, c, h0, vol, offsets, idx, g, w, B0, P, Fdef,
+              young, hg_alpha, av_alpha, av_beta, kscale, a, dedt_av):
     r"""Acceleration of the total-Lagrangian scheme with hourglass control.
 
     Momentum balance :math:`\rho_0 \dot{\mathbf v} = \nabla_X\cdot P` in the
@@ -201,10 +226,22 @@ def tl_forces(x, X, m, rho0, vol, offsets, idx, g, w, B0, P, Fdef, young, hg_alp
     .. math::
         \dot{\mathbf v}_i = \frac{1}{\rho_{0i}} \sum_j V_j
             \big(P_i B_i + P_j B_j\big)\, \mathbf g_{ij}
-            + \frac{\mathbf f^{hg}_i}{m_i},
+            - \sum_j m_j \Pi_{ij} \mathbf G_{ij}
+            + \frac{\mathbf f^{hg}_i}{m_i}.
 
-    and Ganzenmüller's (2015) hourglass force, which penalises the part of the
-    pair separation not predicted by the particles' own deformation gradients:
+    *Artificial viscosity* (Monaghan 1992, as in the updated-Lagrangian
+    :func:`sphdyn.sph.passes.forces`) with the current pair separation
+    :math:`\mathbf x_{ij}`, velocity :math:`\mathbf v_{ij}`, density
+    :math:`\rho = \rho_0/J` and the reference smoothing length, acting along
+    the current line of centres with the reference kernel slope,
+    :math:`\mathbf G_{ij} = -|\mathbf g_{ij}|\,\hat{\mathbf x}_{ij}`
+    (:math:`|\mathbf g_{ij}| = |W'(|\mathbf X_{ij}|)|`), so the viscous pair
+    force is central (linear and angular momentum conserved) and
+    dissipative; the heating rate is :math:`\dot e_i = \tfrac12\sum_j m_j
+    \Pi_{ij} \mathbf v_{ij}\cdot\mathbf G_{ij}`.
+
+    *Hourglass control* (Ganzenmüller 2015) penalises the part of the pair
+    separation not predicted by the particles' own deformation gradients:
     with :math:`\mathbf X_{ij} = \mathbf X_j - \mathbf X_i`,
     :math:`\mathbf x_{ij} = \mathbf x_j - \mathbf x_i`,
     :math:`\delta^i_{ij} = (F_i \mathbf X_{ij} - \mathbf x_{ij})\cdot\hat{\mathbf x}_{ij}`
@@ -215,22 +252,33 @@ def tl_forces(x, X, m, rho0, vol, offsets, idx, g, w, B0, P, Fdef, young, hg_alp
             \frac{V_i V_j W_{ij} \bar E_{ij}}{|\mathbf X_{ij}|^2}
             (\delta^i_{ij} + \delta^j_{ij})\, \hat{\mathbf x}_{ij}.
 
-    It vanishes for every linear deformation and is antisymmetric in the pair.
+    It vanishes for every linear deformation and is antisymmetric in the
+    pair. Its power :math:`-\mathbf f^{hg}_i\cdot\mathbf v_i / m_i` is added
+    to ``dedt_av`` so that the energy balance closes (hourglass work is
+    book-kept with the viscous heat).
 
     Parameters
     ----------
-    x, X : (N, 3) current and reference positions [m].
-    m, rho0, vol : (N,) mass [kg], reference density, reference volume m/rho0.
+    rows : (n_tl,) int64, the particles evaluated (rows of ``a`` and
+        ``dedt_av`` written; other rows untouched).
+    x, v, X : (N, 3) current positions [m], velocities [m/s], reference positions.
+    m, rho, rho0, c, h0, vol : (N,) mass [kg], current and reference density
+        [kg/m^3], wave speed [m/s], reference smoothing length [m],
+        reference volume m/rho0.
     g, w, B0 : from :func:`reference_gradients`.
     P, Fdef : (N, 3, 3) first Piola-Kirchhoff stress [Pa], deformation gradient.
     young : (N,) Young's modulus for the hourglass stiffness [Pa].
-    hg_alpha : float, hourglass coefficient (0 = off; Ganzenmüller uses 10-50).
+    hg_alpha : hourglass coefficient (0 = off; Ganzenmüller uses 10-50).
+    av_alpha, av_beta : artificial viscosity coefficients; kscale: support scale.
     a : (N, 3) out, acceleration [m/s^2].
+    dedt_av : (N,) out, viscous + hourglass heating rate [W/kg].
     """
-    n = x.shape[0]
-    for i in prange(n):
+    for t in prange(rows.shape[0]):
+        i = rows[t]
         a0 = a1 = a2 = 0.0
-        h0 = h1 = h2 = 0.0
+        h0x = h0y = h0z = 0.0
+        q0 = q1 = q2 = 0.0
+        heat = 0.0
         for k in range(offsets[i], offsets[i + 1]):
             j = idx[k]
             vj = vol[j]
@@ -244,26 +292,48 @@ def tl_forces(x, X, m, rho0, vol, offsets, idx, g, w, B0, P, Fdef, young, hg_alp
             # c = (P_i B_i + P_j B_j) g
             for r in range(3):
                 s = 0.0
-                for c in range(3):
-                    bi = B0[i, c, 0] * gk0 + B0[i, c, 1] * gk1 + B0[i, c, 2] * gk2
-                    bj = B0[j, c, 0] * gk0 + B0[j, c, 1] * gk1 + B0[j, c, 2] * gk2
-                    s += P[i, r, c] * bi + P[j, r, c] * bj
+                for cc in range(3):
+                    bi = B0[i, cc, 0] * gk0 + B0[i, cc, 1] * gk1 + B0[i, cc, 2] * gk2
+                    bj = B0[j, cc, 0] * gk0 + B0[j, cc, 1] * gk1 + B0[j, cc, 2] * gk2
+                    s += P[i, r, cc] * bi + P[j, r, cc] * bj
                 if r == 0:
                     a0 += vj * s
                 elif r == 1:
                     a1 += vj * s
                 else:
                     a2 += vj * s
+            # current pair geometry, x_ij = x_j - x_i
+            x0 = x[j, 0] - x[i, 0]
+            x1 = x[j, 1] - x[i, 1]
+            x2 = x[j, 2] - x[i, 2]
+            rx2 = x0 * x0 + x1 * x1 + x2 * x2
+            if rx2 == 0.0:
+                continue
+            rx = np.sqrt(rx2)
+            if av_alpha > 0.0 or av_beta > 0.0:
+                w0 = v[j, 0] - v[i, 0]
+                w1 = v[j, 1] - v[i, 1]
+                w2 = v[j, 2] - v[i, 2]
+                vx = w0 * x0 + w1 * x1 + w2 * x2  # = v_ij . x_ij (both signs flip)
+                if vx < 0.0:
+                    hij = kscale * 0.5 * (h0[i] + h0[j])
+                    mu = hij * vx / (rx2 + 0.01 * hij * hij)
+                    pi_ij = (-av_alpha * 0.5 * (c[i] + c[j]) * mu + av_beta * mu * mu) / (
+                        0.5 * (rho[i] + rho[j]))
+                    gabs = np.sqrt(gk0 * gk0 + gk1 * gk1 + gk2 * gk2)
+                    # -m_j Pi G_ij with G_ij = -|g| (x_i - x_j)/r = |g| x_ij / r
+                    f = -m[j] * pi_ij * gabs / rx
+                    q0 += f * x0
+                    q1 += f * x1
+                    q2 += f * x2
+                    # 1/2 m_j Pi v_ij . G_ij with v_ij . G_ij = -|g| vx / r
+                    heat -= 0.5 * m[j] * pi_ij * gabs * vx / rx
             if hg_alpha > 0.0:
                 X0 = X[j, 0] - X[i, 0]
                 X1 = X[j, 1] - X[i, 1]
                 X2 = X[j, 2] - X[i, 2]
-                x0 = x[j, 0] - x[i, 0]
-                x1 = x[j, 1] - x[i, 1]
-                x2 = x[j, 2] - x[i, 2]
-                rx = np.sqrt(x0 * x0 + x1 * x1 + x2 * x2)
                 rX2 = X0 * X0 + X1 * X1 + X2 * X2
-                if rx == 0.0 or rX2 == 0.0:
+                if rX2 == 0.0:
                     continue
                 e0 = x0 / rx
                 e1 = x1 / rx
@@ -279,14 +349,16 @@ def tl_forces(x, X, m, rho0, vol, offsets, idx, g, w, B0, P, Fdef, young, hg_alp
                     dj += (pj - xr) * er
                 coef = -0.5 * hg_alpha * vol[i] * vj * w[k] * 0.5 * (
                     young[i] + young[j]) / rX2 * (di + dj)
-                h0 += coef * e0
-                h1 += coef * e1
-                h2 += coef * e2
+                h0x += coef * e0
+                h0y += coef * e1
+                h0z += coef * e2
         inv_rho0 = 1.0 / rho0[i]
-        a[i, 0] = a0 * inv_rho0
-        a[i, 1] = a1 * inv_rho0
-        a[i, 2] = a2 * inv_rho0
+        a[i, 0] = a0 * inv_rho0 + q0
+        a[i, 1] = a1 * inv_rho0 + q1
+        a[i, 2] = a2 * inv_rho0 + q2
         if m[i] > 0.0:
-            a[i, 0] += h0 / m[i]
-            a[i, 1] += h1 / m[i]
-            a[i, 2] += h2 / m[i]
+            a[i, 0] += h0x / m[i]
+            a[i, 1] += h0y / m[i]
+            a[i, 2] += h0z / m[i]
+            heat -= (h0x * v[i, 0] + h0y * v[i, 1] + h0z * v[i, 2]) / m[i]
+        dedt_av[i] = heat
