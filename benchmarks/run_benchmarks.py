@@ -30,10 +30,10 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true")
     args = ap.parse_args()
-    runs = [("rings2d", 1000, None), ("block3d", 200, 10_000), ("block3d", 50, 100_000),
+    runs = [("rings2d", 1000, None), ("rings2d_tl", 1000, None), ("block3d", 200, 10_000), ("block3d", 50, 100_000),
             ("block3d", 10, 1_000_000)]
     if args.quick:
-        runs = [("rings2d", 100, None), ("block3d", 20, 10_000)]
+        runs = [("rings2d", 100, None), ("rings2d_tl", 100, None), ("block3d", 20, 10_000)]
     print(f"machine: {platform.processor() or platform.machine()}, "
           f"{platform.system()} {platform.release()}, python {platform.python_version()}")
     print()

@@ -1,4 +1,4 @@
-"""Command line: ``sphdyn run|check|restart|plot|export|info|bench|material-test``.
+"""Command line: ``sphdyn run|check|restart|ensemble|plot|export|info|bench|material-test``.
 
 Each subcommand is a thin function over the Python API. Exit codes: 0 success,
 1 a failed run (guard stopped it; all output kept), 2 bad input (deck or
@@ -48,6 +48,21 @@ def _finish(summary: dict) -> int:
     keys = ("status", "particles", "steps", "time", "wall_seconds",
             "particle_steps_per_s", "energy_error_max_rel")
     print(json.dumps({k: summary.get(k) for k in keys}))
+    return 0
+
+
+def cmd_ensemble(args) -> int:
+    from .ensemble import run_ensemble, write_report
+
+    out = Path(args.out) if args.out else Path("out") / f"{Path(args.deck).stem}-ensemble"
+    if args.report:
+        print(write_report(out))
+        return 0
+    path = run_ensemble(args.deck, args.samples, vary=args.vary or (), out=out,
+                        scheduler=args.scheduler, workers=args.workers,
+                        threads=args.threads, overrides=args.set or (),
+                        progress=not args.quiet)
+    print(path)
     return 0
 
 
@@ -205,6 +220,28 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     r.set_defaults(func=cmd_run)
 
+    en = sub.add_parser("ensemble", help="run N random samples of a deck (and a grid "
+                        "of --vary values) on Dask; resumable; CSV table + damage figure")
+    en.add_argument("deck")
+    en.add_argument("--samples", type=int, default=1, help="replicates per grid point, "
+                    "seeds derived from run.seed and the replicate index (default 1)")
+    en.add_argument("--vary", action="append", metavar="KEY=V1,V2,...",
+                    help="a deck key and its values, e.g. sph.support_scale=0.7,1.0,1.5; "
+                    "repeatable (the grid is the product)")
+    en.add_argument("--scheduler", metavar="ADDRESS", help="a running Dask scheduler, "
+                    "e.g. tcp://host:8786 (default: a local cluster of processes)")
+    en.add_argument("--workers", type=int, help="local worker processes (default: one "
+                    "per core, at most one per sample)")
+    en.add_argument("--threads", type=int, help="Numba threads per sample (default: "
+                    "cores / workers locally, 1 on a scheduler)")
+    en.add_argument("--out", help="output directory (default out/<deck>-ensemble)")
+    en.add_argument("--set", action="append", metavar="KEY=VALUE",
+                    help="override a deck value in every sample")
+    en.add_argument("--report", action="store_true", help="run nothing: rewrite "
+                    "ensemble.csv and ensemble_damage.png from the samples in --out")
+    en.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    en.set_defaults(func=cmd_ensemble)
+
     c = sub.add_parser("check", help="validate a deck and build its model, run nothing")
     c.add_argument("deck")
     c.add_argument("--set", action="append", metavar="KEY=VALUE")
@@ -247,7 +284,7 @@ def build_parser() -> argparse.ArgumentParser:
     i.set_defaults(func=cmd_info)
 
     b = sub.add_parser("bench", help="run a built-in benchmark, print one JSON line")
-    b.add_argument("case", choices=("rings2d", "block3d"))
+    b.add_argument("case", choices=("rings2d", "rings2d_tl", "block3d"))
     b.add_argument("--steps", type=int, default=1000)
     b.add_argument("--threads", type=int, default=0)
     b.add_argument("--particles", type=int, help="block3d: approximate particle count")

@@ -12,7 +12,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..neighbours import build_neighbours
-from .total_lagrangian import (deformation_gradient, piola_stress, reference_gradients,
+from .total_lagrangian import (corrected_pair_gradients, deformation_gradient,
+                               hourglass_coefficients, piola_stress, reference_gradients,
                                tl_density, tl_forces)
 
 
@@ -58,16 +59,24 @@ class TotalLagrangian:
         full = build_neighbours(p.x0, p.h0, radius_factor, 0.0, dim, active=active)
         self.offsets, self.idx = same_body_pairs(full.offsets, full.idx, p.body)
         self.vol = np.divide(p.m, p.rho0, out=np.zeros(n), where=p.rho0 > 0)
-        self.g = np.zeros((self.idx.size, 3))
-        self.w = np.zeros(self.idx.size)
+        nnz = self.idx.size
+        g = np.zeros((nnz, 3))
+        w = np.zeros(nnz)
         self.B0 = np.zeros((n, 3, 3))
         reference_gradients(p.x0, p.h0, self.vol, self.offsets, self.idx, kid, sigma,
-                            dim, kscale, self.g, self.w, self.B0)
+                            dim, kscale, g, w, self.B0)
+        self.gi = np.zeros((nnz, 3))
+        self.gj = np.zeros((nnz, 3))
+        self.fac = np.zeros(nnz)
+        corrected_pair_gradients(p.x0, self.offsets, self.idx, g, self.B0, self.gi,
+                                 self.gj, self.fac)
         self.F = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
         self.Finv = self.F.copy()
         self.P = np.zeros((n, 3, 3))
-        self.young = np.ascontiguousarray(young, dtype=float)
-        self.hourglass = float(hourglass)
+        self.hgk = np.zeros(nnz)
+        hourglass_coefficients(self.rows, p.x0, self.vol, self.offsets, self.idx, w,
+                               np.ascontiguousarray(young, dtype=float), float(hourglass),
+                               self.hgk)
         self.alpha = float(alpha)
         self.beta = float(beta)
         self.kscale = float(kscale)
@@ -75,7 +84,7 @@ class TotalLagrangian:
     def velocity_gradient(self, p) -> None:
         """Fill ``p.L`` (and ``F``) of the total-Lagrangian rows."""
         deformation_gradient(self.rows, p.x, p.v, self.vol, self.offsets, self.idx,
-                             self.g, self.B0, self.dim, self.F, self.Finv, p.L)
+                             self.gi, self.dim, self.F, self.Finv, p.L)
 
     def density(self, p) -> None:
         """``rho = rho0 / det F`` and ``h = h0`` on the total-Lagrangian rows."""
@@ -86,9 +95,8 @@ class TotalLagrangian:
         and hourglass terms."""
         piola_stress(self.rows, self.F, self.Finv, p.sig, self.P)
         tl_forces(self.rows, p.x, p.v, p.x0, p.m, p.rho, p.rho0, p.c, p.h0, self.vol,
-                  self.offsets, self.idx, self.g, self.w, self.B0, self.P, self.F,
-                  self.young, self.hourglass, self.alpha, self.beta, self.kscale, p.a,
-                  dedt_av)
+                  self.offsets, self.idx, self.gi, self.gj, self.fac, self.hgk, self.P,
+                  self.F, self.dim, self.alpha, self.beta, self.kscale, p.a, dedt_av)
 
     @property
     def mean_neighbours(self) -> float:

@@ -116,7 +116,35 @@ def reference_gradients(X, h0, vol, offsets, idx, kid, sigma, dim, kscale, g, w,
 
 
 @njit(cache=True, parallel=True)
-def deformation_gradient(rows, x, v, vol, offsets, idx, g, B0, dim, Fdef, Finv, L):
+def corrected_pair_gradients(X, offsets, idx, g, B0, gi, gj, fac):
+    r"""Corrected reference gradients of both ends of every pair, once.
+
+    ``gi[k] = B_i g_ij`` and ``gj[k] = B_j g_ij`` (nnz, 3), so the force pass
+    evaluates :math:`(P_i B_i + P_j B_j)\, \mathbf g_{ij} = P_i\,
+    \mathbf{gi}_k + P_j\, \mathbf{gj}_k` with 18 multiply-adds per pair;
+    ``fac[k]`` (nnz,) is the scalar with :math:`\mathbf g_{ij} =
+    \mathrm{fac}_k (\mathbf X_i - \mathbf X_j)`, i.e. :math:`W'(R)/R` at the
+    reference distance (<= 0), used by the artificial viscosity. ``X`` (N, 3)
+    reference positions [m].
+    """
+    for i in prange(offsets.shape[0] - 1):
+        for k in range(offsets[i], offsets[i + 1]):
+            j = idx[k]
+            g0 = g[k, 0]
+            g1 = g[k, 1]
+            g2 = g[k, 2]
+            for a in range(3):
+                gi[k, a] = B0[i, a, 0] * g0 + B0[i, a, 1] * g1 + B0[i, a, 2] * g2
+                gj[k, a] = B0[j, a, 0] * g0 + B0[j, a, 1] * g1 + B0[j, a, 2] * g2
+            d0 = X[i, 0] - X[j, 0]
+            d1 = X[i, 1] - X[j, 1]
+            d2 = X[i, 2] - X[j, 2]
+            r2 = d0 * d0 + d1 * d1 + d2 * d2
+            fac[k] = (g0 * d0 + g1 * d1 + g2 * d2) / r2 if r2 > 0.0 else 0.0
+
+
+@njit(cache=True, parallel=True)
+def deformation_gradient(rows, x, v, vol, offsets, idx, gi, dim, Fdef, Finv, L):
     r"""Deformation gradient and velocity gradient from the reference kernel.
 
     .. math::
@@ -126,7 +154,9 @@ def deformation_gradient(rows, x, v, vol, offsets, idx, g, B0, dim, Fdef, Finv, 
                    \tilde{\mathbf g}_{ij},
         \qquad L_i = \dot F_i F_i^{-1}
 
-    (exact for linear motions thanks to :math:`B_i`). Only the particles
+    (exact for linear motions thanks to :math:`B_i`), with
+    :math:`\tilde{\mathbf g}_{ij}` = ``gi`` from
+    :func:`corrected_pair_gradients`. Only the particles
     ``rows`` (int64 indices) are evaluated; ``Fdef``, ``Finv`` (its inverse)
     and ``L`` (N, 3, 3) are written in those rows only; in 2D ``F_zz = 1``.
     ``L`` feeds the same material kernels as the updated-Lagrangian scheme
@@ -144,9 +174,9 @@ def deformation_gradient(rows, x, v, vol, offsets, idx, g, B0, dim, Fdef, Finv, 
             vj = vol[j]
             if vj == 0.0:
                 continue
-            gt0 = B0[i, 0, 0] * g[k, 0] + B0[i, 0, 1] * g[k, 1] + B0[i, 0, 2] * g[k, 2]
-            gt1 = B0[i, 1, 0] * g[k, 0] + B0[i, 1, 1] * g[k, 1] + B0[i, 1, 2] * g[k, 2]
-            gt2 = B0[i, 2, 0] * g[k, 0] + B0[i, 2, 1] * g[k, 1] + B0[i, 2, 2] * g[k, 2]
+            gt0 = gi[k, 0]
+            gt1 = gi[k, 1]
+            gt2 = gi[k, 2]
             for a in range(3):
                 dx = vj * (x[j, a] - x[i, a])
                 dv = vj * (v[j, a] - v[i, a])
@@ -216,8 +246,8 @@ def piola_stress(rows, Fdef, Finv, sig, P):
 
 
 @njit(cache=True, parallel=True)
-def tl_forces(rows, x, v, X, m, rho, rho0, c, h0, vol, offsets, idx, g, w, B0, P, Fdef,
-              young, hg_alpha, av_alpha, av_beta, kscale, a, dedt_av):
+def tl_forces(rows, x, v, X, m, rho, rho0, c, h0, vol, offsets, idx, gi, gj, fac, hgk,
+              P, Fdef, dim, av_alpha, av_beta, kscale, a, dedt_av):
     r"""Acceleration of the total-Lagrangian scheme with hourglass control.
 
     Momentum balance :math:`\rho_0 \dot{\mathbf v} = \nabla_X\cdot P` in the
@@ -233,12 +263,14 @@ def tl_forces(rows, x, v, X, m, rho, rho0, c, h0, vol, offsets, idx, g, w, B0, P
     :func:`sphdyn.sph.passes.forces`) with the current pair separation
     :math:`\mathbf x_{ij}`, velocity :math:`\mathbf v_{ij}`, density
     :math:`\rho = \rho_0/J` and the reference smoothing length, acting along
-    the current line of centres with the reference kernel slope,
-    :math:`\mathbf G_{ij} = -|\mathbf g_{ij}|\,\hat{\mathbf x}_{ij}`
-    (:math:`|\mathbf g_{ij}| = |W'(|\mathbf X_{ij}|)|`), so the viscous pair
-    force is central (linear and angular momentum conserved) and
-    dissipative; the heating rate is :math:`\dot e_i = \tfrac12\sum_j m_j
-    \Pi_{ij} \mathbf v_{ij}\cdot\mathbf G_{ij}`.
+    the current line of centres with the reference kernel factor,
+    :math:`\mathbf G_{ij} = \frac{W'(R_{ij})}{R_{ij}} (\mathbf x_i - \mathbf
+    x_j)` (:math:`R_{ij} = |\mathbf X_{ij}|`, ``fac`` below): the
+    updated-Lagrangian form with the kernel factor frozen at the reference
+    distance, so the viscous pair force is central (linear and angular
+    momentum conserved) and dissipative; the heating rate is
+    :math:`\dot e_i = \tfrac12\sum_j m_j \Pi_{ij} \mathbf v_{ij}\cdot
+    \mathbf G_{ij}`.
 
     *Hourglass control* (Ganzenmüller 2015) penalises the part of the pair
     separation not predicted by the particles' own deformation gradients:
@@ -253,7 +285,10 @@ def tl_forces(rows, x, v, X, m, rho, rho0, c, h0, vol, offsets, idx, g, w, B0, P
             (\delta^i_{ij} + \delta^j_{ij})\, \hat{\mathbf x}_{ij}.
 
     It vanishes for every linear deformation and is antisymmetric in the
-    pair. Its power :math:`-\mathbf f^{hg}_i\cdot\mathbf v_i / m_i` is added
+    pair. Since :math:`(\delta^i + \delta^j)\hat{\mathbf x} =
+    [((F_i + F_j)\mathbf X_{ij} - 2\mathbf x_{ij})\cdot\mathbf x_{ij}]\,
+    \mathbf x_{ij} / |\mathbf x_{ij}|^2`, the reference factor
+    ``hgk`` of :func:`hourglass_coefficients` is all it needs per pair. Its power :math:`-\mathbf f^{hg}_i\cdot\mathbf v_i / m_i` is added
     to ``dedt_av`` so that the energy balance closes (hourglass work is
     book-kept with the viscous heat).
 
@@ -265,100 +300,138 @@ def tl_forces(rows, x, v, X, m, rho, rho0, c, h0, vol, offsets, idx, g, w, B0, P
     m, rho, rho0, c, h0, vol : (N,) mass [kg], current and reference density
         [kg/m^3], wave speed [m/s], reference smoothing length [m],
         reference volume m/rho0.
-    g, w, B0 : from :func:`reference_gradients`.
+    gi, gj, fac : from :func:`corrected_pair_gradients`.
+    hgk : (nnz,) hourglass pair factors from :func:`hourglass_coefficients`
+        (all zero = hourglass control off).
     P, Fdef : (N, 3, 3) first Piola-Kirchhoff stress [Pa], deformation gradient.
-    young : (N,) Young's modulus for the hourglass stiffness [Pa].
-    hg_alpha : hourglass coefficient (0 = off; Ganzenmüller uses 10-50).
+    dim : 2 or 3 (2: z components skipped; they are zero).
     av_alpha, av_beta : artificial viscosity coefficients; kscale: support scale.
     a : (N, 3) out, acceleration [m/s^2].
     dedt_av : (N,) out, viscous + hourglass heating rate [W/kg].
     """
+    visc = av_alpha > 0.0 or av_beta > 0.0
+    three = dim == 3
     for t in prange(rows.shape[0]):
         i = rows[t]
-        a0 = a1 = a2 = 0.0
-        h0x = h0y = h0z = 0.0
+        pi00 = P[i, 0, 0]
+        pi01 = P[i, 0, 1]
+        pi02 = P[i, 0, 2]
+        pi10 = P[i, 1, 0]
+        pi11 = P[i, 1, 1]
+        pi12 = P[i, 1, 2]
+        pi20 = P[i, 2, 0]
+        pi21 = P[i, 2, 1]
+        pi22 = P[i, 2, 2]
+        xi0 = x[i, 0]
+        xi1 = x[i, 1]
+        xi2 = x[i, 2]
+        vi0 = v[i, 0]
+        vi1 = v[i, 1]
+        vi2 = v[i, 2]
+        ci = c[i]
+        rhoi = rho[i]
+        hi = h0[i]
+        rho0i = rho0[i]
+        a0 = a1 = a2 = 0.0  # stress part times rho0_i, viscous part [m/s^2]
         q0 = q1 = q2 = 0.0
+        f0 = f1 = f2 = 0.0  # hourglass force [N]
         heat = 0.0
         for k in range(offsets[i], offsets[i + 1]):
             j = idx[k]
             vj = vol[j]
-            if vj == 0.0:
+            fk = fac[k]
+            if vj == 0.0 or fk == 0.0:
                 continue
-            gk0 = g[k, 0]
-            gk1 = g[k, 1]
-            gk2 = g[k, 2]
-            if gk0 == 0.0 and gk1 == 0.0 and gk2 == 0.0:
-                continue
-            # c = (P_i B_i + P_j B_j) g
-            for r in range(3):
-                s = 0.0
-                for cc in range(3):
-                    bi = B0[i, cc, 0] * gk0 + B0[i, cc, 1] * gk1 + B0[i, cc, 2] * gk2
-                    bj = B0[j, cc, 0] * gk0 + B0[j, cc, 1] * gk1 + B0[j, cc, 2] * gk2
-                    s += P[i, r, cc] * bi + P[j, r, cc] * bj
-                if r == 0:
-                    a0 += vj * s
-                elif r == 1:
-                    a1 += vj * s
-                else:
-                    a2 += vj * s
-            # current pair geometry, x_ij = x_j - x_i
-            x0 = x[j, 0] - x[i, 0]
-            x1 = x[j, 1] - x[i, 1]
-            x2 = x[j, 2] - x[i, 2]
-            rx2 = x0 * x0 + x1 * x1 + x2 * x2
-            if rx2 == 0.0:
-                continue
-            rx = np.sqrt(rx2)
-            if av_alpha > 0.0 or av_beta > 0.0:
-                w0 = v[j, 0] - v[i, 0]
-                w1 = v[j, 1] - v[i, 1]
-                w2 = v[j, 2] - v[i, 2]
-                vx = w0 * x0 + w1 * x1 + w2 * x2  # = v_ij . x_ij (both signs flip)
+            # (P_i B_i + P_j B_j) g = P_i gi + P_j gj
+            bi0 = gi[k, 0]
+            bi1 = gi[k, 1]
+            bj0 = gj[k, 0]
+            bj1 = gj[k, 1]
+            a0 += vj * (pi00 * bi0 + pi01 * bi1 + P[j, 0, 0] * bj0 + P[j, 0, 1] * bj1)
+            a1 += vj * (pi10 * bi0 + pi11 * bi1 + P[j, 1, 0] * bj0 + P[j, 1, 1] * bj1)
+            # current pair geometry d = x_i - x_j
+            d0 = xi0 - x[j, 0]
+            d1 = xi1 - x[j, 1]
+            w0 = vi0 - v[j, 0]
+            w1 = vi1 - v[j, 1]
+            if three:
+                bi2 = gi[k, 2]
+                bj2 = gj[k, 2]
+                a0 += vj * (pi02 * bi2 + P[j, 0, 2] * bj2)
+                a1 += vj * (pi12 * bi2 + P[j, 1, 2] * bj2)
+                a2 += vj * (pi20 * bi0 + pi21 * bi1 + pi22 * bi2
+                            + P[j, 2, 0] * bj0 + P[j, 2, 1] * bj1 + P[j, 2, 2] * bj2)
+                d2 = xi2 - x[j, 2]
+                w2 = vi2 - v[j, 2]
+            else:
+                d2 = 0.0
+                w2 = 0.0
+            r2 = d0 * d0 + d1 * d1 + d2 * d2
+            if visc:
+                vx = w0 * d0 + w1 * d1 + w2 * d2
                 if vx < 0.0:
-                    hij = kscale * 0.5 * (h0[i] + h0[j])
-                    mu = hij * vx / (rx2 + 0.01 * hij * hij)
-                    pi_ij = (-av_alpha * 0.5 * (c[i] + c[j]) * mu + av_beta * mu * mu) / (
-                        0.5 * (rho[i] + rho[j]))
-                    gabs = np.sqrt(gk0 * gk0 + gk1 * gk1 + gk2 * gk2)
-                    # -m_j Pi G_ij with G_ij = -|g| (x_i - x_j)/r = |g| x_ij / r
-                    f = -m[j] * pi_ij * gabs / rx
-                    q0 += f * x0
-                    q1 += f * x1
-                    q2 += f * x2
-                    # 1/2 m_j Pi v_ij . G_ij with v_ij . G_ij = -|g| vx / r
-                    heat -= 0.5 * m[j] * pi_ij * gabs * vx / rx
-            if hg_alpha > 0.0:
+                    hij = kscale * 0.5 * (hi + h0[j])
+                    mu = hij * vx / (r2 + 0.01 * hij * hij)
+                    pi_ij = (-av_alpha * 0.5 * (ci + c[j]) * mu + av_beta * mu * mu) / (
+                        0.5 * (rhoi + rho[j]))
+                    # -m_j Pi G_ij, G_ij = fac (x_i - x_j)
+                    mpf = m[j] * pi_ij * fk
+                    q0 -= mpf * d0
+                    q1 -= mpf * d1
+                    q2 -= mpf * d2
+                    heat += 0.5 * mpf * vx
+            hk = hgk[k]
+            if hk != 0.0 and r2 > 0.0:
                 X0 = X[j, 0] - X[i, 0]
                 X1 = X[j, 1] - X[i, 1]
                 X2 = X[j, 2] - X[i, 2]
-                rX2 = X0 * X0 + X1 * X1 + X2 * X2
-                if rX2 == 0.0:
-                    continue
-                e0 = x0 / rx
-                e1 = x1 / rx
-                e2 = x2 / rx
-                di = 0.0
-                dj = 0.0
-                for r in range(3):
-                    er = e0 if r == 0 else (e1 if r == 1 else e2)
-                    xr = x0 if r == 0 else (x1 if r == 1 else x2)
-                    pi = Fdef[i, r, 0] * X0 + Fdef[i, r, 1] * X1 + Fdef[i, r, 2] * X2
-                    pj = Fdef[j, r, 0] * X0 + Fdef[j, r, 1] * X1 + Fdef[j, r, 2] * X2
-                    di += (pi - xr) * er
-                    dj += (pj - xr) * er
-                coef = -0.5 * hg_alpha * vol[i] * vj * w[k] * 0.5 * (
-                    young[i] + young[j]) / rX2 * (di + dj)
-                h0x += coef * e0
-                h0y += coef * e1
-                h0z += coef * e2
-        inv_rho0 = 1.0 / rho0[i]
+                # s = (F_i + F_j) X_ij - 2 x_ij, with x_ij = x_j - x_i = -d
+                s0 = ((Fdef[i, 0, 0] + Fdef[j, 0, 0]) * X0 + (Fdef[i, 0, 1] + Fdef[j, 0, 1]) * X1
+                      + (Fdef[i, 0, 2] + Fdef[j, 0, 2]) * X2 + 2.0 * d0)
+                s1 = ((Fdef[i, 1, 0] + Fdef[j, 1, 0]) * X0 + (Fdef[i, 1, 1] + Fdef[j, 1, 1]) * X1
+                      + (Fdef[i, 1, 2] + Fdef[j, 1, 2]) * X2 + 2.0 * d1)
+                s2 = ((Fdef[i, 2, 0] + Fdef[j, 2, 0]) * X0 + (Fdef[i, 2, 1] + Fdef[j, 2, 1]) * X1
+                      + (Fdef[i, 2, 2] + Fdef[j, 2, 2]) * X2 + 2.0 * d2)
+                # hgk (s . x_ij) x_ij / r^2 = hgk (s . d) d / r^2
+                coef = hk * (s0 * d0 + s1 * d1 + s2 * d2) / r2
+                f0 += coef * d0
+                f1 += coef * d1
+                f2 += coef * d2
+        inv_rho0 = 1.0 / rho0i
         a[i, 0] = a0 * inv_rho0 + q0
         a[i, 1] = a1 * inv_rho0 + q1
         a[i, 2] = a2 * inv_rho0 + q2
         if m[i] > 0.0:
-            a[i, 0] += h0x / m[i]
-            a[i, 1] += h0y / m[i]
-            a[i, 2] += h0z / m[i]
-            heat -= (h0x * v[i, 0] + h0y * v[i, 1] + h0z * v[i, 2]) / m[i]
+            a[i, 0] += f0 / m[i]
+            a[i, 1] += f1 / m[i]
+            a[i, 2] += f2 / m[i]
+            heat -= (f0 * vi0 + f1 * vi1 + f2 * vi2) / m[i]
         dedt_av[i] = heat
+
+
+@njit(cache=True, parallel=True)
+def hourglass_coefficients(rows, X, vol, offsets, idx, w, young, alpha, hgk):
+    r"""Reference pair factors of Ganzenmüller's (2015) hourglass force.
+
+    .. math:: \mathrm{hgk}_{ij} = -\frac{\alpha}{2}\,
+              \frac{V_i V_j W_{ij}\, \tfrac12 (E_i + E_j)}{|\mathbf X_{ij}|^2}
+
+    for the pairs of ``rows`` (the force is then ``hgk`` times
+    :math:`(\delta^i+\delta^j)\hat{\mathbf x}_{ij}`, see :func:`tl_forces`).
+    ``X`` (N, 3) reference positions [m], ``vol`` (N,) reference volumes,
+    ``w`` (nnz,) reference kernel values, ``young`` (N,) Young's moduli
+    [Pa], ``alpha`` the dimensionless coefficient; ``hgk`` (nnz,) out
+    [N/m^2 in 3D].
+    """
+    for t in prange(rows.shape[0]):
+        i = rows[t]
+        for k in range(offsets[i], offsets[i + 1]):
+            j = idx[k]
+            d0 = X[j, 0] - X[i, 0]
+            d1 = X[j, 1] - X[i, 1]
+            d2 = X[j, 2] - X[i, 2]
+            r2 = d0 * d0 + d1 * d1 + d2 * d2
+            if r2 == 0.0 or alpha == 0.0:
+                hgk[k] = 0.0
+            else:
+                hgk[k] = -0.25 * alpha * vol[i] * vol[j] * w[k] * (young[i] + young[j]) / r2
