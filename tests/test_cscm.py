@@ -362,3 +362,32 @@ def test_group_kernel_matches_point_function_and_wave_speed():
     K, G = p[1], p[2]
     assert c[0] == pytest.approx(math.sqrt((1 - dmg[0]) * (K + 4 * G / 3) / 2400), rel=1e-12)
     assert c[2] == pytest.approx(math.sqrt((K + 4 * G / 3) / 2400), rel=1e-12)
+
+
+def test_fast_return_equals_global_closest_point():
+    # project() takes a local bracketing path when the trial lies above the
+    # meridian; it must find the same closest point as the global scan +
+    # golden-section search of project_global() (and never a worse one).
+    # 1500 random trials: tension, shear, compression up to beyond the cap,
+    # three Lode angles, initial and hardened caps. Tolerance 1e-6 of the
+    # surface extent in J1 (the golden bracket + refinement reach ~1e-9).
+    p = packed()
+    K, G = p[cscm.P_K], p[cscm.P_G]
+    rng = np.random.default_rng(7)
+    k0 = cscm.kappa0(p)
+    checked = 0
+    for kappa in (k0, 60e6, 150e6):
+        X = cscm.cap_function(0.0, kappa, p)[1]
+        ext = X - p[cscm.P_J1APEX]
+        for _ in range(500):
+            J1t = rng.uniform(p[cscm.P_J1APEX] - 5e6, X + 20e6)
+            bhat = rng.choice([-math.pi / 6, 0.0, math.pi / 6]) * rng.uniform(0.2, 1.0)
+            rt = rng.uniform(0.0, 2.0) * cscm.shear_surface(max(J1t, 0.0), p)
+            fast = cscm.project(J1t, rt, bhat, kappa, K, G, p)
+            glob = cscm.project_global(J1t, rt, bhat, kappa, K, G, p)
+            phi = [(j - J1t) ** 2 / (9 * K) + (r - rt) ** 2 / G for j, r in (fast, glob)]
+            assert phi[0] <= phi[1] * (1 + 1e-9) + 1e-30
+            assert abs(fast[0] - glob[0]) < 1e-6 * ext
+            assert abs(fast[1] - glob[1]) < 1e-6 * ext
+            checked += 1
+    assert checked == 1500

@@ -99,6 +99,8 @@ H_SVP = 15
 H_RATE = 21
 H_RF = 22
 NSCAN = 32  # coarse scan of the projection (see project)
+NGOLDEN = 30  # golden-section iterations of the projection (bracket 5e-7 of a scan cell)
+N_STRIPES = 64  # interleaved work stripes of the group kernel (load balance)
 DMAX = 0.999  # maximum damage in unconfined states [R] (notes sec. 1.9)
 
 
@@ -170,15 +172,21 @@ def rubin_factor(q1, q2, bhat):
     bhat : float
         Lode angle in [-pi/6, pi/6] [rad] (see :func:`invariants`).
     """
+    return _rubin_cs(q1, q2, math.cos(bhat), math.sin(bhat))
+
+
+@njit(cache=True)
+def _rubin_cs(q1, q2, cb, sb):
+    """:func:`rubin_factor` with ``cos(beta_hat)``, ``sin(beta_hat)`` given."""
     a0 = 2.0 * q1 * q1 * (q2 - 1.0)
     a1 = math.sqrt(3.0) * q2 + 2.0 * q1 * (q2 - 1.0)
     a2 = q2
     a = (-a1 + math.sqrt(max(a1 * a1 - 4.0 * a2 * a0, 0.0))) / (2.0 * a2)
     b = (2.0 * q1 + a) ** 2 - 3.0
     b0 = -(3.0 + b - a * a) / 4.0
-    cs = math.cos(bhat) - a * math.sin(bhat)
+    cs = cb - a * sb
     b1 = a * cs
-    b2 = cs * cs + b * math.sin(bhat) ** 2
+    b2 = cs * cs + b * sb * sb
     return (-b1 + math.sqrt(max(b1 * b1 - 4.0 * b2 * b0, 0.0))) / (2.0 * b2)
 
 
@@ -275,14 +283,33 @@ def surface_radius(J1, bhat, kappa, p):
     """``sqrt(J2')`` on the yield surface: ``Rub Ff sqrt(Fc)`` (0 outside
     ``[J1_apex, X]``). Yield function ``f = J2' - Rub^2 Ff^2 Fc`` (notes
     sec. 1.4 [S]; thesis eq. 5.1.1)."""
-    fc, X = cap_function(J1, kappa, p)
+    return _radius(J1, meridian(bhat, kappa, p), p)
+
+
+@njit(cache=True)
+def meridian(bhat, kappa, p):
+    """Constants of the meridian ``F(J1)`` at fixed Lode angle and cap:
+    ``(cos beta_hat, sin beta_hat, L(kappa), X(kappa))`` (see
+    :func:`cap_function`), computed once per return instead of per point."""
+    L = kappa if kappa > p[P_KAPPA0] else p[P_KAPPA0]
+    return math.cos(bhat), math.sin(bhat), L, L + p[P_R] * shear_surface(L, p)
+
+
+@njit(cache=True)
+def _radius(J1, m, p):
+    """:func:`surface_radius` with the meridian constants ``m`` of :func:`meridian`."""
+    cb, sb, L, X = m
     if J1 <= p[P_J1APEX] or J1 >= X:
         return 0.0
-    q1, q2 = rubin_q(J1, p)
     ff = shear_surface(J1, p)
     if ff <= 0.0:
         return 0.0
-    return rubin_factor(q1, q2, bhat) * ff * math.sqrt(fc)
+    q1, q2 = rubin_q(J1, p)
+    r = _rubin_cs(q1, q2, cb, sb) * ff
+    if J1 <= L:
+        return r
+    t = (J1 - L) / (X - L)
+    return r * math.sqrt(max(1.0 - t * t, 0.0))
 
 
 @njit(cache=True)
@@ -305,7 +332,103 @@ def project(J1t, rt, bhat, kappa, K, G, p):
     """Closest point of the yield surface to a trial point, energy norm.
 
     Minimises ``phi(J1) = (J1 - J1t)^2/(9K) + (F(J1) - rt)^2/G`` over
-    ``J1 in [J1_apex, X]`` by golden-section search (after a coarse scan of 33 points; 40 iterations, then bisection on the derivative), ``F = Rub Ff sqrt(Fc)`` at the trial Lode
+    ``J1 in [J1_apex, X]``, ``F = Rub Ff sqrt(Fc)`` at the trial Lode angle
+    (associated closest-point return in the meridian plane for isotropic
+    elasticity: notes sec. 1.3 [V text], choice [D]).
+
+    Fast path (the usual plastic sub-step): the trial lies above the
+    meridian, ``J1_apex < J1t < X`` and ``rt > F(J1t)``. For a concave
+    meridian ``F`` (shear surface, Rubin ratios and elliptical cap are
+    concave in J1), ``dphi/dJ1`` is increasing wherever ``F < rt``, and
+    points beyond the first ``J1`` with ``F >= rt`` are farther than that
+    point, so the minimiser is the unique root of ``dphi/dJ1`` found by
+    stepping away from ``J1t`` (doubling steps) until the sign changes,
+    then Illinois regula falsi (:func:`_refine`). If no sign change is found
+    before an end of the interval, or the trial is not above the meridian,
+    :func:`project_global` (scan + golden section + refinement) decides.
+    The two agree to the refinement tolerance (tests/test_cscm.py).
+
+    Returns
+    -------
+    (J1, sqrt(J2')) of the returned point [Pa].
+    """
+    return _project(J1t, rt, meridian(bhat, kappa, p), K, G, p)
+
+
+@njit(cache=True)
+def _project(J1t, rt, m, K, G, p):
+    """:func:`project` with the meridian constants ``m`` of :func:`meridian`."""
+    X = m[3]
+    apex = p[P_J1APEX]
+    if apex < J1t < X:
+        Ft = _radius(J1t, m, p)
+        if rt > Ft > 0.0:
+            g0, dF = _dphi_slope(J1t, J1t, rt, m, K, G, p)
+            if g0 == 0.0:
+                return J1t, Ft
+            sgn = 1.0 if g0 < 0.0 else -1.0
+            # first step: the Newton step with dphi''/2 ~ 1/(9K) + F'^2/G,
+            # which underestimates the curvature where F < rt and F'' < 0,
+            # so it usually overshoots the root and brackets it at once
+            step = abs(g0) / (1.0 / (9.0 * K) + dF * dF / G)
+            step = max(step, 1e-9 * (X - apex))
+            x0, gx0 = J1t, g0
+            for _ in range(40):
+                x1 = J1t + sgn * step
+                if x1 <= apex or x1 >= X:
+                    break
+                g1 = _dphi(x1, J1t, rt, m, K, G, p)
+                if (g1 > 0.0) != (gx0 > 0.0):
+                    if sgn > 0.0:
+                        J1 = _refine(x0, x1, gx0, g1, J1t, rt, m, K, G, p)
+                    else:
+                        J1 = _refine(x1, x0, g1, gx0, J1t, rt, m, K, G, p)
+                    return J1, _radius(J1, m, p)
+                x0, gx0 = x1, g1
+                step *= 2.0
+    return _project_global(J1t, rt, m, K, G, p)
+
+
+@njit(cache=True)
+def _refine(lo, hi, gl, gh, J1t, rt, m, K, G, p):
+    """Root of ``dphi/dJ1`` in ``[lo, hi]`` with ``gl < 0 < gh`` (Illinois regula falsi).
+
+    Superlinear bracketing iteration (Dowell & Jarratt 1971); stops at a
+    bracket of ``1e-11 (|J1t| + alpha)`` (about 1e-4 Pa) or after 60
+    iterations.
+    """
+    tol = 1e-11 * (abs(J1t) + abs(p[P_ALPHA]))
+    side = 0
+    mid = 0.5 * (lo + hi)
+    for _ in range(60):
+        mid = (lo * gh - hi * gl) / (gh - gl)
+        gm = _dphi(mid, J1t, rt, m, K, G, p)
+        if gm < 0.0:
+            lo, gl = mid, gm
+            if side == -1:
+                gh *= 0.5
+            side = -1
+        elif gm > 0.0:
+            hi, gh = mid, gm
+            if side == 1:
+                gl *= 0.5
+            side = 1
+        else:
+            return mid
+        if hi - lo <= tol:
+            return 0.5 * (lo + hi)
+    return mid
+
+
+@njit(cache=True)
+def project_global(J1t, rt, bhat, kappa, K, G, p):
+    """Closest point of the yield surface to a trial point, energy norm (global search).
+
+    Minimises ``phi(J1) = (J1 - J1t)^2/(9K) + (F(J1) - rt)^2/G`` over
+    ``J1 in [J1_apex, X]``: a coarse scan of ``NSCAN + 1`` points brackets
+    the global minimum, ``NGOLDEN`` golden-section steps narrow the bracket,
+    and Illinois regula falsi on ``dphi/dJ1 = 0`` (:func:`_refine`)
+    converges; ``F = Rub Ff sqrt(Fc)`` at the trial Lode
     angle. For isotropic elasticity this is the associated (closest-point)
     return restricted to the meridian plane (notes sec. 1.3 [V text], choice
     [D]).
@@ -314,7 +437,13 @@ def project(J1t, rt, bhat, kappa, K, G, p):
     -------
     (J1, sqrt(J2')) of the returned point [Pa].
     """
-    fc, X = cap_function(0.0, kappa, p)
+    return _project_global(J1t, rt, meridian(bhat, kappa, p), K, G, p)
+
+
+@njit(cache=True)
+def _project_global(J1t, rt, m, K, G, p):
+    """:func:`project_global` with the meridian constants ``m``."""
+    X = m[3]
     # phi need not be unimodal on the whole interval (e.g. a trial beyond
     # the cap: local minima on the shear part and at X), so a coarse scan
     # of NSCAN + 1 points picks the bracket of the global minimum first.
@@ -324,7 +453,7 @@ def project(J1t, rt, bhat, kappa, K, G, p):
     phib = 1e300
     for k in range(NSCAN + 1):
         x = lo0 + k * width
-        fx = surface_radius(x, bhat, kappa, p)
+        fx = _radius(x, m, p)
         ph = (x - J1t) ** 2 / (9.0 * K) + (fx - rt) ** 2 / G
         if ph < phib:
             phib = ph
@@ -334,52 +463,59 @@ def project(J1t, rt, bhat, kappa, K, G, p):
     gr = 0.5 * (math.sqrt(5.0) - 1.0)
     c = b - gr * (b - a)
     d = a + gr * (b - a)
-    fcv = surface_radius(c, bhat, kappa, p)
-    fdv = surface_radius(d, bhat, kappa, p)
+    fcv = _radius(c, m, p)
+    fdv = _radius(d, m, p)
     phic = (c - J1t) ** 2 / (9.0 * K) + (fcv - rt) ** 2 / G
     phid = (d - J1t) ** 2 / (9.0 * K) + (fdv - rt) ** 2 / G
-    for _ in range(40):
+    for _ in range(NGOLDEN):
         if phic < phid:
             b = d
             d = c
             phid = phic
             c = b - gr * (b - a)
-            fcv = surface_radius(c, bhat, kappa, p)
+            fcv = _radius(c, m, p)
             phic = (c - J1t) ** 2 / (9.0 * K) + (fcv - rt) ** 2 / G
         else:
             a = c
             c = d
             phic = phid
             d = a + gr * (b - a)
-            fdv = surface_radius(d, bhat, kappa, p)
+            fdv = _radius(d, m, p)
             phid = (d - J1t) ** 2 / (9.0 * K) + (fdv - rt) ** 2 / G
     J1 = 0.5 * (a + b)
     # The golden section locates the minimiser only to ~sqrt(eps) relative
-    # (phi is flat there); refine by bisection on dphi/dJ1 (central
-    # difference for F') inside a small bracket, if it brackets a sign change.
-    lo = max(J1 - 1e-4 * (b - a), p[P_J1APEX])
-    hi = min(J1 + 1e-4 * (b - a), X)
-    gl = _dphi(lo, J1t, rt, bhat, kappa, K, G, p)
-    gh = _dphi(hi, J1t, rt, bhat, kappa, K, G, p)
+    # (phi is flat there); refine on dphi/dJ1 = 0 (central difference for F')
+    # inside the golden bracket by the Illinois variant of regula falsi
+    # (superlinear, the bracket is kept), if the bracket holds a sign change.
+    lo = max(a, p[P_J1APEX])
+    hi = min(b, X)
+    gl = _dphi(lo, J1t, rt, m, K, G, p)
+    gh = _dphi(hi, J1t, rt, m, K, G, p)
     if gl < 0.0 < gh:
-        for _ in range(60):
-            mid = 0.5 * (lo + hi)
-            if _dphi(mid, J1t, rt, bhat, kappa, K, G, p) < 0.0:
-                lo = mid
-            else:
-                hi = mid
-        J1 = 0.5 * (lo + hi)
-    return J1, surface_radius(J1, bhat, kappa, p)
+        J1 = _refine(lo, hi, gl, gh, J1t, rt, m, K, G, p)
+    return J1, _radius(J1, m, p)
 
 
 @njit(cache=True)
-def _dphi(J1, J1t, rt, bhat, kappa, K, G, p):
-    """Half the derivative of the projection distance ``phi`` (see :func:`project`)."""
+def _dphi_slope(J1, J1t, rt, m, K, G, p):
+    """Half the derivative of the projection distance ``phi`` (see
+    :func:`project`), ``(J1 - J1t)/(9K) + (F - rt) F'/G``, and the meridian
+    slope ``F' = dF/dJ1`` (one-sided difference, step ``h = 1e-7 (|J1| +
+    alpha)``, backward within ``h`` of the cap end X; the O(h F'') error
+    moves the returned point by ~1e-7 of the return distance)."""
     h = 1e-7 * (abs(J1) + abs(p[P_ALPHA]))
-    F = surface_radius(J1, bhat, kappa, p)
-    dF = (surface_radius(J1 + h, bhat, kappa, p)
-          - surface_radius(J1 - h, bhat, kappa, p)) / (2.0 * h)
-    return (J1 - J1t) / (9.0 * K) + (F - rt) * dF / G
+    F = _radius(J1, m, p)
+    if J1 + h < m[3]:
+        dF = (_radius(J1 + h, m, p) - F) / h
+    else:
+        dF = (F - _radius(J1 - h, m, p)) / h
+    return (J1 - J1t) / (9.0 * K) + (F - rt) * dF / G, dF
+
+
+@njit(cache=True)
+def _dphi(J1, J1t, rt, m, K, G, p):
+    """Half the derivative of the projection distance ``phi`` (see :func:`project`)."""
+    return _dphi_slope(J1, J1t, rt, m, K, G, p)[0]
 
 
 @njit(cache=True)
@@ -544,11 +680,16 @@ def cscm_point(h, deps, dt, p, size):
         svp_old = svp
         trial = elastic_increment(svp, de, K, G)
         kappa = h[H_KAPPA]
-        if yield_function(trial, kappa, p) <= 1e-12 * (p[P_ALPHA] ** 2):
+        # yield check f = J2' - F^2 <= tol (as yield_function, with the
+        # invariants and meridian constants reused by the return)
+        J1t, rt, bhat, dev = invariants(trial)
+        mer = meridian(bhat, kappa, p)
+        ft = _radius(J1t, mer, p)
+        if (p[P_J1APEX] <= J1t <= mer[3]
+                and rt * rt - ft * ft <= 1e-12 * (p[P_ALPHA] ** 2)):
             svp = trial
         else:
-            J1t, rt, bhat, dev = invariants(trial)
-            J1p, rp = project(J1t, rt, bhat, kappa, K, G, p)
+            J1p, rp = _project(J1t, rt, mer, K, G, p)
             fac = rp / rt if rt > 0.0 else 0.0
             mp = -J1p / 3.0
             sP = (fac * dev[0] + mp, fac * dev[1] + mp, fac * dev[2] + mp,
@@ -677,29 +818,42 @@ def cscm_update(idx, L, dt, rho, sig, e, c, damage, hist, params, size):
     ``c[i] = sqrt((1-d)(K + 4G/3)/rho)`` with the damaged moduli (``sqrt(K/rho)``
     with the undamaged K for an eroded point, which keeps a compressive
     pressure). Shapes/units: ``base.KERNEL_SIGNATURE_DOC``.
+
+    The particles are dealt round-robin to ``N_STRIPES`` interleaved stripes
+    (stripe ``t`` takes ``idx[t], idx[t + N_STRIPES], ...``) and the stripes
+    to the threads: plastic points cost ten times more than elastic ones and
+    cluster in space (the contact zone), which a contiguous split of ``idx``
+    would give to one thread. Each particle writes only its own rows.
     """
+    n = idx.shape[0]
+    for t in prange(N_STRIPES):
+        for k in range(t, n, N_STRIPES):
+            _update_particle(idx[k], L, dt, rho, sig, e, c, damage, hist, params, size)
+
+
+@njit(cache=True)
+def _update_particle(i, L, dt, rho, sig, e, c, damage, hist, params, size):
+    """One particle of :func:`cscm_update`."""
     K = params[P_K]
     G = params[P_G]
-    for k in prange(idx.shape[0]):
-        i = idx[k]
-        d, w = rate_split(L, i)
-        s_old = jaumann_rotate(load_sym6(sig, i), w, dt)
-        h = hist[i]
-        svp = jaumann_rotate((h[H_SVP], h[H_SVP + 1], h[H_SVP + 2],
-                              h[H_SVP + 3], h[H_SVP + 4], h[H_SVP + 5]), w, dt)
-        ep = jaumann_rotate((h[H_EPS], h[H_EPS + 1], h[H_EPS + 2],
-                             h[H_EPS + 3], h[H_EPS + 4], h[H_EPS + 5]), w, dt)
-        for j in range(6):
-            h[H_SVP + j] = svp[j]
-            h[H_EPS + j] = ep[j]
-        s_new, dmg = cscm_point(h, scale6(d, dt), dt, params, size[i])
-        store_sym6(sig, i, s_new)
-        damage[i] = dmg
-        e[i] += energy_increment(s_old, s_new, d, dt, rho[i])
-        if h[H_ERODED] > 0.0:
-            c[i] = p_wave_speed(K, 0.0, rho[i])
-        else:
-            c[i] = p_wave_speed((1.0 - dmg) * K, (1.0 - dmg) * G, rho[i])
+    d, w = rate_split(L, i)
+    s_old = jaumann_rotate(load_sym6(sig, i), w, dt)
+    h = hist[i]
+    svp = jaumann_rotate((h[H_SVP], h[H_SVP + 1], h[H_SVP + 2],
+                          h[H_SVP + 3], h[H_SVP + 4], h[H_SVP + 5]), w, dt)
+    ep = jaumann_rotate((h[H_EPS], h[H_EPS + 1], h[H_EPS + 2],
+                         h[H_EPS + 3], h[H_EPS + 4], h[H_EPS + 5]), w, dt)
+    for j in range(6):
+        h[H_SVP + j] = svp[j]
+        h[H_EPS + j] = ep[j]
+    s_new, dmg = cscm_point(h, scale6(d, dt), dt, params, size[i])
+    store_sym6(sig, i, s_new)
+    damage[i] = dmg
+    e[i] += energy_increment(s_old, s_new, d, dt, rho[i])
+    if h[H_ERODED] > 0.0:
+        c[i] = p_wave_speed(K, 0.0, rho[i])
+    else:
+        c[i] = p_wave_speed((1.0 - dmg) * K, (1.0 - dmg) * G, rho[i])
 
 
 # --------------------------------------------------------------------------
