@@ -20,7 +20,7 @@ def _tensor(sig, rho=RHO, eps=EPS):
     sig = np.asarray(sig, float).reshape(-1, 3, 3)
     R = np.zeros_like(sig)
     Q = np.zeros_like(sig)
-    artificial_stress_tensor(sig, np.full(sig.shape[0], rho), eps, R, Q)
+    artificial_stress_tensor(sig, np.full(sig.shape[0], rho), np.full(sig.shape[0], eps), R, Q)
     return R
 
 
@@ -106,7 +106,7 @@ def test_momentum_conserved_to_round_off(dim, n_exp):
     c = _cloud(dim)
     n = c["x"].shape[0]
     R = np.zeros((n, 3, 3))
-    artificial_stress_tensor(c["sig"], c["rho"], EPS, R, np.zeros((n, 3, 3)))
+    artificial_stress_tensor(c["sig"], c["rho"], np.full(n, EPS), R, np.zeros((n, 3, 3)))
     a = np.zeros((n, 3))
     nl = c["nl"]
     artificial_stress_forces(c["x"], c["m"], c["h"], R, c["F"], nl.offsets, nl.idx,
@@ -129,7 +129,7 @@ def test_pair_force_is_repulsive_with_the_stated_magnitude():
     sig = np.zeros((2, 3, 3))
     sig[:, 0, 0] = s
     R = np.zeros((2, 3, 3))
-    artificial_stress_tensor(sig, np.full(2, RHO), EPS, R, np.zeros((2, 3, 3)))
+    artificial_stress_tensor(sig, np.full(2, RHO), np.full(2, EPS), R, np.zeros((2, 3, 3)))
     Fij = kernels.grad_factor(kid, sigma, dim, dx, h)
     offsets = np.array([0, 1, 2])
     idx = np.array([1, 0])
@@ -194,3 +194,29 @@ def test_solver_with_artificial_stress_conserves_momentum():
     p1 = (p.m[:, None] * p.v).sum(axis=0)
     assert np.abs(p.sig).max() > 0
     assert np.abs(p1 - p0).max() < 1e-12 * np.abs(p.m[:, None] * p.v).sum()
+
+
+def test_epsilon_per_body():
+    # A second body with its own epsilon = 0 gets no artificial stress
+    # (R = 0 on its rows, even under tension), the first keeps the deck's;
+    # only [sph] epsilon = 0 with a body's epsilon > 0 switches the passes on.
+    second = DECK.format(eps=0.3).replace('name = "b"', 'name = "b"', 1) + """
+[[body]]
+name = "c"
+material = "m"
+dx = 0.001
+artificial_stress = 0.0
+geometry = { shape = "box", lo = [0.02, 0], hi = [0.03, 0.01] }
+"""
+    d = loads_deck(second)
+    s = Solver(build_model(d), d)
+    p = s.p
+    assert np.array_equal(s.as_eps, np.where(p.body == 0, 0.3, 0.0))
+    p.sig[:, 0, 0] = 1e5  # uniaxial tension everywhere
+    s._accelerations(1e-7)
+    assert np.all(s.R[p.body == 1] == 0.0)
+    assert np.all(s.R[p.body == 0, 0, 0] < 0.0)
+    only = DECK.format(eps=0.0).replace("velocity = [1.0, 0]",
+                                        "velocity = [1.0, 0]\nartificial_stress = 0.2")
+    d = loads_deck(only)
+    assert Solver(build_model(d), d).R is not None

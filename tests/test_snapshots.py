@@ -260,3 +260,16 @@ def test_cli_snapshots(run2d, capsys):
     # Without --snapshots: the history plots, as before.
     assert main(["plot", str(run2d)]) == 0
     assert "energies.png" in capsys.readouterr().out
+
+
+def test_several_runs_one_row_each(run2d, tmp_path):
+    # Two runs (here the same one twice) -> a 2 x 3 grid, rows = runs; the
+    # image is taller than the single-run figure with the same 3 panels,
+    # whose grid packs them in one row.
+    out2 = plot_snapshots([run2d, run2d], "von_mises", n=3, out=tmp_path / "two.png")
+    out1 = plot_snapshots(run2d, "von_mises", n=3, out=tmp_path / "one.png")
+    two, one = _check_png(out2), _check_png(out1)
+    assert two.shape[0] > 1.5 * one.shape[0]
+    assert main(["plot", str(run2d), str(run2d), "--snapshots", "speed", "--n", "2",
+                 "--out", str(tmp_path / "cli.png")]) == 0
+    _check_png(tmp_path / "cli.png")

@@ -150,3 +150,19 @@ def test_solver_output_field_and_history_column():
     s.p.sig[:] = 0.0
     assert np.all(particle_fields(s.p, ["swegle"], s.output_fields())["swegle"] == 0.0)
     assert s.energies(0.0, 0.0)["swegle_unstable"] == 0.0
+
+
+def test_quadratic_kernel_is_stable_in_compression_at_any_spacing():
+    # Johnson et al. (1996): w'' = 3/8 > 0 on the whole support, so compressed
+    # particles (here h = 2.5 dx: the nearest neighbours at q = 0.4, where
+    # the cubic spline has W'' < 0 and compression is unstable) are never
+    # flagged with the quadratic kernel, while tension is flagged.
+    assert all(kernels.d2wdq2(kernels.kernel_id("quadratic"), q) > 0
+               for q in np.linspace(0.0, 1.99, 50))
+    x, h = _lattice(hfac=2.5, n_side=14)
+    comp = _uniform(x.shape[0], sxx=-S, syy=-S)
+    inner = _interior(x, margin=6 * DX)
+    assert np.all(_indicator(x, h, comp, kernel="quadratic")[inner] == 0.0)
+    assert np.all(_indicator(x, h, comp, kernel="cubic_spline")[inner] > 0.0)
+    tens = _uniform(x.shape[0], sxx=S, syy=S)
+    assert np.all(_indicator(x, h, tens, kernel="quadratic")[inner] == 1.0)

@@ -89,9 +89,9 @@ def cmd_plot(args) -> int:
     if not args.snapshots:
         from .io import plot_history
 
-        paths = plot_history(Path(args.dir) / "history.csv", Path(args.dir) / "plots")
-        for p in paths:
-            print(p)
+        for d in args.dir:
+            for p in plot_history(Path(d) / "history.csv", Path(d) / "plots"):
+                print(p)
         return 0
 
     from .deck.units import TIME, to_si
@@ -109,8 +109,11 @@ def cmd_plot(args) -> int:
                 times.append(float(item))
             except ValueError:
                 times.append(to_si(item, TIME))
-    for field in dict.fromkeys(fields):
-        print(plot_snapshots(args.dir, field, times=times, n=args.n,
+    fields = list(dict.fromkeys(fields))
+    if args.out and len(fields) > 1:
+        raise ValueError("--out takes one --snapshots field; run once per field")
+    for field in fields:
+        print(plot_snapshots(args.dir, field, times=times, n=args.n, out=args.out,
                              vmin=args.vmin, vmax=args.vmax))
     return 0
 
@@ -258,11 +261,15 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("plot", help="plot DIR/history.csv (or particle snapshots) "
                        "into DIR/plots")
-    p.add_argument("dir")
+    p.add_argument("dir", nargs="+",
+                   help="run directory; with --snapshots several runs give one row each "
+                   "(e.g. a case with and without a remedy)")
     p.add_argument("--snapshots", action="append", metavar="FIELD",
                    help="instead of the history plots, panels of the particles coloured "
                    "by FIELD (von_mises, damage, speed, stress_yy, ...) into "
                    "DIR/plots/snapshots_FIELD.png; repeatable or a comma list")
+    p.add_argument("--out", metavar="PNG",
+                   help="snapshots: the PNG to write (one field only)")
     p.add_argument("--times", metavar="T1,T2,...",
                    help="snapshot times (the nearest frames), seconds or with units, "
                    "e.g. 1e-4,2e-4 or '0.1 ms,0.2 ms'")

@@ -83,10 +83,15 @@ class Solver:
         n = p.n
         self.B = np.zeros((n, 3, 3))
         # artificial stress (Monaghan 2000): R/rho^2 and principal-axis work array
-        self.as_eps = sph.artificial_stress.epsilon
+        # (epsilon per particle: a body may set its own, TL bodies need none)
+        eps_body = np.array([sph.artificial_stress.epsilon if b.artificial_stress is None
+                             else b.artificial_stress for b in deck.body] or [0.0])
+        self.as_eps = eps_body[p.body] if n else np.zeros(0)
+        self.as_eps[total_lagrangian_mask(deck, p.body)] = 0.0
         self.as_n = sph.artificial_stress.n
-        self.R = np.zeros((n, 3, 3)) if self.as_eps > 0 else None
-        self.Q = np.zeros((n, 3, 3)) if self.as_eps > 0 else None
+        on = bool(np.any(self.as_eps > 0))
+        self.R = np.zeros((n, 3, 3)) if on else None
+        self.Q = np.zeros((n, 3, 3)) if on else None
         self.spacing = p.vol0 ** (1.0 / p.dim) if n else np.zeros(0)  # initial dx [m]
         # Swegle indicator per particle, evaluated on demand (history records
         # kept by the Simulation, output frames; see output_fields)

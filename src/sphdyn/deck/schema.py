@@ -985,6 +985,10 @@ class Body(Section):
     formulation: Optional[Literal["updated_lagrangian", "total_lagrangian"]] = \
         Field(None, description="Kernel formulation of this body; default: "
                                 "[sph] formulation.")
+    artificial_stress: Optional[real("artificial-stress factor", lo=0)] = Field(
+        None, description="Artificial-stress epsilon of this body (0 = off "
+                          "for it); default: [sph.artificial_stress] epsilon. "
+                          "Updated-Lagrangian bodies only.")
     mass: Optional[MassField] = Field(
         None, description="Random particle masses (absent: homogeneous, "
                           "m = rho dx^d); see docs/heterogeneity.md.")

@@ -273,7 +273,49 @@ def _squares(xy: np.ndarray, side: float) -> np.ndarray:
     return xy[:, None, :] + corners[None, :, :]
 
 
-def plot_snapshots(outdir: str | os.PathLike, field: str = "von_mises",
+def _run_panels(outdir: Path, field: str, times, n: int, k_slice: int,
+                slice_width: float | None):
+    """Frames of one run for :func:`plot_snapshots`.
+
+    Returns ``(panels, unit, spacing, title, plane, slab)`` with ``panels`` a
+    list of ``(time [s], xy [m] (n, 2), values [SI] (n,))``.
+    """
+    frame_files = list_frames(outdir)
+    if not frame_files:
+        raise FileNotFoundError(f"no frames in {outdir / 'frames'}")
+    frame_times = [read_frame_header(f)[0] for f in frame_files]
+    chosen = select_frames(frame_times, times=times, n=n)
+
+    # Spacing and slab from the first frame of the run.
+    _, _, first, _ = read_frame(frame_files[0])
+    x0 = np.asarray(first["position"], dtype=float)
+    dimension, title = _run_info(outdir)
+    if dimension is None:
+        dimension = 2 if np.ptp(x0[:, 2]) == 0.0 else 3
+    spacing = particle_spacing(x0, dimension)
+    if dimension == 2:
+        plane = (0, 1)
+        slab = None
+    else:
+        plane = tuple(k for k in range(3) if k != k_slice)
+        width = 1.5 * spacing if slice_width is None else float(slice_width)
+        c = x0[:, k_slice]
+        slab = (width, 0.5 * (c.min() + c.max()))
+
+    panels = []
+    unit = ""
+    for i in chosen:
+        t, _, fields, _ = read_frame(frame_files[i])
+        values, unit = field_values(fields, field)
+        x = np.asarray(fields["position"], dtype=float)
+        if slab is not None:
+            keep = slab_mask(x, k_slice, slab[0], slab[1])
+            x, values = x[keep], values[keep]
+        panels.append((t, x[:, plane], values))
+    return panels, unit, spacing, title or outdir.name, plane, slab
+
+
+def plot_snapshots(outdir, field: str = "von_mises",
                    times=None, n: int = 4, out: str | os.PathLike | None = None,
                    slice_axis: str = "z", slice_width: float | None = None,
                    cmap=None, vmin: float | None = None, vmax: float | None = None,
@@ -282,8 +324,11 @@ def plot_snapshots(outdir: str | os.PathLike, field: str = "von_mises",
 
     Parameters
     ----------
-    outdir : str or os.PathLike
-        Output directory of a run (with ``frames/frame_*.h5``).
+    outdir : str or os.PathLike, or a list of them
+        Output directory of a run (with ``frames/frame_*.h5``). With several
+        runs (e.g. the same case with different remedies) the figure has one
+        row per run, titled with the run's title, and one column per
+        selected time; colour scale and axes are shared.
     field : str, optional
         What to colour by: any scalar field in the frames (``von_mises``,
         ``pressure``, ``damage``, ``plastic_strain``, ...), a vector field
@@ -296,7 +341,8 @@ def plot_snapshots(outdir: str | os.PathLike, field: str = "von_mises",
         Without ``times``: this many frames evenly spaced in time, first and
         last included (default 4).
     out : str or os.PathLike, optional
-        PNG to write; default ``outdir/plots/snapshots_<field>.png``.
+        PNG to write; default ``outdir/plots/snapshots_<field>.png`` (of the
+        first run).
     slice_axis : {'x', 'y', 'z'}, optional
         3D runs: normal of the slab shown (default ``z``: x-y view; ``y``:
         x-z view; ``x``: y-z view). Ignored in 2D.
@@ -329,41 +375,18 @@ def plot_snapshots(outdir: str | os.PathLike, field: str = "von_mises",
         If ``field`` is not available (the message lists what is), or for
         bad ``times``, ``n``, ``slice_axis`` or ``slice_width``.
     """
-    outdir = Path(outdir)
-    frame_files = list_frames(outdir)
-    if not frame_files:
-        raise FileNotFoundError(f"no frames in {outdir / 'frames'}")
+    runs = [Path(d) for d in outdir] if isinstance(outdir, (list, tuple)) else [
+        Path(outdir)]
+    if not runs:
+        raise ValueError("no run directory given")
     k_slice = _axis_index(slice_axis)
-    frame_times = [read_frame_header(f)[0] for f in frame_files]
-    chosen = select_frames(frame_times, times=times, n=n)
-
-    # Spacing and slab from the first frame of the run.
-    _, _, first, _ = read_frame(frame_files[0])
-    x0 = np.asarray(first["position"], dtype=float)
-    dimension, title = _run_info(outdir)
-    if dimension is None:
-        dimension = 2 if np.ptp(x0[:, 2]) == 0.0 else 3
-    spacing = particle_spacing(x0, dimension)
+    loaded = [_run_panels(d, field, times, n, k_slice, slice_width) for d in runs]
+    panels = [pan for run in loaded for pan in run[0]]
+    unit = loaded[0][1]
+    spacing = loaded[0][2]
+    plane, slab = loaded[0][4], loaded[0][5]
+    title = loaded[0][3]
     side = float(marker_size) if marker_size is not None else spacing
-    if dimension == 2:
-        plane = (0, 1)
-        slab = None
-    else:
-        plane = tuple(k for k in range(3) if k != k_slice)
-        width = 1.5 * spacing if slice_width is None else float(slice_width)
-        c = x0[:, k_slice]
-        slab = (width, 0.5 * (c.min() + c.max()))
-
-    panels = []  # (time, xy [m], values [SI])
-    unit = ""
-    for i in chosen:
-        t, _, fields, _ = read_frame(frame_files[i])
-        values, unit = field_values(fields, field)
-        x = np.asarray(fields["position"], dtype=float)
-        if slab is not None:
-            keep = slab_mask(x, k_slice, slab[0], slab[1])
-            x, values = x[keep], values[keep]
-        panels.append((t, x[:, plane], values))
 
     # Shared colour scale.
     finite = np.concatenate([v[np.isfinite(v)] for _, _, v in panels])
@@ -413,7 +436,13 @@ def plot_snapshots(outdir: str | os.PathLike, field: str = "von_mises",
     else:  # empty slab
         xlim = ylim = (-1.0, 1.0)
     box_w, box_h = xlim[1] - xlim[0], ylim[1] - ylim[0]
-    nrows, ncols = _grid(len(panels), box_w, box_h)
+    if len(runs) > 1:  # one row per run
+        ncols = max(len(run[0]) for run in loaded)
+        nrows = len(runs)
+        slots = [(r, c) for r, run in enumerate(loaded) for c in range(len(run[0]))]
+    else:
+        nrows, ncols = _grid(len(panels), box_w, box_h)
+        slots = [divmod(k, ncols) for k in range(len(panels))]
 
     # Figure size [in] from the panels' aspect: room for the y labels and
     # colour bar on the side, panel titles and tick labels on each row.
@@ -427,10 +456,13 @@ def plot_snapshots(outdir: str | os.PathLike, field: str = "von_mises",
     t_max = max(t for t, _, _ in panels)
     names = "xyz"
     collection = None
-    for idx, ax in enumerate(axes.flat):
-        if idx >= len(panels):
-            ax.set_visible(False)
-            continue
+    used = set(slots)
+    for row in range(nrows):
+        for col in range(ncols):
+            if (row, col) not in used:
+                axes[row, col].set_visible(False)
+    for idx, (row, col) in enumerate(slots):
+        ax = axes[row, col]
         t, xy, values = panels[idx]
         collection = PolyCollection(_squares(xy * 1e3, side * 1e3), cmap=cmap,
                                     norm=norm, edgecolors="face", linewidths=0.5,
@@ -440,9 +472,10 @@ def plot_snapshots(outdir: str | os.PathLike, field: str = "von_mises",
         ax.set_xlim(*xlim)
         ax.set_ylim(*ylim)
         ax.set_aspect("equal")
-        ax.set_title(_time_label(t, t_max), fontsize=10)
-        row, col = divmod(idx, ncols)
-        if row == nrows - 1 or idx + ncols >= len(panels):
+        label_t = _time_label(t, t_max)
+        ax.set_title(label_t if len(runs) == 1 else f"{loaded[row][3]}\n{label_t}",
+                     fontsize=10 if len(runs) == 1 else 8)
+        if row == nrows - 1 or (row + 1, col) not in used:
             ax.set_xlabel(f"{names[plane[0]]} [mm]")
             ax.xaxis.set_tick_params(labelbottom=True)
         if col == 0:
@@ -451,13 +484,13 @@ def plot_snapshots(outdir: str | os.PathLike, field: str = "von_mises",
     if collection is not None:
         fig.colorbar(collection, ax=axes.ravel().tolist(), label=label,
                      extend=extend, shrink=0.9)
-    heading = f"{field}: {title}" if title else f"{field}: {outdir.name}"
+    heading = f"{field}: {title}" if len(runs) == 1 else f"{field}"
     if slab is not None:
         heading += (f"  (slab |{names[k_slice]} - {slab[1] * 1e3:.3g} mm| "
                     f"≤ {0.5 * slab[0] * 1e3:.3g} mm)")
     fig.suptitle(heading, fontsize=11)
 
-    dest = Path(out) if out is not None else outdir / "plots" / f"snapshots_{field}.png"
+    dest = Path(out) if out is not None else runs[0] / "plots" / f"snapshots_{field}.png"
     with atomic_path(dest) as tmp:
         fig.savefig(tmp, format="png", dpi=dpi)
     return dest

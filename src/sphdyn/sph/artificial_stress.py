@@ -72,7 +72,8 @@ def artificial_stress_tensor(sig, rho, eps, R, Q):
     ----------
     sig : (N, 3, 3) Cauchy stress [Pa], tension positive, symmetric.
     rho : (N,) density [kg/m^3].
-    eps : float, epsilon >= 0 (dimensionless; 0.3 in Gray et al.).
+    eps : (N,) epsilon >= 0 per particle (dimensionless; 0.3 in Gray et al.;
+        0 switches the remedy off for that particle, e.g. per body).
     R : (N, 3, 3) out, artificial stress divided by rho^2 [Pa m^6/kg^2]
         (negative semi-definite).
     Q : (N, 3, 3) work/out, principal directions as columns.
@@ -87,7 +88,7 @@ def artificial_stress_tensor(sig, rho, eps, R, Q):
                 V[a, b] = 1.0 if a == b else 0.0
         scale = abs(A[0, 0]) + abs(A[1, 1]) + abs(A[2, 2]) \
             + abs(A[0, 1]) + abs(A[0, 2]) + abs(A[1, 2])
-        if scale == 0.0:
+        if scale == 0.0 or eps[i] == 0.0:
             for a in range(3):
                 for b in range(3):
                     A[a, b] = 0.0
@@ -123,7 +124,7 @@ def artificial_stress_tensor(sig, rho, eps, R, Q):
                         vkq = V[k, q]
                         V[k, p] = c * vkp - s * vkq
                         V[k, q] = s * vkp + c * vkq
-        f = -eps / (rho[i] * rho[i])
+        f = -eps[i] / (rho[i] * rho[i])
         r0 = f * A[0, 0] if A[0, 0] > 0.0 else 0.0
         r1 = f * A[1, 1] if A[1, 1] > 0.0 else 0.0
         r2 = f * A[2, 2] if A[2, 2] > 0.0 else 0.0
