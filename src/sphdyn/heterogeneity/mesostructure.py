@@ -29,7 +29,8 @@ volume fraction ``phi_k``:
    score, skipping a point whose cell already holds the volume of a sphere
    of diameter ``D_k`` (cap), until the weight ``phi_k * W`` is reached
    (greedy quantile): the fraction is hit to one point, and no aggregate
-   (a connected set lies in one cell) exceeds ``D_k``.
+   (a connected set lies in one cell) exceeds ``D_k``. Volume a class
+   cannot place (cells full) is passed on to the next smaller class.
 4. *ITZ*: mortar points whose centre lies within ``itz_thickness`` of an
    aggregate point centre (Euclidean distance transform, SciPy).
 
@@ -175,8 +176,9 @@ def _phase_core(pts, grid_shape, dx, weight, *, aggregate_fraction,
                                 octaves=octaves, persistence=persistence,
                                 lacunarity=lacunarity, seed=seed,
                                 ridged=ridged))
+    carry = 0.0  # volume a larger class could not place goes to the next
     for k, (dk, fk) in enumerate(classes):
-        target = aggregate_fraction * fk * wtot
+        target = aggregate_fraction * fk * wtot + carry
         if target <= 0:
             continue
         ck = dk / _e_dim(dim)
@@ -198,11 +200,14 @@ def _phase_core(pts, grid_shape, dx, weight, *, aggregate_fraction,
         _, cell[idx] = np.unique(cn.cell[ok], return_inverse=True)
         cap = int(math.floor(_ball_volume(dk, dim) / dx**dim + 1e-9))
         taken = _greedy_select(order, cell, weight, cap, target, agg)
-        if taken + 0.5 * weight[inside].max() < target:
+        carry = max(target - taken, 0.0)
+        last = k == len(classes) - 1
+        if last and taken + 0.5 * weight[inside].max() < target:
             raise ValueError(
                 f"aggregate_fraction {aggregate_fraction} cannot be reached: "
-                f"size class {dk} m holds {taken / wtot:.3f} of the volume "
-                f"(wanted {target / wtot:.3f}); lower aggregate_fraction, "
+                f"the smallest size class {dk} m holds {taken / wtot:.3f} of "
+                f"the volume (wanted {target / wtot:.3f}, including what "
+                f"larger classes could not place); lower aggregate_fraction, "
                 f"refine dx (max size / dx = {dk / dx:.1f}) or add smaller "
                 f"size classes (grading)")
     phases = np.where(agg, AGGREGATE, MORTAR).astype(np.int8)
