@@ -42,6 +42,11 @@ class Wall:
     friction: float
     thickness_factor: float
     kbulk: np.ndarray  # (N,) bulk modulus used by the bulk method [Pa]
+    velocity: np.ndarray = field(default_factory=lambda: np.zeros(3))  # [m/s]
+
+    def point_at(self, t: float) -> np.ndarray:
+        """A point of the wall plane at time ``t`` [s]: point + velocity t."""
+        return self.point + self.velocity * t
 
 
 @dataclass
@@ -165,7 +170,7 @@ def build_model(deck) -> Model:
             normal=np.asarray(w.normal, float) / np.linalg.norm(w.normal),
             method=STIFFNESS_MASS if w.stiffness == "mass" else STIFFNESS_BULK,
             alpha=w.alpha, friction=w.friction, thickness_factor=w.thickness_factor,
-            kbulk=kbw))
+            kbulk=kbw, velocity=np.asarray(w.velocity, float)))
 
     lo_b = particles.x.min(axis=0)
     hi_b = particles.x.max(axis=0)

@@ -200,9 +200,10 @@ class Solver:
                 self.cnl.offsets, self.cnl.idx, self.contact_alpha, self.contact_factor,
                 self.a_contact))
         for w in self.model.walls:
-            cnt = wall_contact(p.x, p.v, p.m, p.vol0, p.rho, w.kbulk, self.dim, w.point,
-                               w.normal, w.thickness_factor, w.method, w.alpha,
-                               w.friction, dt, self.a_contact, self.wall_force)
+            cnt = wall_contact(p.x, p.v, p.m, p.vol0, p.rho, w.kbulk, self.dim,
+                               w.point_at(self.t), w.normal, w.velocity,
+                               w.thickness_factor, w.method, w.alpha, w.friction, dt,
+                               self.a_contact, self.wall_force)
             self.wall_counts[w.name] = int(cnt)
             self.wall_totals[w.name] = self.wall_force.sum(axis=0)
         p.a += self.a_contact
@@ -301,6 +302,8 @@ class Solver:
             rec[f"F_wall_{w.name}"] = fn
             rec[f"F_wall_{w.name}_t"] = float(np.linalg.norm(f - fn * w.normal))
             rec[f"contacts_{w.name}"] = float(self.wall_counts[w.name])
+            if w.velocity.any():
+                rec[f"d_wall_{w.name}"] = float(w.velocity @ w.normal) * self.t
         rec.update(probe_record(self.p, self.model.probes))
         return rec
 
@@ -351,8 +354,8 @@ class Solver:
             self.wall_force[:] = 0.0
             tmp = np.zeros_like(self.a_contact)
             cnt = wall_contact(self.p.x, self.p.v, self.p.m, self.p.vol0, self.p.rho,
-                               w.kbulk, self.dim, w.point, w.normal, w.thickness_factor,
-                               w.method, w.alpha, w.friction, self.dt_prev or self.dt0,
-                               tmp, self.wall_force)
+                               w.kbulk, self.dim, w.point_at(self.t), w.normal, w.velocity,
+                               w.thickness_factor, w.method, w.alpha, w.friction,
+                               self.dt_prev or self.dt0, tmp, self.wall_force)
             self.wall_counts[w.name] = int(cnt)
             self.wall_totals[w.name] = self.wall_force.sum(axis=0)

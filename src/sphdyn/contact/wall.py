@@ -19,6 +19,11 @@ with the spring stiffness of Hušek et al. (2017):
   nominal inertia :math:`\rho_i V_i` (a zero-mass particle carries no
   momentum, so the wall force it reports is zero).
 
+A wall may move with a constant velocity :math:`\mathbf u` (a platen of a
+compression test): the caller passes the current point
+:math:`\mathbf p(t) = \mathbf p_0 + \mathbf u t`, and friction acts on the
+velocity relative to the wall.
+
 Optional Coulomb friction opposes the tangential velocity with magnitude
 :math:`\mu |F_n|`, capped so that it cannot reverse the tangential velocity
 within one step (a regularised stick condition).
@@ -34,8 +39,8 @@ STIFFNESS_BULK = 1
 
 
 @njit(cache=True, parallel=True)
-def wall_contact(x, v, m, vol0, rho, kbulk, dim, point, normal, thickness_factor,
-                 method, alpha, friction, dt, a_contact, force):
+def wall_contact(x, v, m, vol0, rho, kbulk, dim, point, normal, wall_v,
+                 thickness_factor, method, alpha, friction, dt, a_contact, force):
     r"""Penalty contact accelerations of one rigid wall (gather form).
 
     Parameters
@@ -43,8 +48,9 @@ def wall_contact(x, v, m, vol0, rho, kbulk, dim, point, normal, thickness_factor
     x, v : (N, 3) positions [m] and mid-step velocities [m/s].
     m, vol0, rho : (N,) mass [kg], nominal volume [m^dim], density [kg/m^3].
     kbulk : (N,) bulk modulus [Pa] used by the bulk method.
-    point, normal : (3,) a point of the wall and its unit normal (towards the
-        bodies).
+    point, normal : (3,) a point of the wall (at the current time) and its
+        unit normal (towards the bodies).
+    wall_v : (3,) velocity of the wall [m/s] (friction acts on v - wall_v).
     thickness_factor, method, alpha, friction, dt : see module docstring.
     a_contact : (N, 3) in/out, contact acceleration is **added**.
     force : (N, 3) out, force on each particle [N] (N/m in 2D); zero for
@@ -78,10 +84,13 @@ def wall_contact(x, v, m, vol0, rho, kbulk, dim, point, normal, thickness_factor
         a1 = an * normal[1]
         a2 = an * normal[2]
         if friction > 0.0:
-            vn = v[i, 0] * normal[0] + v[i, 1] * normal[1] + v[i, 2] * normal[2]
-            t0 = v[i, 0] - vn * normal[0]
-            t1 = v[i, 1] - vn * normal[1]
-            t2 = v[i, 2] - vn * normal[2]
+            r0 = v[i, 0] - wall_v[0]
+            r1 = v[i, 1] - wall_v[1]
+            r2 = v[i, 2] - wall_v[2]
+            vn = r0 * normal[0] + r1 * normal[1] + r2 * normal[2]
+            t0 = r0 - vn * normal[0]
+            t1 = r1 - vn * normal[1]
+            t2 = r2 - vn * normal[2]
             vt = np.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
             if vt > 0.0:
                 at = min(friction * an, vt / dt)

@@ -1019,6 +1019,11 @@ class Wall(Section):
     thickness_factor: real("thickness factor", lo=0) = Field(
         0.5, description="Contact starts when a particle centre is closer "
                          "than thickness_factor times its spacing.")
+    velocity: VelocityVector = Field(
+        (0.0, 0.0, 0.0), description="Constant velocity of the wall (e.g. a "
+        "platen of a compression test): the plane passes through point + "
+        "velocity * t. The history then also records the wall's displacement "
+        "along its normal, d_wall_<name>.")
 
     @field_validator("bulk_modulus")
     @classmethod
