@@ -327,6 +327,8 @@ def _bisector(px, py, pz, cx, cy, cz, r, rz, half, seeds, lo, best, bi, bj,
                               + (s[2] - a[2]) ** 2)
                 d = (d2 - best) / (2.0 * sep)
                 if tau > 0.0:
+                    if d > min(m, bound) + _SOFT_CUT * tau:
+                        continue
                     if ssum == 0.0:
                         ssum = 1.0
                         m = d
