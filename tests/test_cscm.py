@@ -260,10 +260,14 @@ def test_rate_effects(path):
     assert peaks[0] > static * 1.01
     assert all(b > a for a, b in zip(peaks, peaks[1:]))
     # overstress bound: |s_vp - s_P| <= OVER and the inviscid stress is at
-    # most the shear-surface strength (tension: the static f_ut, no cap)
+    # most the shear-surface strength (tension: the static f_ut, no cap).
+    # Not strict: the total lateral stress is zero, so the inviscid part
+    # carries the lateral overstress with opposite sign (a small confinement
+    # of s_P, which raises its axial strength); measured excess 0.1 % with
+    # the rate-enhanced damage thresholds, hence 1 %.
     bound = (_shear_only_uc(p) if path == "uniaxial-compression" else static) \
         + p[cscm.P_OVERC]
-    assert max(peaks) <= bound * (1 + 1e-9)
+    assert max(peaks) <= bound * 1.01
 
 
 # --------------------------------------------------------------------------
@@ -391,3 +395,80 @@ def test_fast_return_equals_global_closest_point():
             assert abs(fast[1] - glob[1]) < 1e-6 * ext
             checked += 1
     assert checked == 1500
+
+
+def test_recovery_option_2_needs_compressive_volume_strain():
+    # RECOV 10-11 (notes sec. 1.9 [V] flag text): recovery "based on the sign
+    # of both the pressure and the volumetric strain". After tensile failure
+    # in uniaxial strain (eps = 1 %), a small compressive unloading makes the
+    # pressure compressive while the volume strain is still tensile: option
+    # 1 (RECOV = 0) recovers the modulus, option 2 (RECOV = 10) keeps the
+    # brittle damage; once the volume strain is compressive both recover.
+    # Thresholds 0.05 / 0.9: the states are d = 0 and d = 0.986.
+    m = get_model("cscm")
+    out = {}
+    for recov in (0.0, 10.0):
+        p = cscm.pack_cscm({**BASE, "recovery": recov})
+        h = m.initial_history(p)
+        for _ in range(500):
+            cscm.cscm_point(h, (2e-5, 0, 0, 0, 0, 0), 1.0, p, 0.01)
+        for _ in range(12):
+            s1, d1 = cscm.cscm_point(h, (-2e-5, 0, 0, 0, 0, 0), 1.0, p, 0.01)
+        assert s1[0] < 0 and sum(h[cscm.H_EPS:cscm.H_EPS + 3]) > 0
+        for _ in range(12):
+            s2, d2 = cscm.cscm_point(h, (-1e-3, 0, 0, 0, 0, 0), 1.0, p, 0.01)
+        assert s2[0] < 0 and sum(h[cscm.H_EPS:cscm.H_EPS + 3]) < 0
+        out[recov] = (d1, d2)
+    assert out[0.0][0] < 0.05 and out[10.0][0] > 0.9
+    assert out[0.0][1] < 0.1 and out[10.0][1] == pytest.approx(out[0.0][1], abs=1e-12)
+    with pytest.raises(ValueError, match="recovery"):
+        cscm.pack_cscm({**BASE, "recovery": 5.0})
+
+
+@pytest.mark.parametrize("retract", [False, True])
+def test_cap_retraction(retract):
+    # ITRETRC (notes sec. 1.3 [V flag], mechanism [R/D]): hydrostatic
+    # compaction to ~114 MPa moves the cap out (kappa ~ 100 MPa); dilation
+    # under hydrostatic tension then reduces the plastic volume compaction
+    # below zero. Without retraction the cap stays (kappa unchanged, exact);
+    # with retraction it follows X(ev) and stops at the initial cap X0
+    # (kappa = kappa0 to the Newton tolerance, 1e-9 relative).
+    m = get_model("cscm")
+    p = cscm.pack_cscm({**BASE, "cap_retraction": retract})
+    h = m.initial_history(p)
+    for _ in range(400):
+        cscm.cscm_point(h, (-1e-5, -1e-5, -1e-5, 0, 0, 0), 1.0, p, 0.01)
+    k_hard = h[cscm.H_KAPPA]
+    assert k_hard > 4 * cscm.kappa0(p) and h[cscm.H_EV] > 0.003
+    X_hard = cscm.cap_function(0.0, k_hard, p)[1]
+    assert X_hard == pytest.approx(cscm.cap_from_compaction(h[cscm.H_EV], p), rel=1e-3)
+    for _ in range(3000):
+        s, d = cscm.cscm_point(h, (1e-5, 1e-5, 1e-5, 0, 0, 0), 1.0, p, 0.01)
+    assert h[cscm.H_EV] < 0.0
+    if retract:
+        assert h[cscm.H_KAPPA] == pytest.approx(cscm.kappa0(p), rel=1e-9)
+    else:
+        assert h[cscm.H_KAPPA] == k_hard
+
+
+def test_rate_enhanced_damage_thresholds():
+    # choice [D] (docs/cscm.md): with rate effects the damage thresholds are
+    # r0 x (largest dynamic-to-static strength ratio), so in uniaxial tension
+    # at 100/s damage starts only once the stress is well above the static
+    # tensile strength (f_ut = 3.107 MPa); with the scaling switched off it
+    # starts right after the static first yield. Without rate effects the
+    # switch changes nothing (bitwise).
+    ft = 3.107e6
+    onset = {}
+    for rt in (False, True):
+        r = drive("cscm", {**BASE, "rate_effects": True, "rate_thresholds": rt},
+                  "uniaxial-tension", strain=0.002, n_steps=300, rate=100.0)
+        j = int(np.argmax(r["damage"] > 1e-3))
+        onset[rt] = abs(r["y"][j])
+        assert np.all(r["history"][:, cscm.H_RFMAX] >= 1.0)
+    assert onset[False] < 1.3 * ft
+    assert onset[True] > 1.4 * ft
+    a = drive("cscm", {**BASE, "rate_thresholds": False}, "uniaxial-tension",
+              strain=0.002, n_steps=100)
+    b = drive("cscm", BASE, "uniaxial-tension", strain=0.002, n_steps=100)
+    assert np.array_equal(a["stress"], b["stress"])

@@ -84,20 +84,24 @@ P_DMAX_POWER = _NEXT + 5
 P_KAPPA0 = _NEXT + 6     # derived: X0 = kappa0 + R Ff(kappa0)
 P_J1APEX = _NEXT + 7     # derived: Ff(J1_apex) = 0, J1_apex < 0
 P_LI2B = _NEXT + 8       # derived: Li2(-B)
-N_PARAMS = _NEXT + 9
+P_RECOV_VOL = _NEXT + 9  # 1.0: RECOV option 2 (10-11), recovery needs compressive volume strain too
+P_RETRACT = _NEXT + 10   # 1.0: the cap retracts with dilation (ITRETRC = 1)
+P_RATE_R0 = _NEXT + 11   # 1.0: damage thresholds raised by the rate factor (with IRATE)
+N_PARAMS = _NEXT + 12
 
 HISTORY_NAMES = (
     "kappa", "plastic_vol_strain", "damage_brittle", "damage_ductile",
     "tau_t_max", "tau_c_max", "r0_brittle", "r0_ductile", "eroded",
     "strain_xx", "strain_yy", "strain_zz", "strain_xy", "strain_yz", "strain_xz",
     "sigvp_xx", "sigvp_yy", "sigvp_zz", "sigvp_xy", "sigvp_yz", "sigvp_xz",
-    "strain_rate", "rate_factor",
+    "strain_rate", "rate_factor", "rate_factor_max",
 )
 H_KAPPA, H_EV, H_DB, H_DD, H_TT, H_TC, H_R0T, H_R0C, H_ERODED = range(9)
 H_EPS = 9
 H_SVP = 15
 H_RATE = 21
 H_RF = 22
+H_RFMAX = 23
 NSCAN = 32  # coarse scan of the projection (see project)
 NGOLDEN = 30  # golden-section iterations of the projection (bracket 5e-7 of a scan cell)
 N_STRIPES = 64  # interleaved work stripes of the group kernel (load balance)
@@ -729,17 +733,25 @@ def cscm_point(h, deps, dt, p, size):
                 svp = (sP[0] + g1 * ov[0], sP[1] + g1 * ov[1], sP[2] + g1 * ov[2],
                        sP[3] + g1 * ov[3], sP[4] + g1 * ov[4], sP[5] + g1 * ov[5])
                 J1v, rv, bv, devv = invariants(svp)
-                rf = rv / rp if rp > 0.0 and rv > rp else 1.0
+                # dynamic-to-static strength ratio |s_vp|/|s_P| (Frobenius
+                # norms; = the axial stress ratio in uniaxial stress): choice
+                # [D] for the "dynamic/static strength" of notes sec. 1.10
+                nP = math.sqrt(ddot6(sP, sP))
+                nV = math.sqrt(ddot6(svp, svp))
+                rf = nV / nP if nP > 0.0 and nV > nP else 1.0
             else:
                 svp = sP
                 J1v = J1p
-            # plastic compaction (compression positive) and cap hardening;
-            # the cap never retracts (ITRETRC = 0, notes sec. 1.3 [V flag])
+            # plastic compaction (compression positive) and cap hardening:
+            # X = X(ev) of the compaction law. ITRETRC = 0 (default): the cap
+            # never retracts (X only grows); ITRETRC = 1: X follows ev both
+            # ways, so dilation pulls the cap back, never inside X0 (notes
+            # sec. 1.3/1.7 [V flag text], mechanism [R/D])
             h[H_EV] += (J1t - J1v) / (3.0 * K)
-            if h[H_EV] > 0.0:
+            if h[H_EV] > 0.0 or p[P_RETRACT] > 0.0:
                 X = cap_from_compaction(h[H_EV], p)
-                fcx, Xold = cap_function(0.0, kappa, p)
-                if X > Xold:
+                Xold = mer[3]
+                if X > Xold or (p[P_RETRACT] > 0.0 and X < Xold):
                     h[H_KAPPA] = kappa_from_cap(X, kappa, p)
             # damage thresholds: the damage state variable at first yield
             # (notes sec. 1.9 [R]), evaluated at the yield-onset point inside
@@ -761,14 +773,26 @@ def cscm_point(h, deps, dt, p, size):
         if h[H_R0T] > 0.0 or h[H_R0C] > 0.0:
             J1v, rv, bv, devv = invariants(svp)
             gscale = rf ** p[P_REPOW] if irate else 1.0
+            # rate-enhanced thresholds (choice [D]; notes sec. 1.9 [R] only
+            # say that they increase with rate): r0 x the largest dynamic-to-
+            # static strength ratio reached, so that damage starts at the
+            # viscoplastic (dynamic) strength; never decreasing, like a
+            # damage threshold. In uniaxial stress tau = rf r0 at the dynamic
+            # peak for both tau_t = sqrt(E) eps and tau_c = sqrt(s:eps/2).
+            rscale = 1.0
+            if irate and p[P_RATE_R0] > 0.0:
+                if rf > h[H_RFMAX]:
+                    h[H_RFMAX] = rf
+                rscale = h[H_RFMAX]
             if J1v < 0.0 and h[H_R0T] > 0.0:
                 tau = math.sqrt(E) * max(max_principal(eps), 0.0)
                 if tau > h[H_TT]:
                     h[H_TT] = tau
                 tr = transition(J1v, rv, p[P_PWRT])
                 gf = (p[P_GFS] + tr * (p[P_GFT] - p[P_GFS])) * gscale
-                cc = brittle_softening_c(h[H_R0T], size, gf, p[P_DD])
-                db = logistic_damage(h[H_TT], h[H_R0T], cc, p[P_DD], DMAX)
+                r0 = h[H_R0T] * rscale
+                cc = brittle_softening_c(r0, size, gf, p[P_DD])
+                db = logistic_damage(h[H_TT], r0, cc, p[P_DD], DMAX)
                 if db > h[H_DB]:
                     h[H_DB] = db
             elif J1v >= 0.0 and h[H_R0C] > 0.0:
@@ -777,21 +801,28 @@ def cscm_point(h, deps, dt, p, size):
                     h[H_TC] = tau
                 tr = transition(J1v, rv, p[P_PWRC])
                 gf = (p[P_GFS] + tr * (p[P_GFC] - p[P_GFS])) * gscale
-                aa = ductile_softening_a(h[H_R0C], size, gf, p[P_BB], p[P_LI2B])
+                r0 = h[H_R0C] * rscale
+                aa = ductile_softening_a(r0, size, gf, p[P_BB], p[P_LI2B])
                 # maximum ductile damage vs confinement: choice [D] (formula
                 # not retrieved, notes sec. 1.9): DMAX (sqrt(3 J2')/J1)^power
                 ratio = math.sqrt(3.0) * rv / J1v if J1v > 0.0 else 1.0
                 dmax = DMAX * (min(ratio, 1.0) ** p[P_DMAX_POWER])
-                dd = logistic_damage(h[H_TC], h[H_R0C], aa, p[P_BB], dmax)
+                dd = logistic_damage(h[H_TC], r0, aa, p[P_BB], dmax)
                 if dd > h[H_DD]:
                     h[H_DD] = dd
     h[H_RF] = rf
     for k in range(6):
         h[H_SVP + k] = svp[k]
         h[H_EPS + k] = eps[k]
-    # applied damage and recovery (notes sec. 1.9 [V flag / R mechanism])
+    # applied damage and recovery (notes sec. 1.9 [V flag / R mechanism]):
+    # brittle damage is recovered to RECOV d_b under compressive pressure
+    # (option 1, RECOV 0-1) and, for option 2 (RECOV 10-11), only if the
+    # volumetric strain is compressive as well
     J1v = -(svp[0] + svp[1] + svp[2])
-    if J1v > 0.0:
+    compressed = J1v > 0.0
+    if p[P_RECOV_VOL] > 0.0 and eps[0] + eps[1] + eps[2] >= 0.0:
+        compressed = False
+    if compressed:
         d = max(p[P_RECOV] * h[H_DB], h[H_DD])
     else:
         d = max(h[H_DB], h[H_DD])
@@ -908,7 +939,11 @@ def cscm_parameters(values: dict) -> dict:
     ``alpha``, ..., ``repow``), and the switches ``rate_effects`` (bool,
     default False = IRATE 0), ``erode`` (bool, default False),
     ``erode_strain`` (default 0.05, i.e. ERODE = 1.05), ``recovery`` (RECOV
-    in [0, 1], default 0), ``incre`` (sub-increment strain limit, default from
+    in [0, 1] or [10, 11], default 0: LS-DYNA option 1 on the sign of the
+    pressure, option 2 = RECOV - 10 on the signs of pressure and volume
+    strain), ``cap_retraction`` (bool, ITRETRC = 1, default False),
+    ``rate_thresholds`` (bool, default True: with rate effects the damage
+    thresholds scale with the dynamic strength ratio, choice [D]), ``incre`` (sub-increment strain limit, default from
     the strength, see :func:`pack_cscm`), ``dmax_power`` (default 1).
     """
     fc = get_float(values, "fc", default=30e6, min_value=0.0, min_inclusive=False)
@@ -925,8 +960,14 @@ def cscm_parameters(values: dict) -> dict:
     out["rate_effects"] = bool(values.get("rate_effects", False))
     out["erode"] = bool(values.get("erode", False))
     out["erode_strain"] = get_float(values, "erode_strain", default=0.05, min_value=0.0)
-    out["recovery"] = get_float(values, "recovery", default=0.0, min_value=0.0,
-                                max_value=1.0)
+    recov = get_float(values, "recovery", default=0.0, min_value=0.0, max_value=11.0)
+    if 1.0 < recov < 10.0:
+        raise ValueError(f"material parameter 'recovery' must be in [0, 1] (recovery "
+                         f"on the pressure sign) or [10, 11] (pressure and volume "
+                         f"strain signs, LS-DYNA RECOV option 2), got {recov}")
+    out["recovery"] = recov
+    out["cap_retraction"] = bool(values.get("cap_retraction", False))
+    out["rate_thresholds"] = bool(values.get("rate_thresholds", True))
     out["dmax_power"] = get_float(values, "dmax_power", default=1.0, min_value=0.0)
     if values.get("incre") is not None:
         out["incre"] = get_float(values, "incre", min_value=0.0, min_inclusive=False)
@@ -940,7 +981,8 @@ def pack_cscm(values: dict) -> np.ndarray:
     """Packed CSCM parameter vector from SI values (see :func:`cscm_parameters`).
 
     Layout ``[density, K, G] + PARAM_NAMES + [irate, erode, erode_strain,
-    recovery, incre, dmax_power, kappa0, J1_apex, Li2(-B)]``. The default
+    recovery, incre, dmax_power, kappa0, J1_apex, Li2(-B), recovery_mode,
+    cap_retraction, rate_thresholds]``. The default
     sub-increment limit is ``incre = 0.25 (alpha - lamda) / (2 G)``, a quarter
     of the tensor shear strain at which the TXC surface is reached at zero
     pressure (LS-DYNA's INCRE default formula is not known, notes sec. 1.3:
@@ -954,7 +996,10 @@ def pack_cscm(values: dict) -> np.ndarray:
     p[P_IRATE] = 1.0 if v["rate_effects"] else 0.0
     p[P_ERODE] = 1.0 if v["erode"] else 0.0
     p[P_ERODE_STRAIN] = v["erode_strain"]
-    p[P_RECOV] = v["recovery"]
+    p[P_RECOV] = v["recovery"] - 10.0 if v["recovery"] >= 10.0 else v["recovery"]
+    p[P_RECOV_VOL] = 1.0 if v["recovery"] >= 10.0 else 0.0
+    p[P_RETRACT] = 1.0 if v["cap_retraction"] else 0.0
+    p[P_RATE_R0] = 1.0 if v["rate_thresholds"] else 0.0
     p[P_DMAX_POWER] = v["dmax_power"]
     p[P_INCRE] = v.get("incre", 0.25 * (v["alpha"] - v["lamda"]) / (2.0 * v["G"]))
     p[P_J1APEX] = _apex(p)
@@ -977,6 +1022,7 @@ def initial_history(p: np.ndarray) -> np.ndarray:
     h = np.zeros(len(HISTORY_NAMES))
     h[H_KAPPA] = p[P_KAPPA0]
     h[H_RF] = 1.0
+    h[H_RFMAX] = 1.0
     return h
 
 
