@@ -15,6 +15,7 @@ from .contact.wall import STIFFNESS_BULK, STIFFNESS_MASS
 from .geometry import lattice_from_shape, select
 from .heterogeneity.cracks import crack_mask
 from .heterogeneity.mass import body_rng, mass_field
+from .heterogeneity.mesostructure import AGGREGATE, ITZ, MORTAR, generate_phases
 from .materials import get_model
 from .probes import Probe, quantity
 from .state import BC_FIXED, BC_VELOCITY, Particles
@@ -72,6 +73,27 @@ def _material_params(mat) -> dict:
     return {k: v for k, v in d.items() if v is not None}
 
 
+def _phase_materials(deck, b: int, body, x: np.ndarray, dim: int) -> list[str]:
+    """Material name of every particle of a body with a mesostructure ([] if none).
+
+    Phases from :func:`sphdyn.heterogeneity.mesostructure.generate_phases`,
+    seeded by ``run.seed`` and the body index.
+    """
+    ms = body.mesostructure
+    if ms is None:
+        return []
+    seed = int(np.random.SeedSequence([int(deck.run.seed), b, 0x6D65736F]).generate_state(1)[0])
+    phases = generate_phases(
+        x, body.dx, aggregate_fraction=ms.aggregate_fraction,
+        max_aggregate_size=ms.max_aggregate_size, itz_thickness=ms.itz_thickness,
+        aggregate_shape=ms.shape, octaves=ms.octaves, persistence=ms.persistence,
+        lacunarity=ms.lacunarity, seed=seed, dim=dim)
+    mortar = ms.mortar or body.material
+    table = {int(MORTAR): mortar, int(AGGREGATE): ms.aggregate or body.material,
+             int(ITZ): ms.itz or mortar}
+    return [table[int(k)] for k in phases]
+
+
 def build_model(deck) -> Model:
     """Create the particle model described by a validated deck."""
     dim = deck.run.dimension
@@ -96,26 +118,33 @@ def build_model(deck) -> Model:
             raise ValueError(f"body {body.name!r}: its geometry holds no particle at "
                              f"dx = {body.dx} m; make dx smaller or the shape larger")
         mat = mats[body.material]
+        names = _phase_materials(deck, b, body, x, dim)
         p = Particles.allocate(n, dim, n_hist)
         p.x[:] = x
         p.x0[:] = x
         p.v[:] = np.asarray(body.velocity, dtype=float)
         vol = body.dx ** dim
         p.vol0[:] = vol
-        p.rho[:] = mat.density
-        p.rho0[:] = mat.density
+        p.rho[:] = [mats[nm].density for nm in names] if names else mat.density
+        p.rho0[:] = p.rho
         # numerical heterogeneity (paper sec. 4, 5.2): crack particles get zero
         # mass, the others a random mass field of the homogeneous total
         cracks = [c.model_dump() for c in body.crack]
         solid = ~crack_mask(x, cracks, body.dx, body.name)
         spec = None if body.mass is None else body.mass.model_dump()
-        p.m[:], _ = mass_field(mat.density * vol, spec, solid,
-                               body_rng(deck.run.seed, b))
+        if names:  # phases of different densities: factors times rho_i dx^d
+            factors, _ = mass_field(1.0, spec, solid, body_rng(deck.run.seed, b))
+            p.m[:] = factors * p.rho0 * vol
+        else:
+            p.m[:], _ = mass_field(mat.density * vol, spec, solid,
+                                   body_rng(deck.run.seed, b))
         p.h[:] = deck.sph.h_factor * body.dx
         p.h0[:] = p.h
         p.body[:] = b
-        p.mat[:] = mat_index[body.material]
-        p.c[:] = models[body.material].wave_speed(params[body.material], mat.density)
+        for nm in set(names) or {body.material}:
+            sel = slice(None) if not names else np.asarray(names) == nm
+            p.mat[sel] = mat_index[nm]
+            p.c[sel] = models[nm].wave_speed(params[nm], mats[nm].density)
         p.hist_names = list(models[body.material].history_names)
         parts.append(p)
     particles = Particles.concatenate(parts)

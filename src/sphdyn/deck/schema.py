@@ -836,6 +836,43 @@ _MASS_PARAMS = {"uniform": ("low", "high"), "normal": ("mean", "std"),
                 "histogram": ("edges", "weights")}
 
 
+class Mesostructure(Section):
+    """[body.mesostructure]: concrete phases from fractal coherent noise.
+
+    Aggregate, mortar and interfacial transition zone (ITZ) are generated
+    on the body's particles (thesis sec. 7.2; docs/mesostructure.md) and
+    each phase takes its own [[material]] (e.g. CSCM with different fc or
+    density; all of one model family). The field is seeded by run.seed and
+    the body's index, so ensembles vary it through run.seed.
+    """
+
+    aggregate_fraction: real("volume fraction", lo=0, hi=1, lo_open=True,
+                             hi_open=True) = Field(
+        description="Target aggregate volume fraction (hit on the particles "
+                    "to within one voxel).")
+    max_aggregate_size: PositiveLength = Field(
+        description="Largest aggregate (equivalent diameter).")
+    itz_thickness: quantity(LENGTH, "thickness", lo=0) = Field(
+        0.0, description="Thickness of the ITZ band around aggregate (0 = no "
+                         "ITZ; at least about one particle spacing to be "
+                         "resolved).")
+    shape: Literal["rounded", "crushed"] = Field(
+        "rounded", description="Aggregate shape: rounded (gravel) or "
+                               "crushed (angular).")
+    octaves: integer("octave count", lo=1, hi=8) = Field(
+        3, description="Octaves of the fractional Brownian motion.")
+    persistence: real("persistence", lo=0, hi=1, lo_open=True) = Field(
+        0.5, description="Amplitude ratio of successive octaves.")
+    lacunarity: real("lacunarity", lo=1, lo_open=True) = Field(
+        2.0, description="Frequency ratio of successive octaves.")
+    mortar: Optional[reference_to("material")] = Field(
+        None, description="Material of the mortar (default: the body's).")
+    aggregate: Optional[reference_to("material")] = Field(
+        None, description="Material of the aggregate (default: the body's).")
+    itz: Optional[reference_to("material")] = Field(
+        None, description="Material of the ITZ (default: the mortar's).")
+
+
 class MassField(Section):
     """[body.mass]: random particle masses (Husek et al. 2017, sec. 4).
 
@@ -989,6 +1026,9 @@ class Body(Section):
         None, description="Artificial-stress epsilon of this body (0 = off "
                           "for it); default: [sph.artificial_stress] epsilon. "
                           "Updated-Lagrangian bodies only.")
+    mesostructure: Optional[Mesostructure] = Field(
+        None, description="Aggregate / mortar / ITZ phases with their own "
+                          "materials (absent: one material).")
     mass: Optional[MassField] = Field(
         None, description="Random particle masses (absent: homogeneous, "
                           "m = rho dx^d); see docs/heterogeneity.md.")
