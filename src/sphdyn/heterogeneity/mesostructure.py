@@ -31,6 +31,10 @@ volume fraction ``phi_k``:
    (greedy quantile): the fraction is hit to one point, and no aggregate
    (a connected set lies in one cell) exceeds ``D_k``. Volume a class
    cannot place (cells full) is passed on to the next smaller class.
+   Pieces smaller than ``D_k / 2`` (the class's lower bound: class k holds
+   sizes in (D_k/2, D_k]) are excluded and the selection redrawn, up to 10
+   times; fragments left after that are removed and their volume passed on
+   (kept in the last class, so that the fraction is always hit).
 4. *ITZ*: mortar points whose centre lies within ``itz_thickness`` of an
    aggregate point centre (Euclidean distance transform, SciPy).
 
@@ -60,6 +64,8 @@ ITZ = np.int8(2)
 SHAPES = ("rounded", "crushed")
 _ROUGHNESS = {"rounded": 0.05, "crushed": 0.05}  # default roughness a
 _SOFTNESS = 0.15  # tau / c_k of the rounded shape
+_MIN_SIZE_RATIO = 0.5  # pieces of class k below 0.5 D_k are redrawn
+_REDRAWS = 10
 
 
 def _e_dim(dim: int) -> float:
@@ -199,9 +205,29 @@ def _phase_core(pts, grid_shape, dx, weight, *, aggregate_fraction,
         cell = np.full(weight.shape[0], -1, dtype=np.int64)
         _, cell[idx] = np.unique(cn.cell[ok], return_inverse=True)
         cap = int(math.floor(_ball_volume(dk, dim) / dx**dim + 1e-9))
-        taken = _greedy_select(order, cell, weight, cap, target, agg)
-        carry = max(target - taken, 0.0)
+        vmin = _ball_volume(_MIN_SIZE_RATIO * dk, dim) / dx**dim
         last = k == len(classes) - 1
+        excluded = np.zeros(weight.shape[0], dtype=bool)
+        for attempt in range(_REDRAWS + 1):
+            sel = np.zeros(weight.shape[0], dtype=bool)
+            taken = _greedy_select(order[~excluded[order]], cell, weight, cap,
+                                   target, sel)
+            # fragments below the class's lower size (clipped cells, noise
+            # specks) are redrawn from the remaining points
+            lab, _ = ndimage.label(sel.reshape(grid_shape))
+            lab = lab.ravel()
+            small = np.bincount(lab) < vmin
+            small[0] = False
+            frag = small[lab]
+            if not frag.any() or (last and attempt == _REDRAWS):
+                break
+            if attempt == _REDRAWS:
+                sel &= ~frag
+                taken -= float(weight[frag].sum())
+                break
+            excluded |= frag
+        agg |= sel
+        carry = max(target - taken, 0.0)
         if last and taken + 0.5 * weight[inside].max() < target:
             raise ValueError(
                 f"aggregate_fraction {aggregate_fraction} cannot be reached: "
