@@ -13,6 +13,7 @@ A warm-up call on a small lattice compiles or loads the Numba cache first.
 from __future__ import annotations
 
 import argparse
+import os
 import time
 
 import numba
@@ -25,8 +26,11 @@ from sphdyn.heterogeneity.noise import cellular, fbm, grid_points
 
 
 def _t(f):
-    t0 = time.perf_counter()
+    """Wall time of f(); the process CPU time is kept in _t.cpu (the
+    machine may be shared: CPU time / threads bounds the idle wall time)."""
+    t0, c0 = time.perf_counter(), time.process_time()
     out = f()
+    _t.cpu = time.process_time() - c0
     return time.perf_counter() - t0, out
 
 
@@ -46,13 +50,14 @@ def main():
                         aggregate_shape=shape, **kw)
     x = grid_points((args.n,) * 3, dx)
     n = x.shape[0]
-    print(f"numba threads: {numba.get_num_threads()}, particles: {n}")
+    print(f"numba threads: {numba.get_num_threads()}, particles: {n}, "
+          f"load average {os.getloadavg()[0]:.1f}")
     t, _ = _t(lambda: fbm(x, feature_size=0.01, octaves=3))
-    print(f"fbm, 3 octaves                 {t:7.2f} s")
+    print(f"fbm, 3 octaves                 {t:7.2f} s  cpu {_t.cpu:6.2f} s")
     t, _ = _t(lambda: cellular(x, cell_size=0.01))
-    print(f"cellular, hard                 {t:7.2f} s")
+    print(f"cellular, hard                 {t:7.2f} s  cpu {_t.cpu:6.2f} s")
     t, _ = _t(lambda: cellular(x, cell_size=0.01, softness=0.0015))
-    print(f"cellular, soft                 {t:7.2f} s")
+    print(f"cellular, soft                 {t:7.2f} s  cpu {_t.cpu:6.2f} s")
     for shape in ("rounded", "crushed"):
         for name, grading in (("D_max 12 mm", None),
                               ("Fuller 16-8-4", fuller_grading(16 * dx,
@@ -62,7 +67,8 @@ def main():
                 x, dx, max_aggregate_size=dmax, aggregate_shape=shape,
                 grading=grading, **kw))
             st = phase_statistics(ph, dx, x=x)
-            print(f"generate_phases {shape:8s} {name:14s} {t:7.2f} s   "
+            print(f"generate_phases {shape:8s} {name:14s} {t:7.2f} s  cpu "
+                  f"{_t.cpu:6.2f} s  "
                   f"agg {st.aggregate_fraction:.4f} ITZ "
                   f"{st.itz_fraction:.3f} pieces {st.diameters.size} "
                   f"max d_eq {st.diameters.max() * 1e3:.2f} mm")

@@ -34,7 +34,8 @@ volume fraction ``phi_k``:
    Pieces smaller than ``D_k / 2`` (the class's lower bound: class k holds
    sizes in (D_k/2, D_k]) are excluded and the selection redrawn, up to 10
    times; fragments left after that are removed and their volume passed on
-   (kept in the last class, so that the fraction is always hit).
+   (kept in the last class, which also stops redrawing when the exclusions
+   would leave it short of its target, so that the fraction is hit).
 4. *ITZ*: mortar points whose centre lies within ``itz_thickness`` of an
    aggregate point centre (Euclidean distance transform, SciPy).
 
@@ -208,10 +209,17 @@ def _phase_core(pts, grid_shape, dx, weight, *, aggregate_fraction,
         vmin = _ball_volume(_MIN_SIZE_RATIO * dk, dim) / dx**dim
         last = k == len(classes) - 1
         excluded = np.zeros(weight.shape[0], dtype=bool)
+        wmax = float(weight[inside].max())
+        prev = None
         for attempt in range(_REDRAWS + 1):
             sel = np.zeros(weight.shape[0], dtype=bool)
             taken = _greedy_select(order[~excluded[order]], cell, weight, cap,
                                    target, sel)
+            if last and prev is not None and taken + 0.5 * wmax < target:
+                # the exclusions cost capacity the last class needs: keep
+                # the previous draw (with its fragments), which hit the target
+                sel, taken = prev
+                break
             # fragments below the class's lower size (clipped cells, noise
             # specks) are redrawn from the remaining points
             lab, _ = ndimage.label(sel.reshape(grid_shape))
@@ -225,10 +233,11 @@ def _phase_core(pts, grid_shape, dx, weight, *, aggregate_fraction,
                 sel &= ~frag
                 taken -= float(weight[frag].sum())
                 break
+            prev = (sel, taken)
             excluded |= frag
         agg |= sel
         carry = max(target - taken, 0.0)
-        if last and taken + 0.5 * weight[inside].max() < target:
+        if last and taken + 0.5 * wmax < target:
             raise ValueError(
                 f"aggregate_fraction {aggregate_fraction} cannot be reached: "
                 f"the smallest size class {dk} m holds {taken / wtot:.3f} of "
