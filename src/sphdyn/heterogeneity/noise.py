@@ -301,25 +301,30 @@ def _bisector(px, py, pz, cx, cy, cz, r, rz, half, seeds, lo, best, bi, bj,
     # min over seeds b != a of the distance d_b to the bisector plane of a, b
     # and, for tau > 0, the soft minimum -tau log sum exp(-d_b / tau) over
     # the seeds with d_b <= min + 5 tau (each dropped term < e^-5 of the
-    # largest; the soft minimum is a shape function, not a distance). A seed b cannot give less than (|p - b| - |p - a|) / 2;
-    # `bound` (>= the minimum, from a smaller block) tightens the pruning.
+    # largest; the soft minimum is a shape function, not a distance).
+    # A seed b cannot give less than (|p - b| - |p - a|) / 2; `bound` (>=
+    # the minimum, from a smaller block; the exact minimum for tau > 0)
+    # tightens the pruning.
     r1 = np.sqrt(best)
     a = seeds[bi - lo[0], bj - lo[1], bk - lo[2]]
     m = np.inf
     ssum = 0.0
+    # prune when (sqrt(e) - r1) / 2 > min(m, bound) + cut tau, i.e. e > lim2
+    cut = min(m, bound) + _SOFT_CUT * tau
+    lim2 = (2.0 * cut + r1) ** 2
     for i in range(cx - r, cx + r + 1):
         ex = _box_d1(px, i, half) ** 2
-        if 0.5 * (np.sqrt(ex) - r1) > min(m, bound) + _SOFT_CUT * tau:
+        if ex > lim2:
             continue
         for j in range(cy - r, cy + r + 1):
             ey = ex + _box_d1(py, j, half) ** 2
-            if 0.5 * (np.sqrt(ey) - r1) > min(m, bound) + _SOFT_CUT * tau:
+            if ey > lim2:
                 continue
             for k in range(cz - rz, cz + rz + 1):
                 if i == bi and j == bj and k == bk:
                     continue
                 ez = ey + _box_d1(pz, k, half) ** 2
-                if 0.5 * (np.sqrt(ez) - r1) > min(m, bound) + _SOFT_CUT * tau:
+                if ez > lim2:
                     continue
                 s = seeds[i - lo[0], j - lo[1], k - lo[2]]
                 d2 = (px - s[0]) ** 2 + (py - s[1]) ** 2 + (pz - s[2]) ** 2
@@ -327,7 +332,7 @@ def _bisector(px, py, pz, cx, cy, cz, r, rz, half, seeds, lo, best, bi, bj,
                               + (s[2] - a[2]) ** 2)
                 d = (d2 - best) / (2.0 * sep)
                 if tau > 0.0:
-                    if d > min(m, bound) + _SOFT_CUT * tau:
+                    if d > cut:
                         continue
                     if ssum == 0.0:
                         ssum = 1.0
@@ -339,6 +344,9 @@ def _bisector(px, py, pz, cx, cy, cz, r, rz, half, seeds, lo, best, bi, bj,
                         ssum += np.exp((m - d) / tau)
                 elif d < m:
                     m = d
+                    if m < cut:
+                        cut = m
+                        lim2 = (2.0 * cut + r1) ** 2
     if tau > 0.0:
         return m, m - tau * np.log(ssum)
     return m, m
