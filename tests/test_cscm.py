@@ -454,20 +454,20 @@ def test_cap_retraction(retract):
 def test_rate_enhanced_damage_thresholds():
     # choice [D] (docs/cscm.md): with rate effects the damage thresholds are
     # r0 x (largest dynamic-to-static strength ratio), so in uniaxial tension
-    # at 100/s damage starts only once the stress is well above the static
-    # tensile strength (f_ut = 3.107 MPa); with the scaling switched off it
-    # starts right after the static first yield. Without rate effects the
-    # switch changes nothing (bitwise).
+    # at 100/s the stress at which damage reaches 1 % is well above the
+    # static tensile strength (f_ut = 3.107 MPa; measured 1.79 f_ut), while
+    # without the scaling it is close to it (measured 1.26 f_ut). Without
+    # rate effects the switch changes nothing (bitwise).
     ft = 3.107e6
     onset = {}
     for rt in (False, True):
         r = drive("cscm", {**BASE, "rate_effects": True, "rate_thresholds": rt},
                   "uniaxial-tension", strain=0.002, n_steps=300, rate=100.0)
-        j = int(np.argmax(r["damage"] > 1e-3))
+        j = int(np.argmax(r["damage"] > 1e-2))
         onset[rt] = abs(r["y"][j])
         assert np.all(r["history"][:, cscm.H_RFMAX] >= 1.0)
-    assert onset[False] < 1.3 * ft
-    assert onset[True] > 1.4 * ft
+    assert onset[False] < 1.35 * ft
+    assert onset[True] > 1.6 * ft
     a = drive("cscm", {**BASE, "rate_thresholds": False}, "uniaxial-tension",
               strain=0.002, n_steps=100)
     b = drive("cscm", BASE, "uniaxial-tension", strain=0.002, n_steps=100)

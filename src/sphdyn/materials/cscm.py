@@ -733,12 +733,13 @@ def cscm_point(h, deps, dt, p, size):
                 svp = (sP[0] + g1 * ov[0], sP[1] + g1 * ov[1], sP[2] + g1 * ov[2],
                        sP[3] + g1 * ov[3], sP[4] + g1 * ov[4], sP[5] + g1 * ov[5])
                 J1v, rv, bv, devv = invariants(svp)
-                # dynamic-to-static strength ratio |s_vp|/|s_P| (Frobenius
-                # norms; = the axial stress ratio in uniaxial stress): choice
-                # [D] for the "dynamic/static strength" of notes sec. 1.10
-                nP = math.sqrt(ddot6(sP, sP))
-                nV = math.sqrt(ddot6(svp, svp))
-                rf = nV / nP if nP > 0.0 and nV > nP else 1.0
+                # dynamic-to-static strength ratio sqrt(J2'_vp / J2'_P), the
+                # shear-strength ratio of the J2'-based surface: choice [D]
+                # for the "dynamic/static strength" of notes sec. 1.10 (the
+                # ratio of full-tensor norms was tried: it hardly rises under
+                # confinement and lets ductile damage start early in the disc,
+                # see docs/cscm.md)
+                rf = rv / rp if rp > 0.0 and rv > rp else 1.0
             else:
                 svp = sP
                 J1v = J1p
