@@ -1,4 +1,4 @@
-"""Command line: ``sphdyn run|check|restart|ensemble|plot|export|info|bench|material-test``.
+"""Command line: ``sphdyn run|check|restart|ensemble|plot|ucs|export|info|bench|material-test``.
 
 Each subcommand is a thin function over the Python API. Exit codes: 0 success,
 1 a failed run (guard stopped it; all output kept), 2 bad input (deck or
@@ -115,6 +115,22 @@ def cmd_plot(args) -> int:
     for field in fields:
         print(plot_snapshots(args.dir, field, times=times, n=args.n, out=args.out,
                              vmin=args.vmin, vmax=args.vmax))
+    return 0
+
+
+def cmd_ucs(args) -> int:
+    from .compression import ensemble_report
+
+    stats = ensemble_report(args.dirs, args.wall, args.out, homogeneous=args.homogeneous)
+    ps, es = stats["peak_stress"], stats["strain_at_peak"]
+    print(f"{ps['n']} runs ({stats['skipped']} skipped): peak stress "
+          f"{ps['mean'] * 1e-6:.2f} MPa (CoV {100 * ps['cov']:.1f} %), strain at peak "
+          f"{es['mean'] * 1e3:.3f} permille (CoV {100 * es['cov']:.1f} %)")
+    if "homogeneous" in stats:
+        h = stats["homogeneous"]
+        print(f"homogeneous: {h['peak_stress'] * 1e-6:.2f} MPa at "
+              f"{h['strain_at_peak'] * 1e3:.3f} permille")
+    print(Path(args.out) / "ucs_curves.png")
     return 0
 
 
@@ -280,6 +296,16 @@ def build_parser() -> argparse.ArgumentParser:
                    help="snapshot colour-scale minimum, SI (negative: --vmin=-1e6)")
     p.add_argument("--vmax", type=float, help="snapshot colour-scale maximum, SI")
     p.set_defaults(func=cmd_plot)
+
+    u = sub.add_parser("ucs", help="stress-strain curves of compression runs between "
+                       "platens (one or an ensemble): peak statistics and a figure")
+    u.add_argument("dirs", nargs="+", help="run directories (e.g. OUT/sample_*)")
+    u.add_argument("--wall", required=True, help="name of the moving platen [[wall]]")
+    u.add_argument("--homogeneous", metavar="DIR", help="run of the homogeneous model, "
+                   "drawn in black")
+    u.add_argument("--out", default="out/ucs_report", help="directory for "
+                   "ucs_samples.csv, ucs_statistics.json, ucs_curves.png")
+    u.set_defaults(func=cmd_ucs)
 
     e = sub.add_parser("export", help="convert native frames (VTK series or CSV)")
     e.add_argument("dir")
