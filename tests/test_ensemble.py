@@ -74,6 +74,12 @@ def test_seeds_are_deterministic_distinct_and_shared_across_the_grid(deck, tmp_p
     assert specs[4].vary == {"sph.support_scale": "1.5"}
     assert specs[4].overrides == ("sph.support_scale=1.5", f"run.seed={seeds[1]}")
     assert specs[4].outdir.endswith("sample_0004")
+    # a deck that is valid only with its --vary key still gets the deck's seed
+    lacking = tmp_path / "lacking.toml"
+    lacking.write_text(TINY.replace('distribution = "uniform", low = 0.0, high = 2.0',
+                                    'distribution = "lognormal"'))
+    specs = plan_samples(lacking, 2, ["body.disc.mass.sigma=0,0.5"], tmp_path / "o")
+    assert [s.seed for s in specs] == seeds[:2] * 2
 
 
 def test_vary_parsing_and_default_layout():

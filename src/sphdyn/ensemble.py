@@ -104,6 +104,29 @@ def parse_vary(items) -> list[tuple[str, list[str]]]:
     return grid
 
 
+def _base_seed(deck: Path, overrides, grid) -> int:
+    """``run.seed`` of the deck with ``overrides`` and the first grid point.
+
+    The deck may need a ``--vary`` key to be valid (e.g. a parameter of a
+    mass law given only by ``--vary``), so the first grid point is applied;
+    if that is still invalid, the seed is read from the TOML (default 0) and
+    the invalid samples are recorded when they run.
+    """
+    import tomllib
+
+    from .deck import DeckError, load_deck
+
+    first = [f"{k}={v[0]}" for k, v in grid]
+    try:
+        return load_deck(deck, [*overrides, *first]).run.seed
+    except DeckError:
+        seeds = [o.partition("=")[2] for o in overrides if o.startswith("run.seed=")]
+        if seeds:
+            return int(seeds[-1])
+        raw = tomllib.loads(deck.read_text(encoding="utf-8"))
+        return int(raw.get("run", {}).get("seed", 0))
+
+
 @dataclass(frozen=True)
 class SampleSpec:
     """Everything a worker needs to run one sample (plain data, picklable)."""
@@ -135,9 +158,9 @@ def plan_samples(deck: str | Path, samples: int, vary=(), out: str | Path = "out
     if samples < 1:
         raise ValueError(f"--samples {samples}: give at least 1 sample")
     deck = Path(deck).resolve()
-    if base_seed is None:
-        base_seed = load_deck(deck, list(overrides)).run.seed
     grid = parse_vary(vary) if vary and isinstance(vary[0], str) else list(vary)
+    if base_seed is None:
+        base_seed = _base_seed(deck, overrides, grid)
     keys = [k for k, _ in grid]
     specs = []
     combos = itertools.product(*[v for _, v in grid]) if grid else [()]
