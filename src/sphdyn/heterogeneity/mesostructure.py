@@ -71,7 +71,9 @@ _REDRAWS = 10
 
 def _e_dim(dim: int) -> float:
     # equivalent-diameter factor: d_eq = e_dim * (volume)^(1/dim)
-    return (6.0 / math.pi) ** (1.0 / 3.0) if dim == 3 else (4.0 / math.pi) ** 0.5
+    if dim == 3:
+        return (6.0 / math.pi) ** (1.0 / 3.0)
+    return (4.0 / math.pi) ** 0.5
 
 
 def _ball_volume(d: float, dim: int) -> float:
@@ -257,8 +259,9 @@ def generate_phase_grid(grid_shape, dx: float, *, aggregate_fraction: float,
                         max_aggregate_size: float, itz_thickness: float = 0.0,
                         aggregate_shape: str = "rounded", grading=None,
                         octaves: int = 3, persistence: float = 0.5,
-                        lacunarity: float = 2.0, roughness: float | None = None,
-                        seed: int = 0, origin=(0.0, 0.0, 0.0), mask=None
+                        lacunarity: float = 2.0,
+                        roughness: float | None = None, seed: int = 0,
+                        origin=(0.0, 0.0, 0.0), mask=None
                         ) -> np.ndarray:
     """Phase field on a voxel grid (see module doc for the algorithm).
 

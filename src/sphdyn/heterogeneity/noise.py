@@ -49,7 +49,8 @@ distance to the boundary of its Voronoi cell is
 
 .. math::
 
-    d_{face}(x) = \\min_{b \\ne a} \\frac{|x - s_b|^2 - |x - s_a|^2}{2\\,|s_b - s_a|}
+    d_{face}(x) = \\min_{b \\ne a}
+                  \\frac{|x - s_b|^2 - |x - s_a|^2}{2\\,|s_b - s_a|}
 
 (distance to the nearest bisector plane, exact for the convex cell). Seeds
 are searched in the 7 x 7 x 7 block of cells around the point (7 x 7 x 1 in
@@ -65,7 +66,7 @@ either C extensions without releases for current Pythons (``noise``) or
 evaluate one point per Python call (``perlin-noise``, ``opensimplex``'s
 scalar API; its array API covers only grids). Evaluating a million particle
 positions directly, in parallel, with per-octave independent tables and the
-cellular variant in the same code path is 150 lines of Numba.
+cellular variant in the same code path takes a few hundred lines of Numba.
 """
 
 from __future__ import annotations
@@ -80,7 +81,6 @@ __all__ = ["permutation_tables", "gradient_noise", "fbm", "Cellular",
 
 _TABLE = 256
 _SOFT_CUT = 5.0
-_U64_MASK = (1 << 64) - 1
 
 
 def permutation_tables(seed: int, count: int) -> np.ndarray:
@@ -140,8 +140,10 @@ def _perlin(x, y, z, p):
     x1 = x - 1.0
     y1 = y - 1.0
     z1 = z - 1.0
-    l1 = _grad(p[AA], x, y, z) + u * (_grad(p[BA], x1, y, z) - _grad(p[AA], x, y, z))
-    l2 = _grad(p[AB], x, y1, z) + u * (_grad(p[BB], x1, y1, z) - _grad(p[AB], x, y1, z))
+    l1 = (_grad(p[AA], x, y, z)
+          + u * (_grad(p[BA], x1, y, z) - _grad(p[AA], x, y, z)))
+    l2 = (_grad(p[AB], x, y1, z)
+          + u * (_grad(p[BB], x1, y1, z) - _grad(p[AB], x, y1, z)))
     l3 = (_grad(p[AA + 1], x, y, z1)
           + u * (_grad(p[BA + 1], x1, y, z1) - _grad(p[AA + 1], x, y, z1)))
     l4 = (_grad(p[AB + 1], x, y1, z1)

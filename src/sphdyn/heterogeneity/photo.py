@@ -6,7 +6,10 @@
    ``w(k) = sum_{i<=k} p_i``, ``mu(k) = sum_{i<=k} p_i g_i``, the threshold
    maximises the between-class variance
 
-   .. math:: \\sigma_B^2(k) = \\frac{(\\mu_T\\, w(k) - \\mu(k))^2}{w(k)\\,(1 - w(k))}.
+   .. math::
+
+       \\sigma_B^2(k) = \\frac{(\\mu_T\\, w(k) - \\mu(k))^2}
+                             {w(k)\\,(1 - w(k))}.
 
 3. Clean: binary opening then closing with a disc of ``radius`` pixels
    (removes noise specks and bridges), removal of pieces smaller than
@@ -126,8 +129,9 @@ class SectionStatistics:
             else float("nan")
 
     def summary(self) -> str:
-        return (f"area fraction {self.area_fraction:.4f}, {self.diameters.size}"
-                f" pieces, d_eq median {self.percentile(50):.4g} m, 95% "
+        return (f"area fraction {self.area_fraction:.4f}, "
+                f"{self.diameters.size} pieces, d_eq median "
+                f"{self.percentile(50):.4g} m, 95% "
                 f"{self.percentile(95):.4g} m")
 
 
