@@ -20,6 +20,7 @@ pyplot, no global state) and saved atomically.
 from __future__ import annotations
 
 import math
+import textwrap
 import os
 import re
 import tomllib
@@ -472,14 +473,14 @@ def plot_snapshots(outdir, field: str = "von_mises",
         ax.set_xlim(*xlim)
         ax.set_ylim(*ylim)
         ax.set_aspect("equal")
-        label_t = _time_label(t, t_max)
-        ax.set_title(label_t if len(runs) == 1 else f"{loaded[row][3]}\n{label_t}",
-                     fontsize=10 if len(runs) == 1 else 8)
+        ax.set_title(_time_label(t, t_max), fontsize=10 if len(runs) == 1 else 9)
         if row == nrows - 1 or (row + 1, col) not in used:
             ax.set_xlabel(f"{names[plane[0]]} [mm]")
             ax.xaxis.set_tick_params(labelbottom=True)
         if col == 0:
-            ax.set_ylabel(f"{names[plane[1]]} [mm]")
+            run_label = "" if len(runs) == 1 else textwrap.fill(loaded[row][3], 28) + "\n"
+            ax.set_ylabel(f"{run_label}{names[plane[1]]} [mm]",
+                          fontsize=10 if len(runs) == 1 else 8)
     label = field if not shown_unit else f"{field} [{shown_unit}]"
     if collection is not None:
         fig.colorbar(collection, ax=axes.ravel().tolist(), label=label,
