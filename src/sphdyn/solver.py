@@ -123,6 +123,7 @@ class Solver:
         # Lagrangian list then holds the other particles only
         tl = total_lagrangian_mask(deck, p.body)
         self.ul_active = ~tl if tl.any() else None
+        self.has_ul = not tl.all()  # False: the updated-Lagrangian passes are skipped
         self.tl = None
         if tl.any():
             young = np.zeros(n)
@@ -168,10 +169,11 @@ class Solver:
         p, nl = self.p, self.nl
         if self.F.shape[0] != nl.idx.shape[0]:
             self.F = np.empty(nl.idx.shape[0])  # only after a neighbour rebuild
-        particle_volumes(p.m, p.rho, self.vol)
-        velocity_gradient(p.x, p.v, p.h, self.vol, nl.offsets, nl.idx, self.kid,
-                          self.sigma, self.dim, self.kscale, self.correct, self.F, p.L,
-                          self.B)
+        if self.has_ul:
+            particle_volumes(p.m, p.rho, self.vol)
+            velocity_gradient(p.x, p.v, p.h, self.vol, nl.offsets, nl.idx, self.kid,
+                              self.sigma, self.dim, self.kscale, self.correct, self.F,
+                              p.L, self.B)
         if self.tl is not None:
             self.tl.velocity_gradient(p)
 
@@ -182,10 +184,11 @@ class Solver:
         start of the step; h changes slowly, by design of the Benz update).
         """
         p, nl = self.p, self.nl
-        scaled_stress(p.sig, p.rho, self.S)
-        forces(p.x, p.v, p.m, p.rho, p.h, p.c, self.S, self.B, self.F, nl.offsets,
-               nl.idx, self.dim, self.kscale, self.correct, self.alpha, self.beta, p.a,
-               self.dedt_av)
+        if self.has_ul:
+            scaled_stress(p.sig, p.rho, self.S)
+            forces(p.x, p.v, p.m, p.rho, p.h, p.c, self.S, self.B, self.F, nl.offsets,
+                   nl.idx, self.dim, self.kscale, self.correct, self.alpha, self.beta,
+                   p.a, self.dedt_av)
         if self.R is not None:
             artificial_stress_tensor(p.sig, p.rho, self.as_eps, self.R, self.Q)
             artificial_stress_forces(p.x, p.m, p.h, self.R, self.F, nl.offsets, nl.idx,
@@ -263,8 +266,9 @@ class Solver:
         if self.cnl is not None:
             self.cnl = update_neighbours(self.cnl, p.x, self.size, self.dim)
         self._gradients()
-        update_density_and_h(p.L, dt, self.dim, self.benz, p.h0, self.hmin, self.hmax,
-                             p.rho, p.h)
+        if self.has_ul:
+            update_density_and_h(p.L, dt, self.dim, self.benz, p.h0, self.hmin,
+                                 self.hmax, p.rho, p.h)
         if self.tl is not None:
             self.tl.density(p)
         for g in model.groups:

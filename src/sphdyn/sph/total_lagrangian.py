@@ -332,6 +332,18 @@ def tl_forces(rows, x, v, X, m, rho, rho0, c, h0, vol, offsets, idx, gi, gj, fac
         rhoi = rho[i]
         hi = h0[i]
         rho0i = rho0[i]
+        f00 = Fdef[i, 0, 0]
+        f01 = Fdef[i, 0, 1]
+        f02 = Fdef[i, 0, 2]
+        f10 = Fdef[i, 1, 0]
+        f11 = Fdef[i, 1, 1]
+        f12 = Fdef[i, 1, 2]
+        f20 = Fdef[i, 2, 0]
+        f21 = Fdef[i, 2, 1]
+        f22 = Fdef[i, 2, 2]
+        Xi0 = X[i, 0]
+        Xi1 = X[i, 1]
+        Xi2 = X[i, 2]
         a0 = a1 = a2 = 0.0  # stress part times rho0_i, viscous part [m/s^2]
         q0 = q1 = q2 = 0.0
         f0 = f1 = f2 = 0.0  # hourglass force [N]
@@ -382,16 +394,18 @@ def tl_forces(rows, x, v, X, m, rho, rho0, c, h0, vol, offsets, idx, gi, gj, fac
                     heat += 0.5 * mpf * vx
             hk = hgk[k]
             if hk != 0.0 and r2 > 0.0:
-                X0 = X[j, 0] - X[i, 0]
-                X1 = X[j, 1] - X[i, 1]
-                X2 = X[j, 2] - X[i, 2]
+                X0 = X[j, 0] - Xi0
+                X1 = X[j, 1] - Xi1
                 # s = (F_i + F_j) X_ij - 2 x_ij, with x_ij = x_j - x_i = -d
-                s0 = ((Fdef[i, 0, 0] + Fdef[j, 0, 0]) * X0 + (Fdef[i, 0, 1] + Fdef[j, 0, 1]) * X1
-                      + (Fdef[i, 0, 2] + Fdef[j, 0, 2]) * X2 + 2.0 * d0)
-                s1 = ((Fdef[i, 1, 0] + Fdef[j, 1, 0]) * X0 + (Fdef[i, 1, 1] + Fdef[j, 1, 1]) * X1
-                      + (Fdef[i, 1, 2] + Fdef[j, 1, 2]) * X2 + 2.0 * d1)
-                s2 = ((Fdef[i, 2, 0] + Fdef[j, 2, 0]) * X0 + (Fdef[i, 2, 1] + Fdef[j, 2, 1]) * X1
-                      + (Fdef[i, 2, 2] + Fdef[j, 2, 2]) * X2 + 2.0 * d2)
+                s0 = (f00 + Fdef[j, 0, 0]) * X0 + (f01 + Fdef[j, 0, 1]) * X1 + 2.0 * d0
+                s1 = (f10 + Fdef[j, 1, 0]) * X0 + (f11 + Fdef[j, 1, 1]) * X1 + 2.0 * d1
+                s2 = 0.0
+                if three:
+                    X2 = X[j, 2] - Xi2
+                    s0 += (f02 + Fdef[j, 0, 2]) * X2
+                    s1 += (f12 + Fdef[j, 1, 2]) * X2
+                    s2 = ((f20 + Fdef[j, 2, 0]) * X0 + (f21 + Fdef[j, 2, 1]) * X1
+                          + (f22 + Fdef[j, 2, 2]) * X2 + 2.0 * d2)
                 # hgk (s . x_ij) x_ij / r^2 = hgk (s . d) d / r^2
                 coef = hk * (s0 * d0 + s1 * d1 + s2 * d2) / r2
                 f0 += coef * d0
