@@ -332,6 +332,16 @@ def yield_function(s, kappa, p):
 
 
 @njit(cache=True)
+def _j1_radius(s):
+    """``(J1, sqrt(J2'))`` of a stress 6-tuple (CSCM convention, see
+    :func:`invariants`), without the Lode angle."""
+    m = (s[0] + s[1] + s[2]) / 3.0
+    d0, d1, d2 = s[0] - m, s[1] - m, s[2] - m
+    J2 = 0.5 * (d0 * d0 + d1 * d1 + d2 * d2) + s[3] * s[3] + s[4] * s[4] + s[5] * s[5]
+    return -3.0 * m, math.sqrt(J2)
+
+
+@njit(cache=True)
 def project(J1t, rt, bhat, kappa, K, G, p):
     """Closest point of the yield surface to a trial point, energy norm.
 
@@ -772,7 +782,7 @@ def cscm_point(h, deps, dt, p, size):
                     h[H_R0C] = max(math.sqrt(max(0.5 * ddot6(s_on, e_on), 0.0)), 1e-30)
         # damage evolution
         if h[H_R0T] > 0.0 or h[H_R0C] > 0.0:
-            J1v, rv, bv, devv = invariants(svp)
+            J1v, rv = _j1_radius(svp)
             gscale = rf ** p[P_REPOW] if irate else 1.0
             # rate-enhanced thresholds (choice [D]; notes sec. 1.9 [R] only
             # say that they increase with rate): r0 x the largest dynamic-to-
