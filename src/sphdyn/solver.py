@@ -116,7 +116,7 @@ class Solver:
         for w in model.walls:
             if w.method == STIFFNESS_BULK and n:
                 self.dt_contact = min(self.dt_contact, 0.5 * bulk_contact_time_step(
-                    p.m, p.vol0, p.rho, w.kbulk, self.dim, w.alpha))
+                    p.m, p.vol0, p.rho0, w.kbulk, self.dim, w.alpha))
         r0 = model.radius_factor * float(p.h.max()) if n else 0.0
         self.skin = sph.neighbours.skin_factor * r0
         # total-Lagrangian bodies: fixed reference neighbours; the updated-
@@ -203,7 +203,7 @@ class Solver:
                 self.cnl.offsets, self.cnl.idx, self.contact_alpha, self.contact_factor,
                 self.a_contact))
         for w in self.model.walls:
-            cnt = wall_contact(p.x, p.v, p.m, p.vol0, p.rho, w.kbulk, self.dim,
+            cnt = wall_contact(p.x, p.v, p.m, p.vol0, p.rho0, w.kbulk, self.dim,
                                w.point_at(self.t), w.normal, w.velocity,
                                w.thickness_factor, w.method, w.alpha, w.friction, dt,
                                self.a_contact, self.wall_force)
@@ -357,7 +357,7 @@ class Solver:
         for w in self.model.walls:
             self.wall_force[:] = 0.0
             tmp = np.zeros_like(self.a_contact)
-            cnt = wall_contact(self.p.x, self.p.v, self.p.m, self.p.vol0, self.p.rho,
+            cnt = wall_contact(self.p.x, self.p.v, self.p.m, self.p.vol0, self.p.rho0,
                                w.kbulk, self.dim, w.point_at(self.t), w.normal, w.velocity,
                                w.thickness_factor, w.method, w.alpha, w.friction,
                                self.dt_prev or self.dt0, tmp, self.wall_force)

@@ -14,10 +14,14 @@ with the spring stiffness of Hušek et al. (2017):
   zero-mass particle (the limit :math:`m \to 0`);
 * bulk-modulus-based, paper eq. (9): :math:`k_i = \alpha K A_i / L_i` with
   :math:`A_i = V_i^{(d-1)/d}` and :math:`L_i = V_i^{1/d}` (the particle's
-  face area and size; in 2D per unit depth, so :math:`k = \alpha K`). This
-  works when :math:`m_i = 0`: the acceleration then uses the particle's
-  nominal inertia :math:`\rho_i V_i` (a zero-mass particle carries no
-  momentum, so the wall force it reports is zero).
+  face area and size; in 2D per unit depth, so :math:`k = \alpha K`). The
+  acceleration uses the particle's nominal inertia :math:`\rho_{0i} V_i`
+  (its mass in a homogeneous body), :math:`a = k\delta / (\rho_0 V)`, so
+  zero-mass particles (initial cracks) and the light particles of a random
+  mass field get the same, bounded acceleration and the stable time step
+  :math:`2\sqrt{\rho_0 V/k}` does not collapse; the force a particle
+  reports and exerts is :math:`m_i a` (a conservative spring of stiffness
+  :math:`k\, m_i/(\rho_0 V)`; zero for zero mass).
 
 A wall may move with a constant velocity :math:`\mathbf u` (a platen of a
 compression test): the caller passes the current point
@@ -46,7 +50,8 @@ def wall_contact(x, v, m, vol0, rho, kbulk, dim, point, normal, wall_v,
     Parameters
     ----------
     x, v : (N, 3) positions [m] and mid-step velocities [m/s].
-    m, vol0, rho : (N,) mass [kg], nominal volume [m^dim], density [kg/m^3].
+    m, vol0, rho : (N,) mass [kg], nominal volume [m^dim], reference density
+        [kg/m^3] (``rho * vol0`` is the nominal inertia of the bulk method).
     kbulk : (N,) bulk modulus [Pa] used by the bulk method.
     point, normal : (3,) a point of the wall (at the current time) and its
         unit normal (towards the bodies).
@@ -74,7 +79,7 @@ def wall_contact(x, v, m, vol0, rho, kbulk, dim, point, normal, wall_v,
         if pen <= 0.0:
             continue
         count += 1
-        inertia = m[i] if m[i] > 0.0 else rho[i] * vol0[i]
+        inertia = rho[i] * vol0[i]
         if method == STIFFNESS_MASS:
             an = alpha * pen / (dt * dt)
         else:
@@ -112,6 +117,6 @@ def bulk_contact_time_step(m, vol0, rho, kbulk, dim, alpha):
     The mass-based spring needs none (:math:`\omega\Delta t = \sqrt\alpha`).
     Returns the minimum over particles [s].
     """
-    inertia = np.where(m > 0.0, m, rho * vol0)
+    inertia = rho * vol0  # nominal inertia, see the module docstring
     k = alpha * kbulk * vol0 ** ((dim - 2.0) / dim)
     return float(np.min(2.0 * np.sqrt(inertia / k)))
