@@ -118,6 +118,33 @@ def cmd_plot(args) -> int:
     return 0
 
 
+def cmd_mesostructure(args) -> int:
+    from .deck import load_deck
+    from .heterogeneity.mesostructure import phase_statistics, save_phase_slices
+    from .model import build_model
+
+    deck = load_deck(args.deck, args.set or [])
+    model = build_model(deck)
+    p = model.particles
+    out = Path(args.out) if args.out else Path("out") / f"{Path(args.deck).stem}-phases"
+    shown = 0
+    for b, body in enumerate(deck.body):
+        if body.mesostructure is None:
+            continue
+        sel = p.body == b
+        st = phase_statistics(model.phase[sel], body.dx, x=p.x[sel])
+        png = save_phase_slices(model.phase[sel], out / f"phases_{body.name}.png",
+                                body.dx, x=p.x[sel],
+                                title=f"{body.name}: seed {deck.run.seed}")
+        print(f"{body.name}: {st.summary()}")
+        print(png)
+        shown += 1
+    if not shown:
+        print("no [body.mesostructure] in this deck")
+        return 1
+    return 0
+
+
 def cmd_ucs(args) -> int:
     from .compression import ensemble_report
 
@@ -296,6 +323,15 @@ def build_parser() -> argparse.ArgumentParser:
                    help="snapshot colour-scale minimum, SI (negative: --vmin=-1e6)")
     p.add_argument("--vmax", type=float, help="snapshot colour-scale maximum, SI")
     p.set_defaults(func=cmd_plot)
+
+    ms = sub.add_parser("mesostructure", help="generate the [body.mesostructure] phases "
+                        "of a deck without running it: statistics and slice images")
+    ms.add_argument("deck")
+    ms.add_argument("--set", action="append", metavar="KEY=VALUE",
+                    help="override a deck value, e.g. --set run.seed=7")
+    ms.add_argument("--out", help="directory for phases_<body>.png "
+                    "(default out/<deck>-phases)")
+    ms.set_defaults(func=cmd_mesostructure)
 
     u = sub.add_parser("ucs", help="stress-strain curves of compression runs between "
                        "platens (one or an ensemble): peak statistics and a figure")

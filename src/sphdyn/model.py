@@ -64,6 +64,9 @@ class Model:
     radius_factor: float
     bulk_modulus: np.ndarray = field(repr=False, default=None)  # (N,) per particle
     probes: list[Probe] = field(default_factory=list)
+    #: (N,) int8 mesostructure phase (0 mortar, 1 aggregate, 2 ITZ; -1 for
+    #: bodies without [body.mesostructure])
+    phase: np.ndarray = field(repr=False, default=None)
 
 
 def _material_params(mat) -> dict:
@@ -73,15 +76,16 @@ def _material_params(mat) -> dict:
     return {k: v for k, v in d.items() if v is not None}
 
 
-def _phase_materials(deck, b: int, body, x: np.ndarray, dim: int) -> list[str]:
-    """Material name of every particle of a body with a mesostructure ([] if none).
+def _phase_materials(deck, b: int, body, x: np.ndarray, dim: int):
+    """Material names and phases of a body's particles (([], None) without a
+    mesostructure).
 
     Phases from :func:`sphdyn.heterogeneity.mesostructure.generate_phases`,
     seeded by ``run.seed`` and the body index.
     """
     ms = body.mesostructure
     if ms is None:
-        return []
+        return [], None
     seed = int(np.random.SeedSequence([int(deck.run.seed), b, 0x6D65736F]).generate_state(1)[0])
     phases = generate_phases(
         x, body.dx, aggregate_fraction=ms.aggregate_fraction,
@@ -91,7 +95,7 @@ def _phase_materials(deck, b: int, body, x: np.ndarray, dim: int) -> list[str]:
     mortar = ms.mortar or body.material
     table = {int(MORTAR): mortar, int(AGGREGATE): ms.aggregate or body.material,
              int(ITZ): ms.itz or mortar}
-    return [table[int(k)] for k in phases]
+    return [table[int(k)] for k in phases], phases
 
 
 def build_model(deck) -> Model:
@@ -110,7 +114,7 @@ def build_model(deck) -> Model:
             f"({' vs '.join(str(list(h)) for h in sorted(layouts))}): history columns "
             "are stored by position; use materials of one model family per run")
 
-    parts = []
+    parts, phase_parts = [], []
     for b, body in enumerate(deck.body):
         x = lattice_from_shape(body.geometry.model_dump(), body.dx, dim)
         n = x.shape[0]
@@ -118,7 +122,8 @@ def build_model(deck) -> Model:
             raise ValueError(f"body {body.name!r}: its geometry holds no particle at "
                              f"dx = {body.dx} m; make dx smaller or the shape larger")
         mat = mats[body.material]
-        names = _phase_materials(deck, b, body, x, dim)
+        names, ph = _phase_materials(deck, b, body, x, dim)
+        phase_parts.append(np.full(n, -1, np.int8) if ph is None else ph)
         p = Particles.allocate(n, dim, n_hist)
         p.x[:] = x
         p.x0[:] = x
@@ -216,4 +221,4 @@ def build_model(deck) -> Model:
         body_names=[b.name for b in deck.body], domain_lo=lo, domain_hi=hi,
         kernel_id=kid, kernel_sigma=kernels.normalisation(kid, dim),
         radius_factor=kernels.support(kid) * deck.sph.support_scale,
-        bulk_modulus=kb, probes=probes)
+        bulk_modulus=kb, probes=probes, phase=np.concatenate(phase_parts))

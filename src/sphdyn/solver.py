@@ -213,7 +213,10 @@ class Solver:
 
     def output_fields(self) -> dict:
         """Output fields the solver evaluates on demand, for ``particle_fields``."""
-        return {"swegle": self.swegle_field}
+        phase = self.model.phase
+        if phase is None:
+            phase = np.full(self.p.n, -1, np.int8)
+        return {"swegle": self.swegle_field, "phase": lambda: phase}
 
     def swegle_field(self) -> np.ndarray:
         """Swegle indicator (N,) of the current state (see :mod:`sphdyn.sph.swegle`).

@@ -34,7 +34,7 @@ from .units import (DENSITY, LENGTH, PRESSURE, TIME, VELOCITY, Dimension,
 ALLOWED_FIELDS: list[str] = [
     "velocity", "displacement", "stress", "pressure", "von_mises", "density",
     "mass", "smoothing_length", "damage", "internal_energy", "plastic_strain",
-    "bc", "body", "material", "swegle",
+    "bc", "body", "material", "swegle", "phase",
 ]
 
 DEFAULT_FIELDS = ("velocity", "displacement", "stress", "pressure", "von_mises",

@@ -39,6 +39,8 @@ DERIVED_FIELDS: dict[str, str] = {
     "swegle": "Swegle tensile-instability indicator: fraction of neighbour "
               "pairs with W''(r) sigma_n > 0 (tension positive), in [0, 1]; "
               "NaN without a solver; see docs/tensile-instability.md, (N,)",
+    "phase": "mesostructure phase (int8): 0 mortar, 1 aggregate, 2 ITZ, -1 "
+             "for bodies without [body.mesostructure], (N,)",
 }
 
 
@@ -72,6 +74,8 @@ def _compute(p: "Particles", name: str, computed) -> np.ndarray:
         return np.array(computed[name](), copy=True)
     if name == "swegle":
         return np.full(p.n, np.nan)  # no solver supplied it
+    if name == "phase":
+        return np.full(p.n, -1, np.int8)  # no model supplied it
     simple = {"density": "rho", "mass": "m", "smoothing_length": "h",
               "damage": "damage", "internal_energy": "e", "bc": "bc",
               "body": "body", "material": "mat"}
