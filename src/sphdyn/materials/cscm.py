@@ -687,6 +687,13 @@ def cscm_point(h, deps, dt, p, size):
     if dt > 0.0:
         rate = math.sqrt(2.0 / 3.0 * ddot6(deps, deps)) / dt
     h[H_RATE] = rate
+    eta_t = eta_c = eta_s = 0.0
+    if irate and rate > 1e-12:
+        # fluidities eta_t = eta0t/rate^nt, eta_c = eta0c/rate^nc,
+        # eta_s = srate eta_t (notes 1.11 [R]), constant over the step
+        eta_t = p[P_ETA0T] / rate ** p[P_NT]
+        eta_c = p[P_ETA0C] / rate ** p[P_NC]
+        eta_s = p[P_SRATE] * eta_t
     rf = 1.0
     for _ in range(n):
         eps = (eps[0] + de[0], eps[1] + de[1], eps[2] + de[2],
@@ -712,16 +719,13 @@ def cscm_point(h, deps, dt, p, size):
             over = 0.0
             if irate and rate > 1e-12:
                 # Duvaut-Lions fluidity, interpolated with trans (notes 1.11 [R])
+                # (eta_t, eta_c, eta_s depend on the step's rate only)
                 if J1t < 0.0:
                     tr = transition(J1t, rt, p[P_PWRT])
-                    eta_t = p[P_ETA0T] / rate ** p[P_NT]
-                    eta_s = p[P_SRATE] * eta_t
                     eta = eta_s + tr * (eta_t - eta_s)
                     over = p[P_OVERT]
                 else:
                     tr = transition(J1t, rt, p[P_PWRC])
-                    eta_c = p[P_ETA0C] / rate ** p[P_NC]
-                    eta_s = p[P_SRATE] * p[P_ETA0T] / rate ** p[P_NT]
                     eta = eta_s + tr * (eta_c - eta_s)
                     over = p[P_OVERC]
                 # overstress limit E rate eta <= OVER (notes 1.11 [R], choice [D])
@@ -742,7 +746,7 @@ def cscm_point(h, deps, dt, p, size):
                     g1 *= over / ovn
                 svp = (sP[0] + g1 * ov[0], sP[1] + g1 * ov[1], sP[2] + g1 * ov[2],
                        sP[3] + g1 * ov[3], sP[4] + g1 * ov[4], sP[5] + g1 * ov[5])
-                J1v, rv, bv, devv = invariants(svp)
+                J1v, rv = _j1_radius(svp)
                 # dynamic-to-static strength ratio sqrt(J2'_vp / J2'_P), the
                 # shear-strength ratio of the J2'-based surface: choice [D]
                 # for the "dynamic/static strength" of notes sec. 1.10 (the
