@@ -87,13 +87,20 @@ geometry = { shape = "cylinder", centre = [0.001, 0.019, 0], radius = 0.006 }
 }
 
 
-@pytest.mark.parametrize("variant", ["updated_lagrangian", "total_lagrangian"])
+TL_UPDATED = {**TL_TWO_BODIES, "[[body]]": TL_TWO_BODIES["[[body]]"].replace(
+    'formulation = "total_lagrangian"',
+    'formulation = "total_lagrangian"\nreference_update_every = 15')}
+
+
+@pytest.mark.parametrize("variant", ["updated_lagrangian", "total_lagrangian",
+                                     "total_lagrangian_updated_reference"])
 def test_restart_continues_to_the_same_result(tmp_path, variant):
     # An interrupted run restarted from its checkpoint must reproduce the
     # uninterrupted run bitwise (same neighbour list, same operation order);
     # the total-Lagrangian variant has two bodies in particle contact, so the
     # contact neighbour list is part of the checkpoint too.
-    extra = TL_TWO_BODIES if variant == "total_lagrangian" else {}
+    extra = {"updated_lagrangian": {}, "total_lagrangian": TL_TWO_BODIES,
+             "total_lagrangian_updated_reference": TL_UPDATED}[variant]
     full = _sim(tmp_path, "full", **extra)
     full.run()
     if extra:

@@ -125,6 +125,7 @@ class Solver:
         self.ul_active = ~tl if tl.any() else None
         self.has_ul = not tl.all()  # False: the updated-Lagrangian passes are skipped
         self.tl = None
+        self.ref_every = sph.reference_update_every
         if tl.any():
             young = np.zeros(n)
             for g in model.groups:
@@ -266,6 +267,9 @@ class Solver:
         self.dt_prev = dt
 
         self.nl = update_neighbours(nl, p.x, p.h, self.dim, self.ul_active)
+        if (self.tl is not None and self.ref_every
+                and self.step_count % self.ref_every == 0):
+            self.tl.update_reference(p)
         if self.cnl is not None:
             self.cnl = update_neighbours(self.cnl, p.x, self.size, self.dim)
         self._gradients()
@@ -322,6 +326,8 @@ class Solver:
 
     def state_arrays(self) -> dict:
         out = {"a_contact": self.a_contact, "B": self.B, "dedt_av": self.dedt_av}
+        if self.tl is not None:  # the reference configuration may have been updated
+            out.update({"tl_X": self.tl.X, "tl_rho_ref": self.tl.rho_ref})
         lists = {"nl": self.nl} if self.cnl is None else {"nl": self.nl, "cnl": self.cnl}
         for key, nl in lists.items():
             out.update({f"{key}_offsets": nl.offsets, f"{key}_idx": nl.idx,
@@ -349,6 +355,11 @@ class Solver:
                 nl.x_ref = arrays[f"{key}_x_ref"].copy()
                 nl.h_ref = arrays[f"{key}_h_ref"].copy()
         if self.tl is not None:
+            if "tl_X" in arrays and not (np.array_equal(arrays["tl_X"], self.tl.X) and
+                                         np.array_equal(arrays["tl_rho_ref"],
+                                                        self.tl.rho_ref)):
+                self.tl.rebuild(self.p, arrays["tl_X"].copy(),
+                               arrays["tl_rho_ref"].copy())
             self.tl.velocity_gradient(self.p)  # F of the restored state
         if self.cnl is not None:  # contact count of the restored state
             self.contact_count = int(particle_contact(

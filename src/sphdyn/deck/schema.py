@@ -424,6 +424,10 @@ class Sph(Section):
         10.0, description="Ganzenmueller (2015) hourglass coefficient alpha "
                           "of total-Lagrangian bodies (0 = off; 10-50 "
                           "recommended). Unused by updated-Lagrangian bodies.")
+    reference_update_every: integer("step count", lo=0) = Field(
+        0, description="Total-Lagrangian bodies: make the current configuration "
+                       "the new reference every this many steps (0 = never; "
+                       "for large deformations; costs one neighbour build).")
     kernel: Literal["cubic_spline", "quintic_spline", "wendland_c2",
                     "wendland_c4", "gaussian", "quadratic"] = Field(
         "cubic_spline", description="Smoothing kernel.")

@@ -36,7 +36,8 @@ class TotalLagrangian:
 
     Parameters
     ----------
-    p : Particles (reference configuration ``p.x0``, ``p.h0``, ``p.rho0``).
+    p : Particles (initial reference configuration ``p.x0``, ``p.h0``,
+        ``p.rho0``).
     rows : (n_tl,) int64, the particles of total-Lagrangian bodies.
     kid, sigma, radius_factor, kscale : kernel id, normalisation, support
         radius factor (q_max * kappa) and support scale kappa.
@@ -46,40 +47,64 @@ class TotalLagrangian:
 
     Only pairs of particles within one body and both in ``rows`` are kept;
     rows of other particles are empty, so the arrays are (N, ...) and all
-    passes write the ``rows`` only.
+    passes write the ``rows`` only. :meth:`update_reference` makes the current
+    configuration the new reference (``X``, ``rho_ref``; the Cauchy stress
+    carries over, F restarts from I).
     """
 
     def __init__(self, p, rows, kid, sigma, radius_factor, kscale, young, hourglass,
                  alpha=0.0, beta=0.0):
-        n, dim = p.n, p.dim
-        self.dim = dim
+        self.dim = p.dim
         self.rows = np.ascontiguousarray(rows, dtype=np.int64)
+        self.kid, self.sigma = kid, sigma
+        self.radius_factor = radius_factor
+        self.kscale = float(kscale)
+        self.young = np.ascontiguousarray(young, dtype=float)
+        self.hourglass = float(hourglass)
+        self.alpha = float(alpha)
+        self.beta = float(beta)
+        self.n_updates = 0
+        self.rebuild(p, p.x0.copy(), p.rho0.copy())
+
+    def rebuild(self, p, X: np.ndarray, rho_ref: np.ndarray) -> None:
+        """Reference list, corrected gradients and pair factors for ``X`` (N, 3)."""
+        n, dim = p.n, p.dim
+        self.X = X
+        self.rho_ref = rho_ref
         active = np.zeros(n, dtype=bool)
         active[self.rows] = True
-        full = build_neighbours(p.x0, p.h0, radius_factor, 0.0, dim, active=active)
+        full = build_neighbours(X, p.h0, self.radius_factor, 0.0, dim, active=active)
         self.offsets, self.idx = same_body_pairs(full.offsets, full.idx, p.body)
-        self.vol = np.divide(p.m, p.rho0, out=np.zeros(n), where=p.rho0 > 0)
+        self.vol = np.divide(p.m, rho_ref, out=np.zeros(n), where=rho_ref > 0)
         nnz = self.idx.size
         g = np.zeros((nnz, 3))
         w = np.zeros(nnz)
         self.B0 = np.zeros((n, 3, 3))
-        reference_gradients(p.x0, p.h0, self.vol, self.offsets, self.idx, kid, sigma,
-                            dim, kscale, g, w, self.B0)
+        reference_gradients(X, p.h0, self.vol, self.offsets, self.idx, self.kid,
+                            self.sigma, dim, self.kscale, g, w, self.B0)
         self.gi = np.zeros((nnz, 3))
         self.gj = np.zeros((nnz, 3))
         self.fac = np.zeros(nnz)
-        corrected_pair_gradients(p.x0, self.offsets, self.idx, g, self.B0, self.gi,
+        corrected_pair_gradients(X, self.offsets, self.idx, g, self.B0, self.gi,
                                  self.gj, self.fac)
         self.F = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
         self.Finv = self.F.copy()
         self.P = np.zeros((n, 3, 3))
         self.hgk = np.zeros(nnz)
-        hourglass_coefficients(self.rows, p.x0, self.vol, self.offsets, self.idx, w,
-                               np.ascontiguousarray(young, dtype=float), float(hourglass),
-                               self.hgk)
-        self.alpha = float(alpha)
-        self.beta = float(beta)
-        self.kscale = float(kscale)
+        hourglass_coefficients(self.rows, X, self.vol, self.offsets, self.idx, w,
+                               self.young, self.hourglass, self.hgk)
+
+    def update_reference(self, p) -> None:
+        """Make the current positions and densities the reference configuration.
+
+        For large deformations (thesis sec. 2.2.1: the Lagrangian kernel
+        fails once the reference neighbourhoods are badly distorted): the
+        neighbour list, corrected gradients and hourglass factors are rebuilt
+        from ``p.x`` with ``rho_ref = p.rho``; the Cauchy stress and history
+        stay. Costs one neighbour build.
+        """
+        self.rebuild(p, p.x.copy(), p.rho.copy())
+        self.n_updates += 1
 
     def velocity_gradient(self, p) -> None:
         """Fill ``p.L`` (and ``F``) of the total-Lagrangian rows."""
@@ -87,16 +112,17 @@ class TotalLagrangian:
                              self.gi, self.dim, self.F, self.Finv, p.L)
 
     def density(self, p) -> None:
-        """``rho = rho0 / det F`` and ``h = h0`` on the total-Lagrangian rows."""
-        tl_density(self.rows, self.F, p.rho0, p.h0, p.rho, p.h)
+        """``rho = rho_ref / det F`` and ``h = h0`` on the total-Lagrangian rows."""
+        tl_density(self.rows, self.F, self.rho_ref, p.h0, p.rho, p.h)
 
     def accelerations(self, p, dedt_av) -> None:
         """Overwrite ``p.a`` and ``dedt_av`` rows with the TL stress, viscosity
         and hourglass terms."""
         piola_stress(self.rows, self.F, self.Finv, p.sig, self.P)
-        tl_forces(self.rows, p.x, p.v, p.x0, p.m, p.rho, p.rho0, p.c, p.h0, self.vol,
-                  self.offsets, self.idx, self.gi, self.gj, self.fac, self.hgk, self.P,
-                  self.F, self.dim, self.alpha, self.beta, self.kscale, p.a, dedt_av)
+        tl_forces(self.rows, p.x, p.v, self.X, p.m, p.rho, self.rho_ref, p.c, p.h0,
+                  self.vol, self.offsets, self.idx, self.gi, self.gj, self.fac, self.hgk,
+                  self.P, self.F, self.dim, self.alpha, self.beta, self.kscale, p.a,
+                  dedt_av)
 
     @property
     def mean_neighbours(self) -> float:
