@@ -235,6 +235,23 @@ def test_moving_wall_unit_behaviour():
             assert a[0, 0] > 0.0  # dragged along by the wall
 
 
+def test_wall_velocity_ramp():
+    # ramp_time T: v(t) = u t/T, displacement u t^2/(2T) up to T, then
+    # u (t - T/2); continuous in position and velocity at T.
+    from sphdyn.model import Wall
+    w = Wall("w", np.zeros(3), np.array([0.0, -1.0, 0.0]), 0, 1.0, 0.0, 0.5,
+             np.zeros(1), velocity=np.array([0.0, -2.0, 0.0]), ramp_time=1e-3)
+    assert w.point_at(0.5e-3)[1] == pytest.approx(-2.0 * 0.25e-6 / 2e-3, rel=1e-12)
+    assert w.velocity_at(0.5e-3)[1] == pytest.approx(-1.0, rel=1e-12)
+    eps = 1e-12
+    assert w.point_at(1e-3 - eps)[1] == pytest.approx(w.point_at(1e-3 + eps)[1], rel=1e-6)
+    assert w.point_at(3e-3)[1] == pytest.approx(-2.0 * 2.5e-3, rel=1e-12)
+    assert w.velocity_at(3e-3)[1] == -2.0
+    w0 = Wall("w", np.zeros(3), np.array([0.0, -1.0, 0.0]), 0, 1.0, 0.0, 0.5,
+              np.zeros(1), velocity=np.array([0.0, -2.0, 0.0]))
+    assert w0.point_at(1e-3)[1] == -2e-3 and w0.velocity_at(0.0)[1] == -2.0
+
+
 def test_moving_platen_compresses_a_column_with_its_elastic_stiffness():
     # A 10 mm x 20 mm plane-strain column on a fixed base, a rigid platen
     # coming down at 0.5 m/s (0.01 % of the wave speed). Stress waves of

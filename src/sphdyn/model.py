@@ -44,10 +44,22 @@ class Wall:
     thickness_factor: float
     kbulk: np.ndarray  # (N,) bulk modulus used by the bulk method [Pa]
     velocity: np.ndarray = field(default_factory=lambda: np.zeros(3))  # [m/s]
+    ramp_time: float = 0.0  # [s] linear velocity ramp from rest
+
+    def travel(self, t: float) -> float:
+        """Distance travelled in units of the final velocity [s]:
+        ``t^2 / (2 T)`` during the ramp ``t < T``, ``t - T/2`` after it."""
+        T = self.ramp_time
+        return t * t / (2.0 * T) if t < T else t - 0.5 * T
 
     def point_at(self, t: float) -> np.ndarray:
-        """A point of the wall plane at time ``t`` [s]: point + velocity t."""
-        return self.point + self.velocity * t
+        """A point of the wall plane at time ``t`` [s]: point + velocity travel(t)."""
+        return self.point + self.velocity * self.travel(t)
+
+    def velocity_at(self, t: float) -> np.ndarray:
+        """Wall velocity at time ``t`` [s]: velocity min(t / T, 1)."""
+        T = self.ramp_time
+        return self.velocity * (min(t / T, 1.0) if T > 0.0 else 1.0)
 
 
 @dataclass
@@ -204,7 +216,7 @@ def build_model(deck) -> Model:
             normal=np.asarray(w.normal, float) / np.linalg.norm(w.normal),
             method=STIFFNESS_MASS if w.stiffness == "mass" else STIFFNESS_BULK,
             alpha=w.alpha, friction=w.friction, thickness_factor=w.thickness_factor,
-            kbulk=kbw, velocity=np.asarray(w.velocity, float)))
+            kbulk=kbw, velocity=np.asarray(w.velocity, float), ramp_time=w.ramp_time))
 
     lo_b = particles.x.min(axis=0)
     hi_b = particles.x.max(axis=0)

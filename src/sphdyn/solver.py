@@ -205,7 +205,7 @@ class Solver:
                 self.a_contact))
         for w in self.model.walls:
             cnt = wall_contact(p.x, p.v, p.m, p.vol0, p.rho0, w.kbulk, self.dim,
-                               w.point_at(self.t), w.normal, w.velocity,
+                               w.point_at(self.t), w.normal, w.velocity_at(self.t),
                                w.thickness_factor, w.method, w.alpha, w.friction, dt,
                                self.a_contact, self.wall_force)
             self.wall_counts[w.name] = int(cnt)
@@ -314,7 +314,7 @@ class Solver:
             rec[f"F_wall_{w.name}_t"] = float(np.linalg.norm(f - fn * w.normal))
             rec[f"contacts_{w.name}"] = float(self.wall_counts[w.name])
             if w.velocity.any():
-                rec[f"d_wall_{w.name}"] = float(w.velocity @ w.normal) * self.t
+                rec[f"d_wall_{w.name}"] = float(w.velocity @ w.normal) * w.travel(self.t)
         rec.update(probe_record(self.p, self.model.probes))
         return rec
 
@@ -372,7 +372,7 @@ class Solver:
             self.wall_force[:] = 0.0
             tmp = np.zeros_like(self.a_contact)
             cnt = wall_contact(self.p.x, self.p.v, self.p.m, self.p.vol0, self.p.rho0,
-                               w.kbulk, self.dim, w.point_at(self.t), w.normal, w.velocity,
+                               w.kbulk, self.dim, w.point_at(self.t), w.normal, w.velocity_at(self.t),
                                w.thickness_factor, w.method, w.alpha, w.friction,
                                self.dt_prev or self.dt0, tmp, self.wall_force)
             self.wall_counts[w.name] = int(cnt)

@@ -1068,6 +1068,10 @@ class Wall(Section):
         "platen of a compression test): the plane passes through point + "
         "velocity * t. The history then also records the wall's displacement "
         "along its normal, d_wall_<name>.")
+    ramp_time: quantity(TIME, "ramp time", lo=0) = Field(
+        0.0, description="The wall accelerates linearly from rest to velocity "
+                         "over this time (0 = moves at once); a ramp avoids the "
+                         "impact wave of a platen started at full speed.")
 
     @field_validator("bulk_modulus")
     @classmethod
