@@ -472,3 +472,25 @@ def test_rate_enhanced_damage_thresholds():
               strain=0.002, n_steps=100)
     b = drive("cscm", BASE, "uniaxial-tension", strain=0.002, n_steps=100)
     assert np.array_equal(a["stress"], b["stress"])
+
+
+def test_deck_keys_reach_the_parameters():
+    # [[material]] cap_retraction, rate_thresholds and recovery 10-11 (RECOV
+    # option 2) are packed into the parameter vector of the model.
+    from pathlib import Path
+
+    from sphdyn.deck import DeckError, loads_deck
+    from sphdyn.materials import cscm as mod
+    from sphdyn.model import build_model
+
+    base = (Path(__file__).parent.parent / "examples/disc_impact.toml").read_text()
+    text = base.replace('model = "cscm"', 'model = "cscm"\ncap_retraction = true\n'
+                        'recovery = 10.5\nrate_thresholds = false')
+    g = build_model(loads_deck(text)).groups[0]
+    assert g.params[mod.P_RETRACT] == 1.0
+    assert g.params[mod.P_RECOV] == 0.5 and g.params[mod.P_RECOV_VOL] == 1.0
+    g0 = build_model(loads_deck(base)).groups[0]
+    assert g0.params[mod.P_RETRACT] == 0.0 and g0.params[mod.P_RECOV_VOL] == 0.0
+    assert g.params[mod.P_RATE_R0] == 0.0 and g0.params[mod.P_RATE_R0] == 1.0
+    with pytest.raises(DeckError, match="recovery"):
+        loads_deck(base.replace('model = "cscm"', 'model = "cscm"\nrecovery = 5'))

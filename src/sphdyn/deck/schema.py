@@ -690,9 +690,27 @@ class Cscm(Section):
     erode_strain: real("strain", lo=0) = Field(
         0.05, description="Maximum principal strain for erosion (LS-DYNA "
                           "ERODE - 1).")
-    recovery: real("recovery factor", lo=0, hi=1) = Field(
+    recovery: real("recovery factor", lo=0, hi=11) = Field(
         0.0, description="RECOV: 0 = modulus recovered in compression, 1 = "
-                         "brittle damage kept in compression.")
+                         "brittle damage kept in compression (0-1 between); "
+                         "10-11: the same, switched by the volumetric strain "
+                         "instead of the pressure (LS-DYNA option 2).")
+    cap_retraction: StrictBool = Field(
+        False, description="ITRETRC: the cap may move back towards its initial "
+                           "position (never inside it); see docs/cscm.md.")
+    rate_thresholds: StrictBool = Field(
+        True, description="With rate_effects: the damage thresholds rise with "
+                          "the dynamic strength ratio (docs/cscm.md, choice "
+                          "[D]); false keeps them static.")
+
+    @field_validator("recovery")
+    @classmethod
+    def _recovery_range(cls, r):
+        if 1.0 < r < 10.0:
+            raise problem(f"recovery {r} is neither in [0, 1] nor in [10, 11]",
+                          "give 0-1 (pressure switch) or 10-11 (volumetric "
+                          "strain switch)")
+        return r
     incre: Optional[real("strain increment", lo=0, lo_open=True)] = Field(
         None, description="Maximum strain sub-increment (default a quarter "
                           "of the zero-pressure shear yield strain).")
