@@ -9,6 +9,8 @@ from sphdyn.heterogeneity.cracks import crack_mask, crack_particles, distance_to
 from sphdyn.model import build_model
 from sphdyn.simulation import Simulation
 
+from decks import concrete_disc_2d
+
 DX = 1e-3
 BOX = {"shape": "box", "lo": (-0.04, -0.01, 0.0), "hi": (0.04, 0.01, 0.0)}
 
@@ -156,22 +158,7 @@ def test_disc_with_crack_and_pore_block_is_stable_to_the_end(tmp_path, stiffness
     # particles move with the disc (interpolation points), with both wall
     # stiffness laws (bulk = paper eq. 9; mass = eq. 8, whose m -> 0 limit is
     # an acceleration).
-    text = """
-[run]
-dimension = 2
-t_end = "60 us"
-[[material]]
-name = "concrete"
-model = "cscm"
-density = 2400.0
-fc = "43.1 MPa"
-aggregate_size = "8 mm"
-[[body]]
-name = "disc"
-material = "concrete"
-dx = "2.5 mm"
-velocity = [0, "-15 m/s"]
-geometry = { shape = "cylinder", centre = [0, "50.1 mm"], radius = "50 mm" }
+    cracks = """
 [[body.crack]]
 shape = "polyline"
 points = [["1.25 mm", 0, 0], ["1.25 mm", "60 mm", 0]]
@@ -179,17 +166,9 @@ points = [["1.25 mm", 0, 0], ["1.25 mm", "60 mm", 0]]
 shape = "box"
 lo = ["-30 mm", "45 mm", 0]
 hi = ["-23 mm", "52 mm", 0]
-[[wall]]
-name = "base"
-point = [0, 0]
-normal = [0, 1]
-stiffness = "STIFF"
-[output]
-every = "20 us"
-progress = false
-vtk = false
-fields = ["damage", "mass", "velocity"]
-""".replace("STIFF", stiffness)
+"""
+    text = concrete_disc_2d("2.5 mm", "60 us", "20 us", ["damage", "mass", "velocity"],
+                            body=cracks, stiffness=stiffness)
     sim = Simulation.from_deck(loads_deck(text), tmp_path / stiffness)
     p = sim.solver.p
     zero = p.m == 0

@@ -14,38 +14,15 @@ from sphdyn.io import read_frame
 from sphdyn.io.frames import list_frames
 from sphdyn.simulation import Simulation
 
+from decks import concrete_disc_2d
+
 pytest.importorskip("distributed")
 
 # The paper's disc in 2D at a coarse 5 mm spacing (316 particles, ~300 steps,
 # about a second per sample), random uniform masses on [0, 2] m0.
-TINY = """
-[run]
-dimension = 2
-t_end = "150 us"
-seed = 11
-[[material]]
-name = "concrete"
-model = "cscm"
-density = 2400.0
-fc = "43.1 MPa"
-aggregate_size = "8 mm"
-[[body]]
-name = "disc"
-material = "concrete"
-dx = "5 mm"
-velocity = [0, "-15 m/s"]
-geometry = { shape = "cylinder", centre = [0, "50.1 mm"], radius = "50 mm" }
-mass = { distribution = "uniform", low = 0.0, high = 2.0 }
-[[wall]]
-name = "base"
-point = [0, 0]
-normal = [0, 1]
-[output]
-every = "50 us"
-progress = false
-vtk = false
-fields = ["mass", "damage", "velocity"]
-"""
+TINY = concrete_disc_2d(
+    "5 mm", "150 us", "50 us", ["mass", "damage", "velocity"], seed=11,
+    body='mass = { distribution = "uniform", low = 0.0, high = 2.0 }')
 
 
 @pytest.fixture

@@ -13,6 +13,8 @@ from sphdyn.io.frames import list_frames
 from sphdyn.model import build_model
 from sphdyn.simulation import Simulation
 
+from decks import concrete_disc_2d
+
 LAWS = {
     "uniform": {"distribution": "uniform", "low": 0.0, "high": 2.0},
     "normal": {"distribution": "normal", "mean": 1.0, "std": 0.6},
@@ -27,36 +29,6 @@ ZERO_VARIANCE = [
     {"distribution": "lognormal", "sigma": 0.0},
 ]
 
-DISC = """
-[run]
-dimension = 2
-t_end = "20 us"
-seed = {seed}
-[[material]]
-name = "concrete"
-model = "cscm"
-density = 2400.0
-fc = "43.1 MPa"
-aggregate_size = "8 mm"
-[[body]]
-name = "disc"
-material = "concrete"
-dx = "2.5 mm"
-velocity = [0, "-15 m/s"]
-geometry = {{ shape = "cylinder", centre = [0, "50.1 mm"], radius = "50 mm" }}
-{mass}
-[[wall]]
-name = "base"
-point = [0, 0]
-normal = [0, 1]
-[output]
-every = "10 us"
-progress = false
-vtk = false
-fields = ["mass", "damage", "velocity", "stress"]
-"""
-
-
 def _deck(mass: dict | None = None, seed: int = 0):
     if mass is None:
         table = ""
@@ -64,7 +36,9 @@ def _deck(mass: dict | None = None, seed: int = 0):
         items = ", ".join(f"{k} = {v!r}" if not isinstance(v, str) else f'{k} = "{v}"'
                           for k, v in mass.items())
         table = f"mass = {{ {items} }}"
-    return loads_deck(DISC.format(seed=seed, mass=table))
+    return loads_deck(concrete_disc_2d("2.5 mm", "20 us", "10 us",
+                                       ["mass", "damage", "velocity", "stress"],
+                                       seed=seed, body=table))
 
 
 @pytest.mark.parametrize("law", list(LAWS))
