@@ -88,16 +88,18 @@ def _material_params(mat) -> dict:
     return {k: v for k, v in d.items() if v is not None}
 
 
-def _phase_materials(deck, b: int, body, x: np.ndarray, dim: int):
-    """Material names and phases of a body's particles (([], None) without a
-    mesostructure).
+def _phase_materials(deck, b: int, body, x: np.ndarray, dim: int,
+                     mat_index: dict) -> tuple[np.ndarray, np.ndarray | None]:
+    """Material index (N,) and mesostructure phase (N,) int8 of a body's particles.
 
-    Phases from :func:`sphdyn.heterogeneity.mesostructure.generate_phases`,
-    seeded by ``run.seed`` and the body index.
+    Without ``[body.mesostructure]`` every particle has the body's material
+    and the phase is None. Phases from
+    :func:`sphdyn.heterogeneity.mesostructure.generate_phases`, seeded by
+    ``run.seed`` and the body index.
     """
     ms = body.mesostructure
     if ms is None:
-        return [], None
+        return np.full(x.shape[0], mat_index[body.material], np.int32), None
     seed = int(np.random.SeedSequence([int(deck.run.seed), b, 0x6D65736F]).generate_state(1)[0])
     phases = generate_phases(
         x, body.dx, aggregate_fraction=ms.aggregate_fraction,
@@ -105,9 +107,11 @@ def _phase_materials(deck, b: int, body, x: np.ndarray, dim: int):
         aggregate_shape=ms.shape, octaves=ms.octaves, persistence=ms.persistence,
         lacunarity=ms.lacunarity, seed=seed, dim=dim)
     mortar = ms.mortar or body.material
-    table = {int(MORTAR): mortar, int(AGGREGATE): ms.aggregate or body.material,
-             int(ITZ): ms.itz or mortar}
-    return [table[int(k)] for k in phases], phases
+    table = np.zeros(3, np.int32)  # phase -> material index
+    table[MORTAR] = mat_index[mortar]
+    table[AGGREGATE] = mat_index[ms.aggregate or body.material]
+    table[ITZ] = mat_index[ms.itz or mortar]
+    return table[phases], phases
 
 
 def build_model(deck) -> Model:
@@ -126,6 +130,9 @@ def build_model(deck) -> Model:
             f"({' vs '.join(str(list(h)) for h in sorted(layouts))}): history columns "
             "are stored by position; use materials of one model family per run")
 
+    density_of = np.array([m.density for m in deck.material])
+    wave_speed_of = np.array([models[m.name].wave_speed(params[m.name], m.density)
+                              for m in deck.material])
     parts, phase_parts = [], []
     for b, body in enumerate(deck.body):
         x = lattice_from_shape(body.geometry.model_dump(), body.dx, dim)
@@ -134,7 +141,7 @@ def build_model(deck) -> Model:
             raise ValueError(f"body {body.name!r}: its geometry holds no particle at "
                              f"dx = {body.dx} m; make dx smaller or the shape larger")
         mat = mats[body.material]
-        names, ph = _phase_materials(deck, b, body, x, dim)
+        mat_ids, ph = _phase_materials(deck, b, body, x, dim, mat_index)
         phase_parts.append(np.full(n, -1, np.int8) if ph is None else ph)
         p = Particles.allocate(n, dim, n_hist)
         p.x[:] = x
@@ -142,14 +149,16 @@ def build_model(deck) -> Model:
         p.v[:] = np.asarray(body.velocity, dtype=float)
         vol = body.dx ** dim
         p.vol0[:] = vol
-        p.rho[:] = [mats[nm].density for nm in names] if names else mat.density
+        p.mat[:] = mat_ids
+        p.rho[:] = density_of[mat_ids]
         p.rho0[:] = p.rho
+        p.c[:] = wave_speed_of[mat_ids]
         # numerical heterogeneity (paper sec. 4, 5.2): crack particles get zero
         # mass, the others a random mass field of the homogeneous total
         cracks = [c.model_dump() for c in body.crack]
         solid = ~crack_mask(x, cracks, body.dx, body.name)
         spec = None if body.mass is None else body.mass.model_dump()
-        if names:  # phases of different densities: factors times rho_i dx^d
+        if ph is not None:  # phases of different densities: factors times rho_i dx^d
             factors, _ = mass_field(1.0, spec, solid, body_rng(deck.run.seed, b))
             p.m[:] = factors * p.rho0 * vol
         else:
@@ -158,10 +167,6 @@ def build_model(deck) -> Model:
         p.h[:] = deck.sph.h_factor * body.dx
         p.h0[:] = p.h
         p.body[:] = b
-        for nm in set(names) or {body.material}:
-            sel = slice(None) if not names else np.asarray(names) == nm
-            p.mat[sel] = mat_index[nm]
-            p.c[sel] = models[nm].wave_speed(params[nm], mats[nm].density)
         p.hist_names = list(models[body.material].history_names)
         parts.append(p)
     particles = Particles.concatenate(parts)
