@@ -84,10 +84,10 @@ class Solver:
         self.B = np.zeros((n, 3, 3))
         # artificial stress (Monaghan 2000): R/rho^2 and principal-axis work array
         # (epsilon per particle: a body may set its own, TL bodies need none)
+        tl = total_lagrangian_mask(deck, p.body)
         eps_body = np.array([sph.artificial_stress.epsilon if b.artificial_stress is None
-                             else b.artificial_stress for b in deck.body] or [0.0])
-        self.as_eps = eps_body[p.body] if n else np.zeros(0)
-        self.as_eps[total_lagrangian_mask(deck, p.body)] = 0.0
+                             else b.artificial_stress for b in deck.body])
+        self.as_eps = np.where(tl, 0.0, eps_body[p.body])
         self.as_n = sph.artificial_stress.n
         on = bool(np.any(self.as_eps > 0))
         self.R = np.zeros((n, 3, 3)) if on else None
@@ -121,7 +121,6 @@ class Solver:
         self.skin = sph.neighbours.skin_factor * r0
         # total-Lagrangian bodies: fixed reference neighbours; the updated-
         # Lagrangian list then holds the other particles only
-        tl = total_lagrangian_mask(deck, p.body)
         self.ul_active = ~tl if tl.any() else None
         self.has_ul = not tl.all()  # False: the updated-Lagrangian passes are skipped
         self.tl = None
@@ -198,19 +197,25 @@ class Solver:
         if self.tl is not None:
             self.tl.accelerations(p, self.dedt_av)
         self.a_contact[:] = 0.0
+        self._contact(dt, self.a_contact)
+        p.a += self.a_contact
+
+    def _contact(self, dt, a_out) -> None:
+        """Inter-body and wall contact accelerations added to ``a_out`` (N, 3);
+        updates the contact counts and the wall force totals."""
+        p = self.p
         if self.cnl is not None:
             self.contact_count = int(particle_contact(
                 p.x, p.m, self.size, self.model.bulk_modulus, p.body, self.dim,
                 self.cnl.offsets, self.cnl.idx, self.contact_alpha, self.contact_factor,
-                self.a_contact))
+                a_out))
         for w in self.model.walls:
             cnt = wall_contact(p.x, p.v, p.m, p.vol0, p.rho0, w.kbulk, self.dim,
                                w.point_at(self.t), w.normal, w.velocity_at(self.t),
                                w.thickness_factor, w.method, w.alpha, w.friction, dt,
-                               self.a_contact, self.wall_force)
+                               a_out, self.wall_force)
             self.wall_counts[w.name] = int(cnt)
             self.wall_totals[w.name] = self.wall_force.sum(axis=0)
-        p.a += self.a_contact
 
     def output_fields(self) -> dict:
         """Output fields the solver evaluates on demand, for ``particle_fields``."""
@@ -361,19 +366,7 @@ class Solver:
                 self.tl.rebuild(self.p, arrays["tl_X"].copy(),
                                arrays["tl_rho_ref"].copy())
             self.tl.velocity_gradient(self.p)  # F of the restored state
-        if self.cnl is not None:  # contact count of the restored state
-            self.contact_count = int(particle_contact(
-                self.p.x, self.p.m, self.size, self.model.bulk_modulus, self.p.body,
-                self.dim, self.cnl.offsets, self.cnl.idx, self.contact_alpha,
-                self.contact_factor, np.zeros_like(self.a_contact)))
         self._swegle_step = -1
-        # wall totals at the restored state (forces depend on x, v, dt only)
-        for w in self.model.walls:
-            self.wall_force[:] = 0.0
-            tmp = np.zeros_like(self.a_contact)
-            cnt = wall_contact(self.p.x, self.p.v, self.p.m, self.p.vol0, self.p.rho0,
-                               w.kbulk, self.dim, w.point_at(self.t), w.normal, w.velocity_at(self.t),
-                               w.thickness_factor, w.method, w.alpha, w.friction,
-                               self.dt_prev or self.dt0, tmp, self.wall_force)
-            self.wall_counts[w.name] = int(cnt)
-            self.wall_totals[w.name] = self.wall_force.sum(axis=0)
+        # contact counts and wall totals of the restored state (they depend on
+        # x, v and dt only; the accelerations themselves are in the checkpoint)
+        self._contact(self.dt_prev or self.dt0, np.zeros_like(self.a_contact))
