@@ -6,9 +6,8 @@ import pytest
 from sphdyn import kernels
 from sphdyn.geometry import box_lattice
 from sphdyn.neighbours import build_neighbours
-from sphdyn.sph.total_lagrangian import (corrected_pair_gradients, deformation_gradient,
-                                         hourglass_coefficients, piola_stress,
-                                         reference_gradients, tl_forces)
+from sphdyn.sph.total_lagrangian import (deformation_gradient, hourglass_coefficients,
+                                         piola_stress, reference_gradients, tl_forces)
 
 
 def _body(dim, n_side=8, dx=0.01, jitter=0.0, seed=0):
@@ -24,14 +23,18 @@ def _body(dim, n_side=8, dx=0.01, jitter=0.0, seed=0):
     m = rho0 * dx**dim
     vol = m / rho0
     nl = build_neighbours(X, h0, 2.0, 0.0, dim)
-    g = np.zeros((nl.idx.size, 3))
+    fac = np.zeros(nl.idx.size, dtype=np.float32)
     w = np.zeros(nl.idx.size)
     B0 = np.zeros((n, 3, 3))
-    reference_gradients(X, h0, vol, nl.offsets, nl.idx, kid, sigma, dim, 1.0, g, w, B0)
-    gi, gj, fac = np.zeros_like(g), np.zeros_like(g), np.zeros_like(w)
-    corrected_pair_gradients(X, nl.offsets, nl.idx, g, B0, gi, gj, fac)
-    return dict(X=X, n=n, dim=dim, m=m, rho0=rho0, vol=vol, nl=nl, g=g, w=w, B0=B0,
-                gi=gi, gj=gj, fac=fac)
+    gsum = np.zeros((n, 3))
+    reference_gradients(X, h0, vol, nl.offsets, nl.idx, kid, sigma, dim, 1.0, fac, w, B0, gsum)
+    return dict(X=X, n=n, dim=dim, m=m, rho0=rho0, vol=vol, nl=nl, w=w, B0=B0, fac=fac,
+                gsum=gsum)
+
+
+def _Q(b, P):
+    """V P B per particle, as piola_stress computes it."""
+    return b["vol"][:, None, None] * P @ b["B0"]
 
 
 def _linear_map(dim, seed=1, scale=0.2):
@@ -47,8 +50,8 @@ def _F(b, x, v, with_inverse=False):
     Finv = np.zeros((b["n"], 3, 3))
     L = np.zeros((b["n"], 3, 3))
     nl = b["nl"]
-    deformation_gradient(np.arange(b["n"]), x, v, b["vol"], nl.offsets, nl.idx, b["gi"], b["dim"],
-                         F, Finv, L)
+    deformation_gradient(np.arange(b["n"]), x, v, b["X"], b["vol"], nl.offsets, nl.idx,
+                         b["fac"], b["B0"], b["dim"], F, Finv, L)
     return (F, L, Finv) if with_inverse else (F, L)
 
 
@@ -88,10 +91,14 @@ def test_piola_stress_definition():
     s = rng.normal(size=(4, 3, 3))
     sig = s + s.transpose(0, 2, 1)
     P = np.zeros_like(F)
-    piola_stress(np.arange(4), F, np.linalg.inv(F), sig, P)
+    Q = np.zeros_like(F)
+    vol = rng.uniform(1.0, 2.0, 4)
+    B = np.eye(3) + 0.1 * rng.normal(size=(4, 3, 3))
+    piola_stress(np.arange(4), F, np.linalg.inv(F), sig, vol, B, P, Q)
     for k in range(4):
         ref = np.linalg.det(F[k]) * sig[k] @ np.linalg.inv(F[k]).T
         assert np.allclose(P[k], ref, rtol=1e-12, atol=1e-12)
+        assert np.allclose(Q[k], vol[k] * ref @ B[k], rtol=1e-12, atol=1e-12)
 
 
 def _acc(b, x, P, F, hg=0.0, young=3e10, v=None, av=0.0, heat=None):
@@ -100,12 +107,13 @@ def _acc(b, x, P, F, hg=0.0, young=3e10, v=None, av=0.0, heat=None):
     nl = b["nl"]
     v = np.zeros((n, 3)) if v is None else v
     dedt = np.zeros(n) if heat is None else heat
-    hgk = np.zeros(b["w"].size)
+    hgk = np.zeros(b["w"].size, dtype=np.float32)
     hourglass_coefficients(np.arange(n), b["X"], b["vol"], nl.offsets, nl.idx, b["w"],
                            np.full(n, young), hg, hgk)
     tl_forces(np.arange(n), x, v, b["X"], b["m"], b["rho0"], b["rho0"],
               np.full(n, 3000.0), np.full(n, 1.3 * 0.01), b["vol"], nl.offsets, nl.idx,
-              b["gi"], b["gj"], b["fac"], hgk, P, F, b["dim"], av, av, 1.0, a, dedt)
+              b["fac"], hgk, b["gsum"], P, _Q(b, P), b["B0"], F, b["dim"], av, av, 1.0, a,
+              dedt)
     return a
 
 
@@ -124,7 +132,7 @@ def test_momentum_conserved_with_hourglass_control(dim):
     if dim == 2:
         sig[:, 2, :2] = sig[:, :2, 2] = 0.0
     P = np.zeros_like(F)
-    piola_stress(np.arange(b["n"]), F, Finv, sig, P)
+    piola_stress(np.arange(b["n"]), F, Finv, sig, b["vol"], b["B0"], P, np.zeros_like(P))
     a = _acc(b, x, P, F, hg=20.0)
     total = (b["m"][:, None] * a).sum(axis=0)
     assert np.abs(total).max() < 1e-12 * (b["m"][:, None] * np.abs(a)).sum()
@@ -231,18 +239,18 @@ def test_passes_write_only_their_rows():
     a = np.full((n, 3), 7.0)
     heat = np.full(n, 7.0)
     P = np.ones((n, 3, 3))
-    hgk = np.zeros(b["w"].size)
+    hgk = np.zeros(b["w"].size, dtype=np.float32)
     hourglass_coefficients(np.arange(n), b["X"], b["vol"], nl.offsets, nl.idx, b["w"],
                            np.full(n, 3e10), 20.0, hgk)
     tl_forces(rows, x, v, b["X"], b["m"], b["rho0"], b["rho0"], np.full(n, 3000.0),
-              np.full(n, 0.013), b["vol"], nl.offsets, nl.idx, b["gi"], b["gj"], b["fac"],
-              hgk, P, F, 2, 1.0, 1.0, 1.0, a, heat)
+              np.full(n, 0.013), b["vol"], nl.offsets, nl.idx, b["fac"], hgk, b["gsum"],
+              P, _Q(b, P), b["B0"], F, 2, 1.0, 1.0, 1.0, a, heat)
     odd = np.arange(1, n, 2)
     assert np.all(a[odd] == 7.0) and np.all(heat[odd] == 7.0)
     assert np.all(a[rows] != 7.0)
     L = np.full((n, 3, 3), 7.0)
     Fd = np.full((n, 3, 3), 7.0)
-    deformation_gradient(rows, x, v, b["vol"], nl.offsets, nl.idx, b["gi"], 2,
-                         Fd, np.zeros((n, 3, 3)), L)
+    deformation_gradient(rows, x, v, b["X"], b["vol"], nl.offsets, nl.idx, b["fac"],
+                         b["B0"], 2, Fd, np.zeros((n, 3, 3)), L)
     assert np.all(L[odd] == 7.0) and np.all(Fd[odd] == 7.0)
     assert np.abs(Fd[rows, 2, 2] - 1.0).max() == 0.0

@@ -145,7 +145,11 @@ class Solver:
         if self.contact_on and n:
             self.dt_contact = min(self.dt_contact, 0.5 * contact_time_step(
                 p.m, self.size, model.bulk_modulus, self.dim, c.alpha))
-            cskin = sph.neighbours.skin_factor * c.distance_factor * float(self.size.max())
+            # the same absolute skin as the SPH list (or larger): a skin scaled
+            # with the short contact radius alone forced a rebuild every few
+            # steps in the rings benchmark (0.125 mm at 15 m/s closing speed)
+            cskin = sph.neighbours.skin_factor * max(
+                r0, c.distance_factor * float(self.size.max()))
             self.cnl = build_neighbours(p.x, self.size, c.distance_factor, cskin, self.dim)
         self.t = 0.0
         self.step_count = 0

@@ -12,9 +12,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..neighbours import build_neighbours
-from .total_lagrangian import (corrected_pair_gradients, deformation_gradient,
-                               hourglass_coefficients, piola_stress, reference_gradients,
-                               tl_density, tl_forces)
+from .total_lagrangian import (deformation_gradient, hourglass_coefficients, piola_stress,
+                               reference_gradients, tl_density, tl_forces)
 
 
 def same_body_pairs(offsets: np.ndarray, idx: np.ndarray, body: np.ndarray):
@@ -77,20 +76,17 @@ class TotalLagrangian:
         self.offsets, self.idx = same_body_pairs(full.offsets, full.idx, p.body)
         self.vol = np.divide(p.m, rho_ref, out=np.zeros(n), where=rho_ref > 0)
         nnz = self.idx.size
-        g = np.zeros((nnz, 3))
+        self.fac = np.zeros(nnz, dtype=np.float32)
         w = np.zeros(nnz)
         self.B0 = np.zeros((n, 3, 3))
+        self.gsum = np.zeros((n, 3))
         reference_gradients(X, p.h0, self.vol, self.offsets, self.idx, self.kid,
-                            self.sigma, dim, self.kscale, g, w, self.B0)
-        self.gi = np.zeros((nnz, 3))
-        self.gj = np.zeros((nnz, 3))
-        self.fac = np.zeros(nnz)
-        corrected_pair_gradients(X, self.offsets, self.idx, g, self.B0, self.gi,
-                                 self.gj, self.fac)
+                            self.sigma, dim, self.kscale, self.fac, w, self.B0, self.gsum)
         self.F = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
         self.Finv = self.F.copy()
         self.P = np.zeros((n, 3, 3))
-        self.hgk = np.zeros(nnz)
+        self.Q = np.zeros((n, 3, 3))
+        self.hgk = np.zeros(nnz, dtype=np.float32)
         hourglass_coefficients(self.rows, X, self.vol, self.offsets, self.idx, w,
                                self.young, self.hourglass, self.hgk)
 
@@ -108,8 +104,8 @@ class TotalLagrangian:
 
     def velocity_gradient(self, p) -> None:
         """Fill ``p.L`` (and ``F``) of the total-Lagrangian rows."""
-        deformation_gradient(self.rows, p.x, p.v, self.vol, self.offsets, self.idx,
-                             self.gi, self.dim, self.F, self.Finv, p.L)
+        deformation_gradient(self.rows, p.x, p.v, self.X, self.vol, self.offsets,
+                             self.idx, self.fac, self.B0, self.dim, self.F, self.Finv, p.L)
 
     def density(self, p) -> None:
         """``rho = rho_ref / det F`` and ``h = h0`` on the total-Lagrangian rows."""
@@ -118,11 +114,11 @@ class TotalLagrangian:
     def accelerations(self, p, dedt_av) -> None:
         """Overwrite ``p.a`` and ``dedt_av`` rows with the TL stress, viscosity
         and hourglass terms."""
-        piola_stress(self.rows, self.F, self.Finv, p.sig, self.P)
+        piola_stress(self.rows, self.F, self.Finv, p.sig, self.vol, self.B0, self.P, self.Q)
         tl_forces(self.rows, p.x, p.v, self.X, p.m, p.rho, self.rho_ref, p.c, p.h0,
-                  self.vol, self.offsets, self.idx, self.gi, self.gj, self.fac, self.hgk,
-                  self.P, self.F, self.dim, self.alpha, self.beta, self.kscale, p.a,
-                  dedt_av)
+                  self.vol, self.offsets, self.idx, self.fac, self.hgk, self.gsum, self.P,
+                  self.Q, self.B0, self.F, self.dim, self.alpha, self.beta, self.kscale,
+                  p.a, dedt_av)
 
     @property
     def mean_neighbours(self) -> float:
