@@ -110,7 +110,8 @@ def test_momentum_conserved_to_round_off(dim, n_exp):
     a = np.zeros((n, 3))
     nl = c["nl"]
     artificial_stress_forces(c["x"], c["m"], c["h"], R, c["F"], nl.offsets, nl.idx,
-                             c["kid"], dim, 1.0, c["spacing"], n_exp, a)
+                             c["kid"], dim, 1.0, c["spacing"], n_exp, a, np.zeros((n, 3)),
+                             np.zeros(n))
     p = c["m"][:, None] * a
     scale = np.abs(p).sum()
     assert scale > 0.0
@@ -135,7 +136,8 @@ def test_pair_force_is_repulsive_with_the_stated_magnitude():
     idx = np.array([1, 0])
     a = np.zeros((2, 3))
     artificial_stress_forces(x, np.full(2, m), np.full(2, h), R, np.full(2, Fij), offsets,
-                             idx, kid, dim, 1.0, np.full(2, dx), 4.0, a)
+                             idx, kid, dim, 1.0, np.full(2, dx), 4.0, a, np.zeros((2, 3)),
+                             np.zeros(2))
     expect = m * 2 * (-EPS * s / RHO**2) * Fij * dx
     assert expect > 0.0
     assert a[0, 0] == pytest.approx(expect, rel=1e-13)
@@ -146,7 +148,8 @@ def test_pair_force_is_repulsive_with_the_stated_magnitude():
     f = kernels.w(kid, 0.5 * dx / h) / kernels.w(kid, dx / h)
     a[:] = 0.0
     artificial_stress_forces(x, np.full(2, m), np.full(2, h), R, np.full(2, Fh), offsets,
-                             idx, kid, dim, 1.0, np.full(2, dx), 4.0, a)
+                             idx, kid, dim, 1.0, np.full(2, dx), 4.0, a, np.zeros((2, 3)),
+                             np.zeros(2))
     assert a[0, 0] == pytest.approx(m * 2 * (-EPS * s / RHO**2) * f**4 * Fh * 0.5 * dx,
                                     rel=1e-13)
 

@@ -157,6 +157,7 @@ def test_artificial_stress_keeps_rings_intact_and_they_bounce():
     # -5.58 m/s = -0.74 V0 (restitution 0.74; the rest of the kinetic energy
     # stays in ring vibration). Threshold: rebound faster than 0.6 V0.
     s = _rings(0.3)
+    e0 = s.energies(0.5 * float((s.p.m[:, None] * s.p.v**2).sum()), 0.0)["E_total"]
     t_check = [2e-3, 4e-3, 6e-3, 8e-3, 10.5e-3]
     for t in t_check:
         _run(s, t)
@@ -166,6 +167,11 @@ def test_artificial_stress_keeps_rings_intact_and_they_bounce():
     v2 = _left_velocity(s)
     assert v1 < -0.6 * V0
     assert abs(v2 - v1) < 1e-3 * V0  # rings apart: momentum of each ring constant
+    # the artificial-stress work is booked as heat, so the energy closes
+    # (measured -0.06 % over 11 ms; -2.5 % before it was booked); 1.5 % as
+    # for the total-Lagrangian rings
+    rec = s.energies(0.5 * float((s.p.m[:, None] * s.p.v**2).sum()), 0.0)
+    assert abs(rec["E_total"] - e0) < 0.015 * e0
     # separated by more than the support radius 2 h
     xl = s.p.x[s.p.body == 0, 0].max()
     xr = s.p.x[s.p.body == 1, 0].min()

@@ -197,7 +197,7 @@ class Solver:
             artificial_stress_tensor(p.sig, p.rho, self.as_eps, self.R, self.Q)
             artificial_stress_forces(p.x, p.m, p.h, self.R, self.F, nl.offsets, nl.idx,
                                      self.kid, self.dim, self.kscale, self.spacing,
-                                     self.as_n, p.a)
+                                     self.as_n, p.a, p.v, self.dedt_av)
         if self.tl is not None:
             self.tl.accelerations(p, self.dedt_av)
         self.a_contact[:] = 0.0

@@ -138,7 +138,7 @@ def artificial_stress_tensor(sig, rho, eps, R, Q):
 
 @njit(cache=True, parallel=True)
 def artificial_stress_forces(x, m, h, R, F, offsets, idx, kid, dim, kscale, spacing,
-                             n_exp, a):
+                             n_exp, a, v, dedt):
     r"""Add the artificial-stress acceleration to ``a`` (gather form).
 
     .. math::
@@ -164,6 +164,12 @@ def artificial_stress_forces(x, m, h, R, F, offsets, idx, kid, dim, kscale, spac
     spacing : (N,) initial particle spacing vol0**(1/dim) [m].
     n_exp : float, exponent n (4 in Gray et al.).
     a : (N, 3) in/out, acceleration [m/s^2].
+    v : (N, 3) velocities [m/s].
+    dedt : (N,) in/out, heating rate [W/kg]: :math:`-\mathbf a^{AS}_i\cdot
+        \mathbf v_i` is added, so that the work of the artificial stress is
+        booked with the viscous and hourglass heat and the energy balance
+        closes (:math:`\sum_i m_i \dot e_i = -\sum_i m_i \mathbf a^{AS}_i
+        \cdot\mathbf v_i`, the power of these forces).
     """
     n = x.shape[0]
     three = dim == 3
@@ -225,3 +231,4 @@ def artificial_stress_forces(x, m, h, R, F, offsets, idx, kid, dim, kscale, spac
         a[i, 0] += a0
         a[i, 1] += a1
         a[i, 2] += a2
+        dedt[i] -= a0 * v[i, 0] + a1 * v[i, 1] + a2 * v[i, 2]
