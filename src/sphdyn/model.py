@@ -16,6 +16,7 @@ from .geometry import lattice_from_shape, select
 from .heterogeneity.cracks import crack_mask
 from .heterogeneity.mass import body_rng, mass_field
 from .heterogeneity.mesostructure import AGGREGATE, ITZ, MORTAR, generate_phases
+from .heterogeneity.photo import photo_targets
 from .materials import get_model
 from .probes import Probe, quantity
 from .state import BC_FIXED, BC_VELOCITY, Particles
@@ -95,15 +96,22 @@ def _phase_materials(deck, b: int, body, x: np.ndarray, dim: int,
     Without ``[body.mesostructure]`` every particle has the body's material
     and the phase is None. Phases from
     :func:`sphdyn.heterogeneity.mesostructure.generate_phases`, seeded by
-    ``run.seed`` and the body index.
+    ``run.seed`` and the body index; with ``photo`` the fraction and D_max
+    come from :func:`sphdyn.heterogeneity.photo.photo_targets`.
     """
     ms = body.mesostructure
     if ms is None:
         return np.full(x.shape[0], mat_index[body.material], np.int32), None
     seed = int(np.random.SeedSequence([int(deck.run.seed), b, 0x6D65736F]).generate_state(1)[0])
+    fraction, dmax = ms.aggregate_fraction, ms.max_aggregate_size
+    if ms.photo is not None:
+        t = photo_targets(ms.photo, pixel_size=ms.pixel_size, dx=body.dx, dim=dim,
+                          aggregate=ms.photo_aggregate, itz_thickness=ms.itz_thickness,
+                          aggregate_shape=ms.shape, seed=seed)
+        fraction, dmax = t.aggregate_fraction, t.max_aggregate_size
     phases = generate_phases(
-        x, body.dx, aggregate_fraction=ms.aggregate_fraction,
-        max_aggregate_size=ms.max_aggregate_size, itz_thickness=ms.itz_thickness,
+        x, body.dx, aggregate_fraction=fraction,
+        max_aggregate_size=dmax, itz_thickness=ms.itz_thickness,
         aggregate_shape=ms.shape, octaves=ms.octaves, persistence=ms.persistence,
         lacunarity=ms.lacunarity, seed=seed, dim=dim)
     mortar = ms.mortar or body.material

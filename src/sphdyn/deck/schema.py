@@ -868,12 +868,27 @@ class Mesostructure(Section):
     the body's index, so ensembles vary it through run.seed.
     """
 
-    aggregate_fraction: real("volume fraction", lo=0, hi=1, lo_open=True,
-                             hi_open=True) = Field(
-        description="Target aggregate volume fraction (hit on the particles "
-                    "to within one voxel).")
-    max_aggregate_size: PositiveLength = Field(
-        description="Largest aggregate (equivalent diameter).")
+    aggregate_fraction: Optional[real("volume fraction", lo=0, hi=1, lo_open=True,
+                                      hi_open=True)] = Field(
+        None, description="Target aggregate volume fraction (hit on the "
+                          "particles to within one voxel). Required unless "
+                          "photo is given (then measured from the photo).")
+    max_aggregate_size: Optional[PositiveLength] = Field(
+        None, description="Largest aggregate (equivalent diameter). Required "
+                          "unless photo is given (then fitted to the photo).")
+    photo: Optional[ExistingFile] = Field(
+        None, description="Image of a concrete section (PNG, JPEG; relative "
+                          "to the deck) from which aggregate_fraction and "
+                          "max_aggregate_size are measured: Otsu segmentation, "
+                          "area fraction = volume fraction, D_max fitted so "
+                          "that sections of the generated structure have the "
+                          "photo's 95th-percentile piece size "
+                          "(docs/mesostructure.md).")
+    pixel_size: Optional[PositiveLength] = Field(
+        None, description="Size of one photo pixel (required with photo).")
+    photo_aggregate: Literal["bright", "dark"] = Field(
+        "bright", description="Whether aggregate is the bright or the dark "
+                              "class of the photo.")
     itz_thickness: quantity(LENGTH, "thickness", lo=0) = Field(
         0.0, description="Thickness of the ITZ band around aggregate (0 = no "
                          "ITZ; at least about one particle spacing to be "
@@ -893,6 +908,30 @@ class Mesostructure(Section):
         None, description="Material of the aggregate (default: the body's).")
     itz: Optional[reference_to("material")] = Field(
         None, description="Material of the ITZ (default: the mortar's).")
+
+    @model_validator(mode="after")
+    def _photo_or_targets(self):
+        targets = [k for k in ("aggregate_fraction", "max_aggregate_size")
+                   if getattr(self, k) is not None]
+        if self.photo is not None:
+            if self.pixel_size is None:
+                raise problem("photo is given without pixel_size",
+                              "add pixel_size = \"0.1 mm\" (the size of one pixel)")
+            if targets:
+                raise problem(f"{' and '.join(targets)} given together with photo",
+                              "give either photo (the targets are measured from "
+                              "it) or aggregate_fraction and max_aggregate_size")
+            return self
+        if self.pixel_size is not None:
+            raise problem("pixel_size is given without photo",
+                          "add photo = \"section.png\" or remove pixel_size")
+        missing = [k for k in ("aggregate_fraction", "max_aggregate_size")
+                   if getattr(self, k) is None]
+        if missing:
+            raise problem(f"{' and '.join(missing)} missing",
+                          "give aggregate_fraction and max_aggregate_size, or "
+                          "photo and pixel_size")
+        return self
 
 
 class MassField(Section):

@@ -43,7 +43,8 @@ from sphdyn.heterogeneity.mesostructure import (AGGREGATE,
 
 __all__ = ["read_grey", "otsu_threshold", "segment_aggregate",
            "SectionStatistics", "section_statistics", "PhotoStructure",
-           "structure_from_photo", "save_photo_comparison"]
+           "structure_from_photo", "save_photo_comparison", "PhotoTargets",
+           "photo_targets"]
 
 
 def read_grey(path) -> np.ndarray:
@@ -228,6 +229,59 @@ def structure_from_photo(image, *, pixel_size: float, grid_shape, dx: float,
         dmax *= target / got
     return PhotoStructure(phases, dx, float(dmax), photo,
                           SectionStatistics(float(fr.mean()), ds), fr)
+
+
+@dataclass(frozen=True)
+class PhotoTargets:
+    """Generator targets measured from a photo (:func:`photo_targets`)."""
+
+    aggregate_fraction: float         #: volume (3D) or area (2D) fraction
+    max_aggregate_size: float         #: D_max, m
+    photo: SectionStatistics          #: of the segmented photo
+    sections: SectionStatistics | None  #: of the fitted 3D grid's sections
+
+    def summary(self) -> str:
+        text = (f"photo: {self.photo.summary()}; generator: aggregate_fraction "
+                f"{self.aggregate_fraction:.4f}, max_aggregate_size "
+                f"{self.max_aggregate_size:.4g} m")
+        if self.sections is not None:
+            text += f"; sections of the fitted structure: {self.sections.summary()}"
+        return text
+
+
+def photo_targets(image, *, pixel_size: float, dx: float, dim: int,
+                  aggregate: str = "bright", itz_thickness: float = 0.0,
+                  aggregate_shape: str = "rounded", seed: int = 0,
+                  **generator) -> PhotoTargets:
+    """``aggregate_fraction`` and ``max_aggregate_size`` for the generator from a photo.
+
+    2D models are sections themselves: the fraction is the photo's area
+    fraction and D_max its 95th-percentile equivalent diameter. 3D: the
+    fraction is the area fraction (Delesse) and D_max comes from the
+    fixed point of :func:`structure_from_photo` on a cube of
+    ``clip(6 D_max0 / dx, 32, 80)`` voxels of size ``dx`` (D_max0 = 4/pi
+    d95), a few seconds. ``image`` a path or a grey array in [0, 1];
+    ``pixel_size`` and ``dx`` in m.
+    """
+    grey = read_grey(image) if isinstance(image, (str, Path)) else \
+        np.asarray(image, dtype=np.float64)
+    if dim == 2:
+        mask = segment_aggregate(grey, aggregate=aggregate)
+        photo = section_statistics(mask, pixel_size, 20)
+        if photo.diameters.size == 0:
+            raise ValueError("no aggregate found in the photo: check "
+                             "photo_aggregate (bright/dark)")
+        return PhotoTargets(photo.area_fraction, photo.percentile(95), photo, None)
+    first = section_statistics(segment_aggregate(grey, aggregate=aggregate),
+                               pixel_size, 20)
+    d0 = 4.0 / np.pi * first.percentile(95) if first.diameters.size else 10 * dx
+    n = int(np.clip(np.ceil(6.0 * d0 / dx), 32, 80))
+    res = structure_from_photo(grey, pixel_size=pixel_size, grid_shape=(n, n, n),
+                               dx=dx, itz_thickness=itz_thickness,
+                               aggregate_shape=aggregate_shape, seed=seed,
+                               aggregate=aggregate, **generator)
+    return PhotoTargets(res.photo.area_fraction, res.max_aggregate_size, res.photo,
+                        res.sections)
 
 
 def save_photo_comparison(result: PhotoStructure, grey, mask, path) -> Path:
