@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from .io.atomic import atomic_path
+from .io.plots import save_figure
 from .io import list_frames, read_frame
 from .io.history import read_history_csv
 
@@ -163,6 +164,5 @@ def ensemble_report(sample_dirs, wall: str, out, homogeneous=None) -> dict:
     ax.set_ylim(bottom=0)
     ax.grid(alpha=0.3)
     ax.legend(loc="lower right", fontsize=8)
-    with atomic_path(out / "ucs_curves.png") as tmp:
-        fig.savefig(tmp, format="png", dpi=120)
+    save_figure(fig, out / "ucs_curves.png", 120)
     return stats

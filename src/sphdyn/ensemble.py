@@ -52,7 +52,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .io.atomic import atomic_path, atomic_write_text
+from .io.atomic import atomic_write_text
+from .io.plots import save_figure
 
 __all__ = ["COLUMNS", "SampleSpec", "count_main_cracks", "parse_vary", "plan_samples",
            "plot_damage_grid", "run_ensemble", "run_sample", "sample_metrics",
@@ -153,8 +154,6 @@ def plan_samples(deck: str | Path, samples: int, vary=(), out: str | Path = "out
     ``base_seed`` defaults to the deck's ``run.seed`` (after ``overrides``).
     Sample indices run over the grid points (outer) and replicates (inner).
     """
-    from .deck import load_deck
-
     if samples < 1:
         raise ValueError(f"--samples {samples}: give at least 1 sample")
     deck = Path(deck).resolve()
@@ -593,6 +592,4 @@ def plot_damage_grid(out: str | Path, recs: list[dict] | None = None,
         return None
     fig.tight_layout()
     path = Path(path) if path else out / FIGURE
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png")
-    return path
+    return save_figure(fig, path)

@@ -470,6 +470,8 @@ def save_phase_slices(phases, path, dx: float, *, x=None, index=None,
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from sphdyn.io.plots import save_figure
+
     phases = np.asarray(phases)
     mask = None
     if x is not None:
@@ -502,8 +504,4 @@ def save_phase_slices(phases, path, dx: float, *, x=None, index=None,
     if title:
         fig.suptitle(title, fontsize=10)
     fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, 90)

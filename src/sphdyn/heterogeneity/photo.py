@@ -291,6 +291,8 @@ def save_photo_comparison(result: PhotoStructure, grey, mask, path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from sphdyn.io.plots import save_figure
+
     from sphdyn.heterogeneity.mesostructure import _rgb
 
     fig, ax = plt.subplots(1, 4, figsize=(14, 4.0))
@@ -315,8 +317,4 @@ def save_photo_comparison(result: PhotoStructure, grey, mask, path) -> Path:
     ax[3].legend(fontsize=8)
     ax[3].tick_params(labelsize=7)
     fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=70)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, 70)

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.atomic import atomic_path
+from ..io.plots import save_figure
 
 __all__ = ["plot_mass_histogram"]
 
@@ -49,8 +49,4 @@ def plot_mass_histogram(masses, path, bins: int = 40, law=None, scale: float = 1
         ax.set_title(title, fontsize=9)
     ax.legend(fontsize=8, frameon=False)
     fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png")
-    return path
+    return save_figure(fig, path)

@@ -15,7 +15,7 @@ import numpy as np
 from .atomic import atomic_path
 from .history import read_history_csv
 
-__all__ = ["plot_history", "ENERGY_COLUMNS"]
+__all__ = ["plot_history", "save_figure", "ENERGY_COLUMNS"]
 
 #: Energy columns plotted first, in this order, when present. Any other
 #: column starting with ``E_`` or ``W_`` is added after them.
@@ -33,9 +33,19 @@ def _figure(nrows: int = 1, height: float = 4.0):
     return fig, axes
 
 
-def _save(fig, path: Path) -> Path:
+def save_figure(fig, path, dpi: float | None = None) -> Path:
+    """Write ``fig`` as a PNG at ``path`` atomically, creating the folder, and
+    release it (pyplot-managed figures are closed). Every figure of sphdyn is
+    saved through here."""
+    import sys
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=120)
+        fig.savefig(tmp, format="png", dpi=dpi)
+    pyplot = sys.modules.get("matplotlib.pyplot")
+    if pyplot is not None:  # no-op for figures pyplot does not manage
+        pyplot.close(fig)
     return path
 
 
@@ -110,7 +120,7 @@ def plot_history(csv_path: str | os.PathLike,
             axes[1].legend(loc="best")
             axes[1].grid(True, alpha=0.3)
         axes[-1].set_xlabel("time [s]")
-        written.append(_save(fig, out_dir / "energies.png"))
+        written.append(save_figure(fig, out_dir / "energies.png", 120))
 
     force_cols = [c for c in columns if c.startswith("F_")]
     if time is not None and force_cols:
@@ -122,7 +132,7 @@ def plot_history(csv_path: str | os.PathLike,
         ax.set_title(f"Forces ({title})")
         ax.legend(loc="best")
         ax.grid(True, alpha=0.3)
-        written.append(_save(fig, out_dir / "forces.png"))
+        written.append(save_figure(fig, out_dir / "forces.png", 120))
 
     xkey = "step" if "step" in data else "time" if time is not None else None
     if "dt" in data and xkey is not None:
@@ -133,5 +143,5 @@ def plot_history(csv_path: str | os.PathLike,
         ax.set_title(f"Time step ({title})")
         ax.legend(loc="best")
         ax.grid(True, alpha=0.3)
-        written.append(_save(fig, out_dir / "dt.png"))
+        written.append(save_figure(fig, out_dir / "dt.png", 120))
     return written

@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .atomic import atomic_path
+from .plots import save_figure
 from .frames import list_frames
 from .hdf5 import read_frame, read_frame_header
 
@@ -492,6 +492,4 @@ def plot_snapshots(outdir, field: str = "von_mises",
     fig.suptitle(heading, fontsize=11)
 
     dest = Path(out) if out is not None else runs[0] / "plots" / f"snapshots_{field}.png"
-    with atomic_path(dest) as tmp:
-        fig.savefig(tmp, format="png", dpi=dpi)
-    return dest
+    return save_figure(fig, dest, dpi)

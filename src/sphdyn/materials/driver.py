@@ -285,6 +285,7 @@ def write_outputs(res: dict, out) -> list[Path]:
     """Write ``<model>_<path>.csv`` (SI; history columns prefixed ``hist_``)
     and ``.png`` into ``out``, each atomically (:mod:`sphdyn.io.atomic`)."""
     from ..io.atomic import atomic_path
+    from ..io.plots import save_figure
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -319,7 +320,5 @@ def write_outputs(res: dict, out) -> list[Path]:
     fig.suptitle(f"{res['model']}: {res['path']}")
     fig.tight_layout()
     png = out / f"{stem}.png"
-    with atomic_path(png) as tmp:
-        fig.savefig(tmp, format="png", dpi=110)
-    plt.close(fig)
+    save_figure(fig, png, 110)
     return [csv_path, png]
