@@ -12,7 +12,7 @@ import pytest
 from sphdyn.heterogeneity.photo import (otsu_threshold, read_grey,
                                         save_photo_comparison,
                                         section_statistics, segment_aggregate,
-                                        structure_from_photo)
+                                        photo_targets, structure_from_photo)
 
 _spec = importlib.util.spec_from_file_location(
     "make_section_image",
@@ -110,3 +110,20 @@ def test_structure_from_photo_matches_sections(tmp_path, section):
                                 tmp_path / "cmp.png")
     assert out.read_bytes()[:4] == b"\x89PNG"
     assert "photo" in res.summary() and "generated" in res.summary()
+
+
+def test_photo_targets_for_the_generator(section):
+    # What a deck's `photo` key feeds the generator. 2D: the photo's own
+    # area fraction and d95. 3D: the area fraction (Delesse) and the D_max of
+    # the section fit on the default cube, whose sections match the photo's
+    # d95 to the fit's 8 % (as above) while D_max exceeds it (section effect).
+    grey, _ = section
+    t2 = photo_targets(grey, pixel_size=PIX, dx=2 * PIX, dim=2)
+    assert t2.aggregate_fraction == t2.photo.area_fraction
+    assert t2.max_aggregate_size == t2.photo.percentile(95)
+    t3 = photo_targets(grey, pixel_size=PIX, dx=2 * PIX, dim=3, itz_thickness=2 * PIX,
+                       seed=1)
+    assert t3.aggregate_fraction == t3.photo.area_fraction
+    assert t3.sections.percentile(95) == pytest.approx(t3.photo.percentile(95), rel=0.08)
+    assert t3.max_aggregate_size > t3.photo.percentile(95)
+    assert "generator: aggregate_fraction" in t3.summary()

@@ -137,13 +137,8 @@ def cmd_mesostructure(args) -> int:
                                 body.dx, x=p.x[sel],
                                 title=f"{body.name}: seed {deck.run.seed}")
         print(f"{body.name}: {st.summary()}")
-        ms = body.mesostructure
-        if ms.photo is not None:  # the photo's statistics next to the generated ones
-            from .heterogeneity.photo import photo_targets
-            t = photo_targets(ms.photo, pixel_size=ms.pixel_size, dx=body.dx,
-                              dim=deck.run.dimension, aggregate=ms.photo_aggregate,
-                              itz_thickness=ms.itz_thickness, aggregate_shape=ms.shape)
-            print(f"{body.name}: {t.summary()}")
+        if body.name in model.photo_targets:  # the photo's statistics next to them
+            print(f"{body.name}: {model.photo_targets[body.name].summary()}")
         print(png)
         shown += 1
     if not shown:

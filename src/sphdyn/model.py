@@ -80,6 +80,8 @@ class Model:
     #: (N,) int8 mesostructure phase (0 mortar, 1 aggregate, 2 ITZ; -1 for
     #: bodies without [body.mesostructure])
     phase: np.ndarray = field(repr=False, default=None)
+    #: body name -> PhotoTargets of bodies whose mesostructure comes from a photo
+    photo_targets: dict = field(default_factory=dict)
 
 
 def _material_params(mat) -> dict:
@@ -89,15 +91,16 @@ def _material_params(mat) -> dict:
     return {k: v for k, v in d.items() if v is not None}
 
 
-def _phase_materials(deck, b: int, body, x: np.ndarray, dim: int,
-                     mat_index: dict) -> tuple[np.ndarray, np.ndarray | None]:
+def _phase_materials(deck, b: int, body, x: np.ndarray, dim: int, mat_index: dict,
+                     photos: dict) -> tuple[np.ndarray, np.ndarray | None]:
     """Material index (N,) and mesostructure phase (N,) int8 of a body's particles.
 
     Without ``[body.mesostructure]`` every particle has the body's material
     and the phase is None. Phases from
     :func:`sphdyn.heterogeneity.mesostructure.generate_phases`, seeded by
     ``run.seed`` and the body index; with ``photo`` the fraction and D_max
-    come from :func:`sphdyn.heterogeneity.photo.photo_targets`.
+    come from :func:`sphdyn.heterogeneity.photo.photo_targets`, which are
+    also stored in ``photos[body.name]`` (for the report).
     """
     ms = body.mesostructure
     if ms is None:
@@ -109,6 +112,7 @@ def _phase_materials(deck, b: int, body, x: np.ndarray, dim: int,
                           aggregate=ms.photo_aggregate, itz_thickness=ms.itz_thickness,
                           aggregate_shape=ms.shape, seed=seed)
         fraction, dmax = t.aggregate_fraction, t.max_aggregate_size
+        photos[body.name] = t
     phases = generate_phases(
         x, body.dx, aggregate_fraction=fraction,
         max_aggregate_size=dmax, itz_thickness=ms.itz_thickness,
@@ -142,6 +146,7 @@ def build_model(deck) -> Model:
     wave_speed_of = np.array([models[m.name].wave_speed(params[m.name], m.density)
                               for m in deck.material])
     parts, phase_parts = [], []
+    photos = {}
     for b, body in enumerate(deck.body):
         x = lattice_from_shape(body.geometry.model_dump(), body.dx, dim)
         n = x.shape[0]
@@ -149,7 +154,7 @@ def build_model(deck) -> Model:
             raise ValueError(f"body {body.name!r}: its geometry holds no particle at "
                              f"dx = {body.dx} m; make dx smaller or the shape larger")
         mat = mats[body.material]
-        mat_ids, ph = _phase_materials(deck, b, body, x, dim, mat_index)
+        mat_ids, ph = _phase_materials(deck, b, body, x, dim, mat_index, photos)
         phase_parts.append(np.full(n, -1, np.int8) if ph is None else ph)
         p = Particles.allocate(n, dim, n_hist)
         p.x[:] = x
@@ -246,4 +251,5 @@ def build_model(deck) -> Model:
         body_names=[b.name for b in deck.body], domain_lo=lo, domain_hi=hi,
         kernel_id=kid, kernel_sigma=kernels.normalisation(kid, dim),
         radius_factor=kernels.support(kid) * deck.sph.support_scale,
-        bulk_modulus=kb, probes=probes, phase=np.concatenate(phase_parts))
+        bulk_modulus=kb, probes=probes, phase=np.concatenate(phase_parts),
+        photo_targets=photos)

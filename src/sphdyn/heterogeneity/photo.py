@@ -177,7 +177,7 @@ def _section_stats(phases, dx, min_area):
     return np.array(fr), np.concatenate(ds)
 
 
-def structure_from_photo(image, *, pixel_size: float, grid_shape, dx: float,
+def structure_from_photo(image, *, pixel_size: float, grid_shape=None, dx: float,
                          itz_thickness: float = 0.0,
                          aggregate_shape: str = "crushed", seed: int = 0,
                          aggregate: str = "bright", radius: int = 1,
@@ -188,7 +188,9 @@ def structure_from_photo(image, *, pixel_size: float, grid_shape, dx: float,
     """3D phase grid whose sections match a photo (module doc, steps 1-5).
 
     ``image``: a path or a 2D grey array in [0, 1]; ``pixel_size`` m per
-    pixel; ``grid_shape`` (nx, ny, nz) and ``dx`` (m) of the generated grid.
+    pixel; ``grid_shape`` (nx, ny, nz) and ``dx`` (m) of the generated grid
+    (``grid_shape`` None: a cube of ``clip(6 D0 / dx, 32, 80)`` voxels,
+    D0 = 4/pi d95 of the photo, enough for a few of the largest pieces).
     Segmentation arguments as :func:`segment_aggregate`; ``iterations`` of
     the D_max fixed point. ``fuller_exponent`` q: use the Fuller grading
     (:func:`~sphdyn.heterogeneity.mesostructure.fuller_grading`) from D_max
@@ -209,6 +211,9 @@ def structure_from_photo(image, *, pixel_size: float, grid_shape, dx: float,
                          "(bright/dark) and min_area")
     target = photo.percentile(95)
     dmax = 4.0 / np.pi * target
+    if grid_shape is None:
+        n = int(np.clip(np.ceil(6.0 * dmax / dx), 32, 80))
+        grid_shape = (n, n, n)
     for _ in range(max(int(iterations), 1)):
         dmax = max(dmax, 2.0 * dx)
         if fuller_exponent is not None:
@@ -258,10 +263,9 @@ def photo_targets(image, *, pixel_size: float, dx: float, dim: int,
     2D models are sections themselves: the fraction is the photo's area
     fraction and D_max its 95th-percentile equivalent diameter. 3D: the
     fraction is the area fraction (Delesse) and D_max comes from the
-    fixed point of :func:`structure_from_photo` on a cube of
-    ``clip(6 D_max0 / dx, 32, 80)`` voxels of size ``dx`` (D_max0 = 4/pi
-    d95), a few seconds. ``image`` a path or a grey array in [0, 1];
-    ``pixel_size`` and ``dx`` in m.
+    fixed point of :func:`structure_from_photo` on its default cube of
+    voxels of size ``dx``, a few seconds. ``image`` a path or a grey array
+    in [0, 1]; ``pixel_size`` and ``dx`` in m.
     """
     grey = read_grey(image) if isinstance(image, (str, Path)) else \
         np.asarray(image, dtype=np.float64)
@@ -272,12 +276,8 @@ def photo_targets(image, *, pixel_size: float, dx: float, dim: int,
             raise ValueError("no aggregate found in the photo: check "
                              "photo_aggregate (bright/dark)")
         return PhotoTargets(photo.area_fraction, photo.percentile(95), photo, None)
-    first = section_statistics(segment_aggregate(grey, aggregate=aggregate),
-                               pixel_size, 20)
-    d0 = 4.0 / np.pi * first.percentile(95) if first.diameters.size else 10 * dx
-    n = int(np.clip(np.ceil(6.0 * d0 / dx), 32, 80))
-    res = structure_from_photo(grey, pixel_size=pixel_size, grid_shape=(n, n, n),
-                               dx=dx, itz_thickness=itz_thickness,
+    res = structure_from_photo(grey, pixel_size=pixel_size, dx=dx,
+                               itz_thickness=itz_thickness,
                                aggregate_shape=aggregate_shape, seed=seed,
                                aggregate=aggregate, **generator)
     return PhotoTargets(res.photo.area_fraction, res.max_aggregate_size, res.photo,
