@@ -223,3 +223,23 @@ geometry = { shape = "box", lo = [0.02, 0], hi = [0.03, 0.01] }
                                         "velocity = [1.0, 0]\nartificial_stress = 0.2")
     d = loads_deck(only)
     assert Solver(build_model(d), d).R is not None
+
+
+def test_artificial_stress_power_is_booked_as_heat():
+    # dedt_i -= a_AS_i . v_i (docstring of artificial_stress_forces): with a
+    # and dedt starting at zero, each particle's heating rate is minus the
+    # power per unit mass of its artificial-stress acceleration, so
+    # sum m (a . v + dedt) = 0 and E_total closes (rings test).
+    c = _cloud(2)
+    n = c["x"].shape[0]
+    R = np.zeros((n, 3, 3))
+    artificial_stress_tensor(c["sig"], c["rho"], np.full(n, EPS), R, np.zeros((n, 3, 3)))
+    v = np.random.default_rng(4).normal(size=(n, 3))
+    v[:, 2] = 0.0
+    a = np.zeros((n, 3))
+    dedt = np.zeros(n)
+    nl = c["nl"]
+    artificial_stress_forces(c["x"], c["m"], c["h"], R, c["F"], nl.offsets, nl.idx,
+                             c["kid"], 2, 1.0, c["spacing"], 4.0, a, v, dedt)
+    assert np.abs(a).max() > 0
+    assert np.allclose(dedt, -(a * v).sum(axis=1), rtol=1e-14, atol=0)

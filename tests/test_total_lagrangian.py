@@ -254,3 +254,45 @@ def test_passes_write_only_their_rows():
                          b["B0"], 2, Fd, np.zeros((n, 3, 3)), L)
     assert np.all(L[odd] == 7.0) and np.all(Fd[odd] == 7.0)
     assert np.abs(Fd[rows, 2, 2] - 1.0).max() == 0.0
+
+
+@pytest.mark.parametrize("approach", [True, False])
+def test_pair_viscosity_and_hourglass_match_their_formulas(approach):
+    # Two particles, P = 0, F = I: tl_forces evaluates viscosity and
+    # hourglass with one shared division (_viscous_hourglass); compare with
+    # the formulas written out (docstring of tl_forces, Monaghan 1992 and
+    # Ganzenmueller 2015). Round-off only: 1e-12 relative. A separating pair
+    # has no viscous force.
+    X = np.array([[0.0, 0.0, 0.0], [1e-3, 0.0, 0.0]])
+    x = X + np.array([[0.0, 0.0, 0.0], [-0.1e-3, 0.05e-3, 0.0]])
+    sgn = 1.0 if approach else -1.0
+    v = np.array([[sgn * 3.0, 1.0, 0.0], [-sgn * 2.0, 0.0, 0.0]])
+    m = np.array([2.0, 3.0])
+    rho = np.array([2400.0, 2600.0])
+    c = np.array([3000.0, 3500.0])
+    h0 = np.array([1.2e-3, 1.4e-3])
+    fac = np.array([-5e8, -5e8], dtype=np.float32)
+    hgk = np.array([-7e5, -7e5], dtype=np.float32)
+    offsets, idx = np.array([0, 1, 2]), np.array([1, 0], dtype=np.int32)
+    eye = np.broadcast_to(np.eye(3), (2, 3, 3)).copy()
+    zero = np.zeros((2, 3, 3))
+    alpha, beta, kscale = 1.0, 2.0, 1.0
+    a = np.zeros((2, 3))
+    heat = np.zeros(2)
+    tl_forces(np.arange(2), x, v, X, m, rho, rho, c, h0, m / rho, offsets, idx, fac, hgk,
+              np.zeros((2, 3)), zero, zero, eye, eye, 2, alpha, beta, kscale, a, heat)
+    d = x[0] - x[1]
+    r2 = d @ d
+    vx = min((v[0] - v[1]) @ d, 0.0)
+    h = kscale * 0.5 * (h0[0] + h0[1])
+    mu = h * vx / (r2 + 0.01 * h * h)
+    pi = (-alpha * 0.5 * (c[0] + c[1]) * mu + beta * mu**2) / (0.5 * (rho[0] + rho[1]))
+    f = float(fac[0])
+    a_visc = -m[1] * pi * f * d
+    s = 2.0 * (X[1] - X[0]) + 2.0 * d  # (F_i + F_j) X_ij - 2 x_ij with F = I
+    f_hg = float(hgk[0]) * (s @ d) / r2 * d
+    expect = a_visc + f_hg / m[0]
+    assert (vx < 0) == approach and np.abs(f_hg).max() > 0
+    assert np.allclose(a[0], expect, rtol=1e-12, atol=1e-12 * np.abs(expect).max())
+    heat0 = 0.5 * m[1] * pi * f * vx - (f_hg @ v[0]) / m[0]
+    assert heat[0] == pytest.approx(heat0, rel=1e-12)
