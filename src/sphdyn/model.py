@@ -17,6 +17,7 @@ from .heterogeneity.cracks import crack_mask
 from .heterogeneity.mass import body_rng, mass_field
 from .heterogeneity.mesostructure import AGGREGATE, ITZ, MORTAR, generate_phases
 from .heterogeneity.photo import photo_targets
+from .heterogeneity.variation import factor_of, quantise, standard_normal_field, variation_rng
 from .materials import get_model
 from .probes import Probe, quantity
 from .state import BC_FIXED, BC_VELOCITY, Particles
@@ -82,12 +83,14 @@ class Model:
     phase: np.ndarray = field(repr=False, default=None)
     #: body name -> PhotoTargets of bodies whose mesostructure comes from a photo
     photo_targets: dict = field(default_factory=dict)
+    #: (N,) factor of the [material.variation] parameter (1 without variation)
+    variation: np.ndarray = field(repr=False, default=None)
 
 
 def _material_params(mat) -> dict:
     d = mat.model_dump()
-    d.pop("name", None)
-    d.pop("model", None)
+    for key in ("name", "model", "variation"):
+        d.pop(key, None)
     return {k: v for k, v in d.items() if v is not None}
 
 
@@ -126,6 +129,43 @@ def _phase_materials(deck, b: int, body, x: np.ndarray, dim: int, mat_index: dic
     return table[phases], phases
 
 
+def _material_groups(deck, particles: Particles, models: dict,
+                     params: dict) -> tuple[list[MaterialGroup], np.ndarray]:
+    """Material groups of the particles and the (N,) variation factor.
+
+    One group per material, or, with ``[material.variation]``, one per
+    class of the varied parameter: the parameter times the class factor
+    and the material refitted from it (``model.pack``), see
+    :mod:`sphdyn.heterogeneity.variation`. Factors are drawn from
+    ``variation_rng(run.seed, material index)``.
+    """
+    factor = np.ones(particles.n)
+    groups = []
+    for k, m in enumerate(deck.material):
+        idx = np.flatnonzero(particles.mat == k).astype(np.int64)
+        if not idx.size:
+            continue
+        var = m.variation
+        if var is None or var.cov == 0.0:
+            groups.append(MaterialGroup(m.name, models[m.name], params[m.name], idx))
+            continue
+        rng = variation_rng(deck.run.seed, k)
+        if var.scope == "sample":
+            cls, mids = np.zeros(idx.size, np.int64), rng.standard_normal(1)
+        else:
+            z = standard_normal_field(particles.x[idx], var.correlation_length, rng)
+            cls, mids = quantise(z, var.classes)
+        f = factor_of(mids, var.cov, var.distribution)
+        base = _material_params(m)
+        for c in np.unique(cls):
+            sub = idx[cls == c]
+            values = {**base, var.parameter: base[var.parameter] * f[c]}
+            groups.append(MaterialGroup(f"{m.name}#{c}", models[m.name],
+                                        models[m.name].pack(values), sub))
+            factor[sub] = f[c]
+    return groups, factor
+
+
 def build_model(deck) -> Model:
     """Create the particle model described by a validated deck."""
     dim = deck.run.dimension
@@ -143,8 +183,6 @@ def build_model(deck) -> Model:
             "are stored by position; use materials of one model family per run")
 
     density_of = np.array([m.density for m in deck.material])
-    wave_speed_of = np.array([models[m.name].wave_speed(params[m.name], m.density)
-                              for m in deck.material])
     parts, phase_parts = [], []
     photos = {}
     for b, body in enumerate(deck.body):
@@ -165,7 +203,6 @@ def build_model(deck) -> Model:
         p.mat[:] = mat_ids
         p.rho[:] = density_of[mat_ids]
         p.rho0[:] = p.rho
-        p.c[:] = wave_speed_of[mat_ids]
         # numerical heterogeneity (paper sec. 4, 5.2): crack particles get zero
         # mass, the others a random mass field of the homogeneous total
         cracks = [c.model_dump() for c in body.crack]
@@ -185,15 +222,12 @@ def build_model(deck) -> Model:
     particles = Particles.concatenate(parts)
     particles.hist_names = list(next(iter(layouts), ()))
 
-    groups = []
-    for name, m in mats.items():
-        idx = np.flatnonzero(particles.mat == mat_index[name]).astype(np.int64)
-        if idx.size:
-            groups.append(MaterialGroup(name, models[name], params[name], idx))
+    groups, factor = _material_groups(deck, particles, models, params)
 
     kb = np.zeros(particles.n)
     for g in groups:
         kb[g.idx] = g.model.bulk_modulus(g.params)
+        particles.c[g.idx] = g.model.wave_speed(g.params, particles.rho0[g.idx[0]])  # one density per material
         h0 = g.model.initial_history(g.params)
         if len(h0):
             particles.hist[np.ix_(g.idx, np.arange(len(h0)))] = h0
@@ -252,4 +286,4 @@ def build_model(deck) -> Model:
         kernel_id=kid, kernel_sigma=kernels.normalisation(kid, dim),
         radius_factor=kernels.support(kid) * deck.sph.support_scale,
         bulk_modulus=kb, probes=probes, phase=np.concatenate(phase_parts),
-        photo_targets=photos)
+        photo_targets=photos, variation=factor)

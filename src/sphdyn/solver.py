@@ -226,7 +226,11 @@ class Solver:
         phase = self.model.phase
         if phase is None:
             phase = np.full(self.p.n, -1, np.int8)
-        return {"swegle": self.swegle_field, "phase": lambda: phase}
+        factor = self.model.variation
+        if factor is None:
+            factor = np.ones(self.p.n)
+        return {"swegle": self.swegle_field, "phase": lambda: phase,
+                "variation": lambda: factor}
 
     def swegle_field(self) -> np.ndarray:
         """Swegle indicator (N,) of the current state (see :mod:`sphdyn.sph.swegle`).

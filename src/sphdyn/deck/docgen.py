@@ -197,20 +197,28 @@ def _rows(model: type[BaseModel]) -> list[str]:
     return rows
 
 
-def _section(title: str, model: type[BaseModel], level: int) -> list[str]:
-    """Heading, docstring and key table of a model, then its sub-tables."""
+def _section(title: str, model: type[BaseModel], level: int, path: str = "",
+             seen: set | None = None) -> list[str]:
+    """Heading, docstring and key table of a model, then its sub-tables.
+
+    ``path`` is the dotted TOML path of the table (``material``), ``seen``
+    the (path, model) pairs already written: a sub-table shared by several
+    variants (``[material.variation]``) is written once.
+    """
     doc = " ".join((model.__doc__ or "").split())
     if doc.startswith("[") and ": " in doc:  # drop the "[run]: " prefix
         doc = doc.split(": ", 1)[1]
     doc = doc[:1].upper() + doc[1:]
     return ([f"{'#' * level} {title}", "", doc, ""] + _rows(model) + [""]
-            + _subsections(title, model, level + 1))
+            + _subsections(path, model, level + 1, set() if seen is None else seen))
 
 
-def _subsections(title: str, model: type[BaseModel], level: int) -> list[str]:
+def _subsections(path: str, model: type[BaseModel], level: int,
+                 seen: set | None = None) -> list[str]:
     """Sections for the fields of ``model`` that are tables."""
     out = []
-    prefix = title.strip("[]") + "." if title else ""
+    seen = set() if seen is None else seen
+    prefix = path + "." if path else ""
     for key, info in model.model_fields.items():
         core = strip_optional(field_annotation(info))
         many = get_origin(core) is tuple
@@ -223,9 +231,12 @@ def _subsections(title: str, model: type[BaseModel], level: int) -> list[str]:
                 else "shape"
             for value, member in members.items():
                 out += _section(f"{table} with {tag} = \"{value}\"", member,
-                                level)
+                                level, prefix + key, seen)
         elif isinstance(core, type) and issubclass(core, BaseModel):
-            out += _section(table, core, level)
+            if (prefix + key, core) in seen:
+                continue
+            seen.add((prefix + key, core))
+            out += _section(table, core, level, prefix + key, seen)
     return out
 
 

@@ -34,7 +34,7 @@ from .units import (DENSITY, LENGTH, PRESSURE, TIME, VELOCITY, Dimension,
 ALLOWED_FIELDS: list[str] = [
     "velocity", "displacement", "stress", "pressure", "von_mises", "density",
     "mass", "smoothing_length", "damage", "internal_energy", "plastic_strain",
-    "bc", "body", "material", "swegle", "phase",
+    "bc", "body", "material", "swegle", "phase", "variation",
 ]
 
 DEFAULT_FIELDS = ("velocity", "displacement", "stress", "pressure", "von_mises",
@@ -518,7 +518,73 @@ def _check_corners(lo, hi, lo_key: str) -> None:
 
 # Materials ---------------------------------------------------------------
 
-class Elastic(Section):
+class Variation(Section):
+    """[material.variation]: random scatter of one parameter of a material.
+
+    Thesis sec. 7.2: CSCM as the base material with the strength varied in
+    the ITZ. The parameter is multiplied by a random factor of mean 1 and
+    coefficient of variation cov (lognormal or normal), drawn once per run
+    (scope = "sample") or per particle (scope = "particle", independent or
+    correlated over correlation_length); per-particle factors are grouped
+    into equal-probability classes, each refitted as a whole material (so
+    varying CSCM fc also varies the fitted moduli, surfaces and fracture
+    energies). Seeded by run.seed and the material's index;
+    docs/mesostructure.md.
+    """
+
+    parameter: str = Field(
+        description="Name of the varied parameter of this material, e.g. "
+                    "\"fc\" (CSCM) or \"yield_stress\" (j2); it must be given "
+                    "in the material (not density: use [body.mass]).")
+    cov: real("coefficient of variation", lo=0, hi=1) = Field(
+        description="Coefficient of variation of the factor (0 = no scatter).")
+    distribution: Literal["lognormal", "normal"] = Field(
+        "lognormal", description="Law of the factor, mean 1: lognormal, or "
+                                 "normal kept above 0.05.")
+    scope: Literal["sample", "particle"] = Field(
+        "particle", description="One factor per run (sample) or one per "
+                                "particle.")
+    correlation_length: quantity(LENGTH, "correlation length", lo=0) = Field(
+        0.0, description="scope = particle: correlation length l of a Gaussian "
+                         "random field, correlation exp(-(r/l)^2); 0 = "
+                         "independent particles.")
+    classes: integer("class count", lo=2, hi=256) = Field(
+        16, description="scope = particle: number of equal-probability "
+                        "parameter classes (material groups) the factors are "
+                        "rounded to.")
+
+    @model_validator(mode="after")
+    def _scope_options(self):
+        if self.scope == "sample" and self.correlation_length > 0.0:
+            raise problem("correlation_length is given with scope = \"sample\"",
+                          "remove correlation_length (one factor per run has no "
+                          "spatial structure) or use scope = \"particle\"")
+        return self
+
+
+class _Varied(Section):
+    """Check [material.variation] against the material's own parameters."""
+
+    @model_validator(mode="after")
+    def _varied_parameter(self):
+        var = getattr(self, "variation", None)
+        if var is None:
+            return self
+        fixed = {"name", "model", "density", "variation", "recovery"}
+        numeric = [k for k, f in type(self).model_fields.items() if k not in fixed
+                   and strip_optional(f.annotation) is float]
+        if var.parameter not in numeric:
+            raise problem(f"variation.parameter {var.parameter!r} is not a varied "
+                          f"parameter of model {self.model!r}",
+                          f"use one of {', '.join(numeric)}")
+        if getattr(self, var.parameter) is None:
+            raise problem(f"variation.parameter {var.parameter!r} is not given in "
+                          "the material (its default is generated)",
+                          f"give {var.parameter} explicitly to vary it")
+        return self
+
+
+class Elastic(_Varied):
     """[[material]] model = "elastic": isotropic linear elasticity.
 
     Give exactly one pair of elastic constants: E and nu, or K and G.
@@ -538,6 +604,8 @@ class Elastic(Section):
         None, description="Bulk modulus (give with G).")
     G: Optional[PositivePressure] = Field(
         None, description="Shear modulus (give with K).")
+    variation: Optional[Variation] = Field(
+        None, description="Random scatter of one parameter ([material.variation]).")
 
     @model_validator(mode="after")
     def _one_pair(self):
@@ -587,7 +655,7 @@ def _cscm_override(noun: str, dim: Any = None, **bounds: Any) -> Any:
     return Optional[kind]
 
 
-class Cscm(Section):
+class Cscm(_Varied):
     """[[material]] model = "cscm": concrete, Continuous Surface Cap Model.
 
     Re-implementation of LS-DYNA *MAT_CSCM_CONCRETE (MAT_159, Murray 2007,
@@ -714,6 +782,8 @@ class Cscm(Section):
     incre: Optional[real("strain increment", lo=0, lo_open=True)] = Field(
         None, description="Maximum strain sub-increment (default a quarter "
                           "of the zero-pressure shear yield strain).")
+    variation: Optional[Variation] = Field(
+        None, description="Random scatter of one parameter ([material.variation]).")
 
 
 Material = Annotated[Union[Elastic, J2, Cscm], Field(discriminator="model")]

@@ -41,6 +41,8 @@ DERIVED_FIELDS: dict[str, str] = {
               "NaN without a solver; see docs/tensile-instability.md, (N,)",
     "phase": "mesostructure phase (int8): 0 mortar, 1 aggregate, 2 ITZ, -1 "
              "for bodies without [body.mesostructure], (N,)",
+    "variation": "factor of the [material.variation] parameter (1 for "
+                 "materials without variation), (N,)",
 }
 
 
@@ -76,6 +78,8 @@ def _compute(p: "Particles", name: str, computed) -> np.ndarray:
         return np.full(p.n, np.nan)  # no solver supplied it
     if name == "phase":
         return np.full(p.n, -1, np.int8)  # no model supplied it
+    if name == "variation":
+        return np.ones(p.n)  # no model supplied it
     simple = {"density": "rho", "mass": "m", "smoothing_length": "h",
               "damage": "damage", "internal_energy": "e", "bc": "bc",
               "body": "body", "material": "mat"}
