@@ -118,6 +118,27 @@ def test_lode_angle_sign_convention():
     assert b == pytest.approx(0.0, abs=1e-12) and r == pytest.approx(5e6)
 
 
+def test_tiny_deviator_keeps_its_angle_and_cannot_divide_by_zero():
+    # A deviator of 1e-110 Pa (velocity gradients of 1e-113 /s reach the
+    # first particles at contact) has J2'^(3/2) ~ 1e-330, below the smallest
+    # double: the Lode ratio once divided by zero there, inside a parallel
+    # kernel that swallowed the error and failed the next run of the
+    # process. The invariants are homogeneous in the stress: the angle is
+    # that of the same deviator at 1 MPa and sqrt(J2') scales with it
+    # (relative 1e-14, a few roundings).
+    base = (-2.0, 1.0, 1.0, 0.3, 0.1, 0.0)
+    _, r1, b1, _ = cscm.invariants(tuple(1e6 * v for v in base))
+    for scale in (1e-110, 1e-200, 1e-300):
+        _, r, b, _ = cscm.invariants(tuple(scale * v for v in base))
+        assert b == pytest.approx(b1, rel=1e-14)
+        assert r == pytest.approx(r1 * scale / 1e6, rel=1e-14)
+    # and a whole CSCM point update from rest by such an increment
+    p = get_model("cscm").pack({"density": 2400.0, "fc": 43.1e6})
+    h = cscm.initial_history(p).copy()
+    s, d = cscm.cscm_point(h, (-1e-120, 1e-120, 0.0, 1e-121, 0.0, 3e-121), 2e-7, p, 0.0025)
+    assert d == 0.0 and all(math.isfinite(v) and abs(v) < 1e-100 for v in s)
+
+
 def test_dilogarithm():
     # Li2(-1) = -pi^2/12; Li2(-100) from the inversion formula vs direct
     # numerical integral -int_0^inf x/(e^x/B + 1) dx. 1e-10 / 1e-8.
