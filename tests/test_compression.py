@@ -9,6 +9,7 @@ import pytest
 from sphdyn.cli import main
 from sphdyn.compression import compression_curve, ensemble_report
 from sphdyn.deck import loads_deck
+from sphdyn.model import build_model
 from sphdyn.simulation import Simulation
 
 EXAMPLES = Path(__file__).parent.parent / "examples"
@@ -123,7 +124,6 @@ def test_itz_strength_varied_per_sample_scatters_the_peak_in_its_order(tmp_path)
     # examples.md). Thresholds: the range of the peaks above 3 % of the mean
     # (the factors of seeds 1-3 span more than 10 %, checked first), and
     # the same order as the factors.
-    from sphdyn.model import build_model
     var = '{ parameter = "fc", cov = 0.15, scope = "sample" }'
     text = (EXAMPLES / "ucs_mesostructure.toml").read_text().replace(
         'fc = "28 MPa"', f'fc = "28 MPa"\nvariation = {var}')

@@ -371,6 +371,25 @@ class TestHistory:
 
 # -------------------------------------------------------------------------- plots
 
+def test_energy_drift_is_relative_to_the_largest_energy_term():
+    # A quasi-static test: the kinetic energy stays ~1e-3 J while internal
+    # and contact energy grow to +-100 J and cancel; E_total drifts by 1 J.
+    # Relative to the largest term that is exactly 1 % (a scale taken from
+    # E_kinetic alone would give 1000); the columns are found by prefix.
+    from sphdyn.io.plots import energy_columns, relative_drift
+
+    t = np.linspace(0.0, 1.0, 11)
+    h = {"time": t, "E_kinetic": np.full(11, 1e-3), "E_internal": 100.0 * t,
+         "E_contact": -99.0 * t, "W_external": 0.0 * t, "F_wall_base": 5e5 * t}
+    h["E_total"] = h["E_kinetic"] + h["E_internal"] + h["E_contact"]
+    cols = energy_columns(list(h))
+    assert cols == ["E_kinetic", "E_internal", "E_contact", "W_external", "E_total"]
+    drift = relative_drift(h["E_total"], [h[c] for c in cols])
+    assert drift[0] == 0.0
+    assert np.max(np.abs(drift)) == pytest.approx(0.01, rel=1e-12)
+    assert relative_drift(np.zeros(3), [np.zeros(3)]).tolist() == [0.0, 0.0, 0.0]
+
+
 def test_plot_history_writes_pngs(tmp_path):
     h = History()
     for k in range(50):

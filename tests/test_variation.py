@@ -164,12 +164,30 @@ def test_sample_variation_gives_one_factor_per_run_with_the_requested_law():
     s = np.sqrt(np.log(1 + 0.01))
     assert stats.kstest(draws, stats.lognorm(s, scale=np.exp(-s * s / 2)).cdf).pvalue > 1e-3
     # the same seed gives the same factor, the zero-CoV limit is the plain model
-    assert _model(var, 5).variation[0] == _model(var, 5).variation[0]
+    assert np.array_equal(_model(var, 5).variation, _model(var, 5).variation)
     none = _model('variation = { parameter = "fc", cov = 0.0, scope = "sample" }')
     plain = _model()
     assert [g.name for g in none.groups] == [g.name for g in plain.groups]
     for a, b in zip(none.groups, plain.groups):
         assert np.array_equal(a.params, b.params) and np.array_equal(a.idx, b.idx)
+
+
+def test_variation_is_an_output_field(tmp_path):
+    # The factor per particle is written with the frames (ParaView field
+    # "variation"): the model's factors on the ITZ, 1 on the mortar; a run
+    # without variation writes 1 everywhere.
+    from sphdyn.io import list_frames, read_frame
+    from sphdyn.simulation import Simulation
+
+    out = '[output]\nfields = ["variation", "material"]\nprogress = false\n'
+    for name, var in (("var", 'variation = { parameter = "fc", cov = 0.2 }'), ("plain", "")):
+        deck = loads_deck(DECK.format(seed=1, variation=var) + out)
+        sim = Simulation.from_deck(deck, tmp_path / name)
+        sim.run(max_steps=1)
+        f = read_frame(list_frames(tmp_path / name)[0])[2]
+        assert np.array_equal(f["variation"], sim.solver.model.variation)
+        assert np.all(f["variation"][f["material"] == 0] == 1.0)
+        assert np.any(f["variation"] != 1.0) == (name == "var")
 
 
 @pytest.mark.parametrize("variation, message", [

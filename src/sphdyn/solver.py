@@ -223,14 +223,13 @@ class Solver:
 
     def output_fields(self) -> dict:
         """Output fields the solver evaluates on demand, for ``particle_fields``."""
-        phase = self.model.phase
-        if phase is None:
-            phase = np.full(self.p.n, -1, np.int8)
-        factor = self.model.variation
-        if factor is None:
-            factor = np.ones(self.p.n)
-        return {"swegle": self.swegle_field, "phase": lambda: phase,
-                "variation": lambda: factor}
+        out = {"swegle": self.swegle_field}
+        # the model's per-particle arrays; absent ones get io.fields' defaults
+        if self.model.phase is not None:
+            out["phase"] = lambda: self.model.phase
+        if self.model.variation is not None:
+            out["variation"] = lambda: self.model.variation
+        return out
 
     def swegle_field(self) -> np.ndarray:
         """Swegle indicator (N,) of the current state (see :mod:`sphdyn.sph.swegle`).

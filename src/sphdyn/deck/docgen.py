@@ -210,7 +210,7 @@ def _section(title: str, model: type[BaseModel], level: int, path: str = "",
         doc = doc.split(": ", 1)[1]
     doc = doc[:1].upper() + doc[1:]
     return ([f"{'#' * level} {title}", "", doc, ""] + _rows(model) + [""]
-            + _subsections(path, model, level + 1, set() if seen is None else seen))
+            + _subsections(path, model, level + 1, seen))
 
 
 def _subsections(path: str, model: type[BaseModel], level: int,

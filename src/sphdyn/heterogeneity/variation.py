@@ -96,29 +96,29 @@ def standard_normal_field(x: np.ndarray, correlation_length: float,
     :math:`\exp(-(r/\ell)^2)` at distance r; 0 gives independent values.
     The field lives on a voxel grid of spacing :math:`\ell/4` (coarser if
     the grid would exceed 2e7 voxels) over the points' bounding box plus
-    :math:`2\ell`, periodic (``mode="wrap"``) so that every voxel sums a full
-    kernel of independent noise; points take their voxel's value. Returns
-    (N,) float.
+    :math:`2\ell` (an axis on which all points lie in one plane, e.g. z of a
+    2D body, gets a single voxel), periodic (``mode="wrap"``) so that every
+    voxel sums a full kernel of independent noise; points take their
+    voxel's value. Returns (N,) float.
     """
     x = np.asarray(x, dtype=float)
     n = x.shape[0]
     if correlation_length <= 0.0:
         return rng.standard_normal(n)
-    lo = x.min(axis=0) - 2.0 * correlation_length
-    hi = x.max(axis=0) + 2.0 * correlation_length
-    flat = hi - lo <= 0.0   # a plane-strain z column, a line of points...
-    extent = np.where(flat, 0.0, hi - lo)
-    spacing = correlation_length / 4.0
-    active = int((~flat).sum())
-    spacing = max(spacing, (np.prod(extent[~flat]) / 2e7) ** (1.0 / max(active, 1)))
+    flat = np.ptp(x, axis=0) <= 0.0   # the z column of a 2D body: no axis there
+    lo = np.where(flat, x.min(axis=0), x.min(axis=0) - 2.0 * correlation_length)
+    extent = np.where(flat, 0.0, np.ptp(x, axis=0) + 4.0 * correlation_length)
+    active = max(int((~flat).sum()), 1)
+    spacing = max(correlation_length / 4.0,
+                  (np.prod(extent[~flat]) / 2e7) ** (1.0 / active))
     shape = tuple(1 if f else int(np.ceil(e / spacing)) + 1 for f, e in zip(flat, extent))
     sigma = [0.0 if f else 0.5 * correlation_length / spacing for f in flat]
-    noise = rng.standard_normal(shape)
-    field = ndimage.gaussian_filter(noise, sigma, mode="wrap")
+    field = ndimage.gaussian_filter(rng.standard_normal(shape), sigma, mode="wrap")
+    # exact standard deviation of the filtered unit noise: the filter's
+    # weights are its response to a unit impulse (truncated at 4 sigma)
     delta = np.zeros(tuple(1 if f else 2 * int(4 * s + 0.5) + 1 for f, s in zip(flat, sigma)))
     delta[tuple(d // 2 for d in delta.shape)] = 1.0
     weights = ndimage.gaussian_filter(delta, sigma, mode="constant")
     field /= np.sqrt(np.sum(weights * weights))
     ijk = np.rint((x - lo) / spacing).astype(np.int64)
-    ijk[:, flat] = 0
     return field[tuple(ijk.T)]

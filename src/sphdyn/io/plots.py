@@ -15,7 +15,7 @@ import numpy as np
 from .atomic import atomic_path
 from .history import read_history_csv
 
-__all__ = ["plot_history", "save_figure", "ENERGY_COLUMNS"]
+__all__ = ["plot_history", "save_figure", "ENERGY_COLUMNS", "energy_columns", "relative_drift"]
 
 #: Energy columns plotted first, in this order, when present. Any other
 #: column starting with ``E_`` or ``W_`` is added after them.
@@ -49,7 +49,8 @@ def save_figure(fig, path, dpi: float | None = None) -> Path:
     return path
 
 
-def _energy_columns(columns: list[str]) -> list[str]:
+def energy_columns(columns: list[str]) -> list[str]:
+    """The energy columns (``E_*``, ``W_*``) of a history, known ones first."""
     known = [c for c in ENERGY_COLUMNS if c in columns]
     other = [c for c in columns if c.startswith(("E_", "W_")) and c not in known]
     return known + other
@@ -101,7 +102,7 @@ def plot_history(csv_path: str | os.PathLike,
     time = data.get("time")
     title = csv_path.name
 
-    energy_cols = _energy_columns(columns)
+    energy_cols = energy_columns(columns)
     if time is not None and energy_cols:
         has_total = "E_total" in data
         fig, axes = _figure(2 if has_total else 1)

@@ -195,6 +195,15 @@ def _rubin_cs(q1, q2, cb, sb):
 
 
 @njit(cache=True)
+def _j2_j3(dev):
+    """``J2' = dev:dev/2`` and ``J3' = det(dev)`` of a deviator 6-tuple."""
+    J3 = (dev[0] * (dev[1] * dev[2] - dev[4] * dev[4])
+          - dev[3] * (dev[3] * dev[2] - dev[4] * dev[5])
+          + dev[5] * (dev[3] * dev[4] - dev[1] * dev[5]))
+    return 0.5 * ddot6(dev, dev), J3
+
+
+@njit(cache=True)
 def invariants(s):
     """Invariants of a tension-positive stress 6-tuple in CSCM convention.
 
@@ -209,24 +218,22 @@ def invariants(s):
     """
     m = (s[0] + s[1] + s[2]) / 3.0
     dev = (s[0] - m, s[1] - m, s[2] - m, s[3], s[4], s[5])
-    # J2' and the Lode ratio J3'/J2'^(3/2) on the deviator divided by its
-    # largest component: a tiny deviator (1e-110 Pa stresses at first
-    # contact, whose J2'^(3/2) is below the smallest double) then neither
-    # divides by zero nor gets sqrt(J2') = 0 with a non-zero deviator.
-    big = max(abs(dev[0]), abs(dev[1]), abs(dev[2]), abs(dev[3]), abs(dev[4]),
-              abs(dev[5]))
-    bhat, r = 0.0, 0.0
-    if big > 0.0:
-        u = (dev[0] / big, dev[1] / big, dev[2] / big, dev[3] / big, dev[4] / big,
-             dev[5] / big)
-        j2 = 0.5 * ddot6(u, u)
-        j3 = (u[0] * (u[1] * u[2] - u[4] * u[4])
-              - u[3] * (u[3] * u[2] - u[4] * u[5])
-              + u[5] * (u[3] * u[4] - u[1] * u[5]))
-        x = 1.5 * math.sqrt(3.0) * j3 / j2 ** 1.5
-        x = min(1.0, max(-1.0, x))
-        bhat = -math.asin(x) / 3.0
-        r = big * math.sqrt(j2)
+    J2, J3 = _j2_j3(dev)
+    r = math.sqrt(J2)
+    if J2 <= 1e-200:
+        # J2'^(3/2) would underflow (a 1e-110 Pa deviator at first contact)
+        # and sqrt(J2') may be 0 for a non-zero deviator: the ratio is
+        # scale-free, so evaluate it on the deviator over its largest component
+        big = max(abs(dev[0]), abs(dev[1]), abs(dev[2]), abs(dev[3]), abs(dev[4]),
+                  abs(dev[5]))
+        if big == 0.0:
+            return -3.0 * m, 0.0, 0.0, dev
+        J2, J3 = _j2_j3((dev[0] / big, dev[1] / big, dev[2] / big, dev[3] / big,
+                         dev[4] / big, dev[5] / big))
+        r = big * math.sqrt(J2)
+    x = 1.5 * math.sqrt(3.0) * J3 / J2 ** 1.5
+    x = min(1.0, max(-1.0, x))
+    bhat = -math.asin(x) / 3.0
     return -3.0 * m, r, bhat, dev
 
 
