@@ -125,6 +125,7 @@ def test_ensemble_records_failures_resumes_and_reports(ensemble, capsys):
     assert rows[0]["domain.margin"] == "1.0"
     for r in rows[:2]:
         assert float(r["peak_contact_force"]) > 0
+        assert float(r["peak_contact_force_mean"]) > 0
         assert 0 < float(r["damaged_volume_fraction"]) < 1
         assert float(r["final_kinetic_energy"]) < float(r["initial_kinetic_energy"])
         assert float(r["dissipated_energy"]) > 0
@@ -175,7 +176,7 @@ def test_same_seed_same_result_with_1_or_2_workers_and_direct_run(ensemble, tmp_
         for key in a:
             assert np.array_equal(a[key], b[key]), (k, key)
     for x, y in zip(_table(out1), _table(out2)[:2]):
-        for col in ("peak_contact_force", "dissipated_energy",
+        for col in ("peak_contact_force", "peak_contact_force_mean", "dissipated_energy",
                     "damaged_volume_fraction", "main_cracks", "final_kinetic_energy"):
             assert x[col] == y[col], col
     direct = load_deck(deck, [f"run.seed={sample_seed(11, 1)}"])

@@ -119,6 +119,9 @@ def test_restart_continues_to_the_same_result(tmp_path, variant):
     h_part = read_history_csv(tmp_path / "part/history.csv")
     assert np.array_equal(h_full["time"], h_part["time"])
     assert np.array_equal(h_full["E_total"], h_part["E_total"])
+    # the wall impulse is carried over too (it is not recomputable from the state)
+    assert np.array_equal(h_full["I_wall_floor"], h_part["I_wall_floor"])
+    assert np.interp(ck_t, h_full["time"], h_full["I_wall_floor"]) > 0
 
 
 def test_particles_leaving_the_domain_stop_the_run_with_a_diagnosis(tmp_path):

@@ -1,4 +1,4 @@
-"""Post-processing of particle states: fragment counting.
+"""Post-processing: fragment counting, and contact forces averaged over a window.
 
 A *fragment* is a connected component of the graph in which two particles
 are linked when their distance is below a link length ``d_ij``. With
@@ -15,7 +15,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-__all__ = ["fragment_labels", "count_fragments", "fragment_sizes"]
+__all__ = ["fragment_labels", "count_fragments", "fragment_sizes", "window_mean_force"]
 
 
 def fragment_labels(x, h_or_radius, body=None, mask=None) -> np.ndarray:
@@ -94,3 +94,37 @@ def fragment_sizes(labels) -> np.ndarray:
     """Particle count of each fragment, indexed by label (-1 labels ignored)."""
     labels = np.asarray(labels)
     return np.bincount(labels[labels >= 0]) if (labels >= 0).any() else np.zeros(0, int)
+
+
+def window_mean_force(time, impulse, window: float) -> np.ndarray:
+    r"""Contact force averaged over the last ``window`` seconds, from the impulse.
+
+    .. math:: \bar F(t) = \frac{I(t) - I(t - \tau)}{\tau},
+              \qquad I(t) = \int_0^t F\,dt,
+
+    the mean force over :math:`[t - \tau, t]` (a moving average; its
+    maximum is the peak a load cell of response time :math:`\tau` would
+    read). :math:`I` is the history column ``I_wall_<name>``, which the
+    solver accumulates every step, so the average is exact however sparsely
+    the history is recorded; :math:`I(t - \tau)` is linearly interpolated
+    between records and taken as 0 before the first one (no contact before
+    the run starts). A penalty wall spring oscillates with the period
+    :math:`2\pi\,\Delta t/\sqrt\alpha` (paper eq. 8); any window longer
+    than that removes the oscillation from the peak.
+
+    Parameters
+    ----------
+    time : (K,) record times [s], increasing.
+    impulse : (K,) cumulative normal impulse [N s] (N s/m in 2D) at ``time``.
+    window : float, tau [s] > 0.
+
+    Returns
+    -------
+    (K,) mean force [N] (N/m in 2D) over the window ending at each record.
+    """
+    if not window > 0:
+        raise ValueError(f"window must be > 0 s, got {window}")
+    time = np.asarray(time, dtype=float)
+    impulse = np.asarray(impulse, dtype=float)
+    before = np.interp(time - window, time, impulse, left=0.0)
+    return (impulse - before) / window

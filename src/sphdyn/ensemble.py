@@ -52,6 +52,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .analysis import window_mean_force
 from .io.atomic import atomic_write_text
 from .io.plots import save_figure
 
@@ -68,8 +69,8 @@ FIGURE = "ensemble_damage.png"
 FAILED_DAMAGE = 0.9
 
 #: Columns of ``ensemble.csv`` after the sample, replicate, seed and vary keys.
-COLUMNS = ("status", "peak_contact_force", "dissipated_energy", "viscous_energy",
-           "damaged_volume_fraction", "main_cracks", "final_kinetic_energy",
+COLUMNS = ("status", "peak_contact_force", "peak_contact_force_mean", "dissipated_energy",
+           "viscous_energy", "damaged_volume_fraction", "main_cracks", "final_kinetic_energy",
            "initial_kinetic_energy", "zero_mass_particles", "steps", "wall_seconds",
            "cpu_seconds", "error", "dir")
 
@@ -220,6 +221,9 @@ def sample_metrics(sim) -> dict:
 
     * ``peak_contact_force``: maximum over the history of the summed normal
       wall forces [N] (N/m in 2D); NaN without walls;
+    * ``peak_contact_force_mean``: maximum of the same force averaged over
+      ``[output] force_window`` (:func:`sphdyn.analysis.window_mean_force`),
+      free of the penalty spring's oscillation;
     * ``dissipated_energy``: internal energy at the end [J]: plastic and
       damage work, artificial-viscosity heat (also given alone as
       ``viscous_energy``) and the elastic energy still stored (small after
@@ -232,11 +236,13 @@ def sample_metrics(sim) -> dict:
     s = sim.solver
     p = s.p
     h = sim.history.as_arrays()
-    walls = [f"F_wall_{w.name}" for w in s.model.walls]
+    walls = [w.name for w in s.model.walls]
+    peak = peak_mean = float("nan")
     if walls and len(h.get("time", ())):
-        peak = float(np.max(np.sum([h[w] for w in walls], axis=0)))
-    else:
-        peak = float("nan")
+        peak = float(np.max(np.sum([h[f"F_wall_{w}"] for w in walls], axis=0)))
+        impulse = np.sum([h[f"I_wall_{w}"] for w in walls], axis=0)
+        peak_mean = float(np.max(window_mean_force(h["time"], impulse,
+                                                   sim.deck.output.force_window)))
     vol = np.where(p.m > 0, p.m / p.rho0, 0.0)
     failed = p.damage >= FAILED_DAMAGE
     normal = s.model.walls[0].normal if s.model.walls else np.array([0.0, 1.0, 0.0])
@@ -249,6 +255,7 @@ def sample_metrics(sim) -> dict:
     last = {k: float(v[-1]) for k, v in h.items() if len(v)}
     return {
         "peak_contact_force": peak,
+        "peak_contact_force_mean": peak_mean,
         "dissipated_energy": last.get("E_internal", float("nan")),
         "viscous_energy": last.get("E_viscous", float("nan")),
         "damaged_volume_fraction": float(vol[failed].sum() / vol.sum()),
@@ -557,6 +564,7 @@ def plot_damage_grid(out: str | Path, recs: list[dict] | None = None,
     fig = Figure(figsize=(size * ncol + 0.8, size * len(rows) + 0.4), dpi=110)
     FigureCanvasAgg(fig)
     drawn = 0
+    squares = []  # (axes, scatter, spacing [mm]): squares sized once laid out
     for i, (point, items) in enumerate(rows.items()):
         label = ", ".join(f"{k} = {v}" for k, v in zip(keys, point))
         for j, r in enumerate(items):
@@ -576,10 +584,9 @@ def plot_damage_grid(out: str | Path, recs: list[dict] | None = None,
             xy = f["position"][keep][order] * 1e3
             ext = max(np.ptp(xy[:, 0]), np.ptp(xy[:, 1]), 1e-9)
             dim = 2 if np.ptp(f["position"][:, 2]) == 0 else 3
-            side = particle_spacing(f["position"][keep], dim) * 1e3 / (1.1 * ext)
-            ms = (side * size * 72 * 0.8) ** 2  # marker side in points, squared
-            ax.scatter(xy[:, 0], xy[:, 1], c=f["damage"][keep][order], cmap=cmap,
-                       vmin=0, vmax=1, s=ms, marker="s", linewidths=0)
+            dots = ax.scatter(xy[:, 0], xy[:, 1], c=f["damage"][keep][order], cmap=cmap,
+                              vmin=0, vmax=1, marker="s", linewidths=0)
+            squares.append((ax, dots, particle_spacing(f["position"][keep], dim) * 1e3))
             ax.set_xlim(xy[:, 0].min() - 0.05 * ext, xy[:, 0].max() + 0.05 * ext)
             ax.set_ylim(xy[:, 1].min() - 0.05 * ext, xy[:, 1].max() + 0.05 * ext)
             cracks = r.get("main_cracks", "?")
@@ -591,5 +598,12 @@ def plot_damage_grid(out: str | Path, recs: list[dict] | None = None,
     if not drawn:
         return None
     fig.tight_layout()
+    for ax, dots, spacing in squares:
+        # one particle spacing in points, from the axes' final size, so the
+        # squares tile the lattice without gaps or overlap
+        ax.apply_aspect()
+        width_pt = ax.get_position().width * fig.get_figwidth() * 72
+        side = spacing * width_pt / np.ptp(ax.get_xlim())
+        dots.set_sizes([side ** 2])
     path = Path(path) if path else out / FIGURE
     return save_figure(fig, path)

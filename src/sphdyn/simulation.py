@@ -28,6 +28,7 @@ from .deck import dump_resolved, load_deck
 from .guards import SimulationFailed
 from .io import (FrameWriter, History, atomic_write_text, particle_fields,
                  plot_history, read_checkpoint, write_checkpoint)
+from .analysis import window_mean_force
 from .io.plots import energy_columns, relative_drift
 from .model import build_model
 from .neighbours import max_neighbours, mean_neighbours
@@ -187,10 +188,16 @@ class Simulation:
             # energy term, not to E_kinetic (tiny in a quasi-static test)
             drift = relative_drift(h["E_total"], [h[c] for c in energy_columns(list(h))])
             summary["energy_error_max_rel"] = float(np.max(np.abs(drift)))
+        window = deck.output.force_window
         for w in s.model.walls:
             col = f"F_wall_{w.name}"
             if col in h and h[col].size:
                 summary[f"peak_{col}"] = float(np.max(h[col]))
+            if f"I_wall_{w.name}" in h and h[col].size:
+                summary[f"peak_{col}_mean"] = float(np.max(window_mean_force(
+                    h["time"], h[f"I_wall_{w.name}"], window)))
+        if s.model.walls:
+            summary["force_window"] = window
         return summary
 
 

@@ -111,6 +111,10 @@ class Solver:
         self.guard_work = np.zeros(n, dtype=np.int8)
         self.wall_totals = {w.name: np.zeros(3) for w in model.walls}
         self.wall_counts = {w.name: 0 for w in model.walls}
+        # impulse each wall has given the bodies so far [N s] (N s/m in 2D):
+        # the sum of F^n dt_kick over the kicks, so it equals the bodies'
+        # momentum change through the wall to round-off
+        self.wall_impulse = np.zeros((len(model.walls), 3))
         # contact stability limit of bulk-modulus springs (mass springs need none)
         self.dt_contact = np.inf
         for w in model.walls:
@@ -263,6 +267,8 @@ class Solver:
                           self.vmean)
         self.work_contact += wc
         self.work_external += we
+        for k, w in enumerate(model.walls):
+            self.wall_impulse[k] += self.wall_totals[w.name] * dt_kick
         # the Simulation keeps the records of steps 0, every, 2 every, ...
         record = self.energies(ke, dt,
                                swegle=self.step_count % self.history_every == 0)
@@ -319,10 +325,11 @@ class Solver:
         }
         if self.cnl is not None:
             rec["contacts_bodies"] = float(self.contact_count)
-        for w in self.model.walls:
+        for k, w in enumerate(self.model.walls):
             f = self.wall_totals[w.name]
             fn = float(f @ w.normal)
             rec[f"F_wall_{w.name}"] = fn
+            rec[f"I_wall_{w.name}"] = float(self.wall_impulse[k] @ w.normal)
             rec[f"F_wall_{w.name}_t"] = float(np.linalg.norm(f - fn * w.normal))
             rec[f"contacts_{w.name}"] = float(self.wall_counts[w.name])
             if w.velocity.any():
@@ -337,7 +344,8 @@ class Solver:
                 "work_external": self.work_external}
 
     def state_arrays(self) -> dict:
-        out = {"a_contact": self.a_contact, "B": self.B, "dedt_av": self.dedt_av}
+        out = {"a_contact": self.a_contact, "B": self.B, "dedt_av": self.dedt_av,
+               "wall_impulse": self.wall_impulse}
         if self.tl is not None:  # the reference configuration may have been updated
             out.update({"tl_X": self.tl.X, "tl_rho_ref": self.tl.rho_ref})
         lists = {"nl": self.nl} if self.cnl is None else {"nl": self.nl, "cnl": self.cnl}
@@ -359,6 +367,8 @@ class Solver:
         self.a_contact[...] = arrays["a_contact"]
         self.B[...] = arrays["B"]
         self.dedt_av[...] = arrays["dedt_av"]
+        if "wall_impulse" in arrays:  # absent in checkpoints before 2026-11-23
+            self.wall_impulse[...] = arrays["wall_impulse"]
         for key in ("nl", "cnl"):
             nl = getattr(self, key)
             if nl is not None:

@@ -1293,6 +1293,12 @@ class Output(Section):
                         "forces).")
     checkpoint_every: integer("step count", lo=0) = Field(
         0, description="Steps between checkpoints (0 = off).")
+    force_window: quantity(TIME, "force averaging window", lo=0, lo_open=True) = Field(
+        5e-6, description="Window of the averaged wall force: summary.json and "
+                          "the ensemble table report, next to the raw peak, the "
+                          "peak of the mean force over this window (from the "
+                          "wall impulse I_wall_<name>), which removes the "
+                          "penalty spring's oscillation.")
     progress: StrictBool = Field(True, description="Show a progress bar.")
 
 
