@@ -430,3 +430,27 @@ def test_thesis_two_boxes(gap_in_dx, interacts):
         assert abs(py) > 1e-6 * scale
     else:
         assert py == 0.0
+
+
+def test_default_guard_box_has_the_same_margin_in_every_direction():
+    # A flat 3D plate (100 x 100 x 10 mm): the default box (margin 1) is
+    # expanded by 1 x the largest side (100 mm) on every side, also through
+    # the thickness, so debris squeezed out of the flat faces does not stop
+    # the run after 10 mm. Exact: corners are sums of lattice coordinates.
+    deck = loads_deck(f"""
+[run]
+dimension = 3
+t_end = 1e-3
+{ELASTIC.format(rho=2400.0, E=30e9, nu=0.2)}
+[[body]]
+name = "plate"
+material = "m"
+dx = 0.01
+geometry = {{ shape = "box", lo = [0, 0, 0], hi = [0.1, 0.1, 0.01] }}
+""")
+    model = build_model(deck)
+    x = model.particles.x
+    lo_b, hi_b = x.min(axis=0), x.max(axis=0)
+    side = np.max(hi_b - lo_b)
+    assert np.allclose(lo_b - model.domain_lo, side, rtol=1e-12, atol=0)
+    assert np.allclose(model.domain_hi - hi_b, side, rtol=1e-12, atol=0)

@@ -272,7 +272,9 @@ def build_model(deck) -> Model:
 
     lo_b = particles.x.min(axis=0)
     hi_b = particles.x.max(axis=0)
-    size = np.maximum(hi_b - lo_b, particles.h.max())
+    # the same distance on every side: a thin body (the paper's disc is 20 mm
+    # deep) must not get a thin box, or debris squeezed out sideways stops it
+    size = max(float(np.max(hi_b - lo_b)), float(particles.h.max()))
     lo = lo_b - deck.domain.margin * size if deck.domain.lo is None else np.asarray(
         deck.domain.lo, float)
     hi = hi_b + deck.domain.margin * size if deck.domain.hi is None else np.asarray(

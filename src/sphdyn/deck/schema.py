@@ -491,8 +491,8 @@ class Domain(Section):
         None, description="Upper corner (absent: from the bodies and margin).")
     margin: real("margin", lo=0) = Field(
         1.0, description="For an absent corner: the initial bounding box of "
-                         "the bodies expanded by margin times its size on "
-                         "each side.")
+                         "the bodies expanded on each side by margin times its "
+                         "largest side (the same distance in every direction).")
 
     @field_validator("hi")
     @classmethod
