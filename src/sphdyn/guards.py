@@ -23,7 +23,7 @@ class SimulationFailed(RuntimeError):
         self.diagnosis = diagnosis
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def _flags(x, v, a, sig, rho, lo, hi, out):
     n = x.shape[0]
     bad = 0

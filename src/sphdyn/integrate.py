@@ -28,7 +28,7 @@ from numba import njit, prange
 from .state import BC_FIXED, BC_VELOCITY
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def kick(v, a, a_contact, m, bc, bc_v, dt_kick, v_out_mean):
     r"""Velocity kick with boundary conditions and energy bookkeeping.
 
@@ -85,7 +85,7 @@ def kick(v, a, a_contact, m, bc, bc_v, dt_kick, v_out_mean):
     return ke, wc, we
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def drift(x, v, dt):
     """Position update ``x += dt * v`` (in place); ``x``, ``v`` (N, 3)."""
     n = x.shape[0]
@@ -95,7 +95,7 @@ def drift(x, v, dt):
         x[i, 2] += dt * v[i, 2]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def cfl_time_step(h, c, v, scale, cfl):
     r"""CFL-limited time step.
 
@@ -118,7 +118,7 @@ def cfl_time_step(h, c, v, scale, cfl):
     return cfl * best, k
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def internal_energies(m, e, e_av):
     """Total internal energy and its artificial-viscosity part [J]."""
     s = 0.0
@@ -129,7 +129,7 @@ def internal_energies(m, e, e_av):
     return s, s_av
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def add_heat(e, e_av, dedt_av, dt):
     """Add viscous heating ``dt * dedt_av`` to ``e`` and ``e_av`` (N,) in place."""
     for i in range(e.shape[0]):

@@ -153,7 +153,7 @@ def support(kid: int) -> float:
     return _Q_MAX[_check_kid(kid)]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def support_nb(kid):
     """Numba version of :func:`support` (``kid`` int -> ``q_max`` float)."""
     if kid == 0:
@@ -196,7 +196,7 @@ def normalisation(kid: int, dim: int) -> float:
     return _SIGMA[kid][dim - 1]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def w(kid, q):
     """Unnormalised kernel shape function ``w(q)``, zero for ``q >= q_max``.
 
@@ -256,7 +256,7 @@ def w(kid, q):
     return math.nan  # unknown id: rejected in Python by kernel_id(); NaN is caught by the guards
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def dwdq(kid, q):
     """First derivative ``dw/dq`` of the shape function, zero for ``q >= q_max``.
 
@@ -318,7 +318,7 @@ def dwdq(kid, q):
     return math.nan  # unknown id: rejected in Python by kernel_id(); NaN is caught by the guards
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def d2wdq2(kid, q):
     """Second derivative ``d2w/dq2`` of the shape function, zero for ``q >= q_max``.
 
@@ -382,7 +382,7 @@ def d2wdq2(kid, q):
     return math.nan  # unknown id: rejected in Python by kernel_id(); NaN is caught by the guards
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def dwdq_over_q(kid, q):
     """``w'(q) / q`` evaluated without cancellation, with its limit at ``q = 0``.
 
@@ -442,7 +442,7 @@ def dwdq_over_q(kid, q):
     return math.nan  # unknown id: rejected in Python by kernel_id(); NaN is caught by the guards
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def kernel_value(kid, sigma, dim, r, h):
     """Kernel value ``W(r, h) = sigma_d / h^d * w(r/h)``.
 
@@ -467,7 +467,7 @@ def kernel_value(kid, sigma, dim, r, h):
     return sigma / h**dim * w(kid, r / h)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def grad_factor(kid, sigma, dim, r, h):
     """Scalar ``F`` with ``grad_i W(x_i - x_j, h) = F * (x_i - x_j)``.
 
@@ -497,7 +497,7 @@ def grad_factor(kid, sigma, dim, r, h):
     return sigma / h ** (dim + 2) * dwdq_over_q(kid, r / h)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def second_derivative(kid, sigma, dim, r, h):
     """Second radial derivative ``d2W/dr2 = sigma_d / h^(d+2) * w''(r/h)``.
 

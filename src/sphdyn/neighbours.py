@@ -183,7 +183,7 @@ class NeighbourList:
 # Numba kernels
 # ---------------------------------------------------------------------------
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _cell_coord(xa, lo, inv_cs, n):
     """Cell index along one axis, clamped to [0, n - 1]."""
     c = int(math.floor((xa - lo) * inv_cs))
@@ -194,7 +194,7 @@ def _cell_coord(xa, lo, inv_cs, n):
     return c
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _bin_particles(x, h, grid_ids, lo, inv_cs, nc, dim):
     """Counting sort of the grid particles by flat cell index.
 
@@ -258,7 +258,7 @@ def _bin_particles(x, h, grid_ids, lo, inv_cs, nc, dim):
     return cell_start, order, xs, ys, zs, hs
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _stencil(i, x, h, dim, half_rf, skin, r_grid, lo, inv_cs, nc, h_cut):
     """Cell ranges ``(x0, x1, y0, y1, z0, z1)`` (inclusive) scanned by ``i``.
 
@@ -281,7 +281,7 @@ def _stencil(i, x, h, dim, half_rf, skin, r_grid, lo, inv_cs, nc, h_cut):
             min(cy + k, ny - 1), max(cz - k, 0), min(cz + k, nz - 1))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _count_row(i, s_self, x, h, dim, half_rf, skin, r_grid, lo, inv_cs, nc,
                cell_start, xs, ys, zs, hs, h_cut, big):
     """Number of neighbours of particle ``i``.
@@ -344,7 +344,7 @@ def _cttz(typingctx, v):
     return sig, codegen
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _collect_row(i, s_self, buf, x, h, dim, half_rf, skin, r_grid, lo,
                  inv_cs, nc, cell_start, order, xs, ys, zs, hs, h_cut, big):
     """Write the neighbours of ``i`` (unsorted) to ``buf``; return how many.
@@ -412,7 +412,7 @@ def _collect_row(i, s_self, buf, x, h, dim, half_rf, skin, r_grid, lo,
     return n
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _sift_down(a, lo, root, end):
     """Restore the max-heap property of ``a[lo:lo + end]`` below ``root``."""
     v = a[lo + root]
@@ -429,7 +429,7 @@ def _sift_down(a, lo, root, end):
     a[lo + root] = v
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _heap_sort(a, lo, hi):
     """Sort ``a[lo:hi]`` ascending in place (heap sort: O(n log n), no
     recursion, no allocation)."""
@@ -443,7 +443,7 @@ def _heap_sort(a, lo, hi):
         _sift_down(a, lo, 0, end)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _sorted_store(buf, n, out, pos):
     """Store the ``n`` distinct values of ``buf`` sorted into ``out[pos:]``.
 
@@ -463,7 +463,7 @@ def _sorted_store(buf, n, out, pos):
         _heap_sort(out, pos, pos + n)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def _count_rows(visit, n_grid, counts, x, h, dim, half_rf, skin, r_grid, lo,
                 inv_cs, nc, cell_start, order, xs, ys, zs, hs, h_cut, big):
     """Pass 1: ``counts[i + 1]`` = number of neighbours of ``i``.
@@ -479,7 +479,7 @@ def _count_rows(visit, n_grid, counts, x, h, dim, half_rf, skin, r_grid, lo,
                                    zs, hs, h_cut, big)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def _fill_rows(visit, n_grid, offsets, idx, max_row, x, h, dim, half_rf, skin,
                r_grid, lo, inv_cs, nc, cell_start, order, xs, ys, zs, hs,
                h_cut, big):
@@ -509,7 +509,7 @@ def _fill_rows(visit, n_grid, offsets, idx, max_row, x, h, dim, half_rf, skin,
     return bad
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def _max_disp_dh(x, x_ref, h, h_ref, active, use_active, dim):
     """Max squared displacement and max increase of h over active particles.
 
@@ -540,7 +540,7 @@ def _max_disp_dh(x, x_ref, h, h_ref, active, use_active, dim):
     return md2, mdh
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _mask_changed(active, active_ref):
     """True if ``active != 0`` differs from the bool mask ``active_ref``."""
     for i in range(active.shape[0]):

@@ -25,7 +25,7 @@ import numpy as np
 from numba import njit, prange
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def particle_contact(x, m, size, kbulk, body, dim, offsets, idx, alpha, dist_factor,
                      a_contact):
     """Add inter-body contact accelerations to ``a_contact`` (N, 3) [m/s^2].

@@ -42,7 +42,7 @@ STIFFNESS_MASS = 0
 STIFFNESS_BULK = 1
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def wall_contact(x, v, m, vol0, rho, kbulk, dim, point, normal, wall_v,
                  thickness_factor, method, alpha, friction, dt, a_contact, force):
     r"""Penalty contact accelerations of one rigid wall (gather form).

@@ -124,7 +124,7 @@ def _check_grading(grading, max_aggregate_size):
     return sorted(classes, key=lambda c: -c[0])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _greedy_select(order, cell, weight, cap, target, selected):
     """Take points in `order` until the weight reaches `target`, at most
     `cap` points per cell. Returns the weight taken."""

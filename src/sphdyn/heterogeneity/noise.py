@@ -98,12 +98,12 @@ def permutation_tables(seed: int, count: int) -> np.ndarray:
     return out
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def _fade(t):
     return t * t * t * (t * (t * 6.0 - 15.0) + 10.0)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def _grad(h, x, y, z):
     # dot product with one of the 12 cube-edge vectors (Perlin 2002)
     h = h & 15
@@ -117,7 +117,7 @@ def _grad(h, x, y, z):
     return (u if (h & 1) == 0 else -u) + (v if (h & 2) == 0 else -v)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _perlin(x, y, z, p):
     fx = np.floor(x)
     fy = np.floor(y)
@@ -153,7 +153,7 @@ def _perlin(x, y, z, p):
     return m1 + w * (m2 - m1)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def _fbm_kernel(pts, scale, tables, offsets, persistence, lacunarity, ridged,
                 out):
     n = pts.shape[0]
@@ -223,7 +223,7 @@ def fbm(points, *, feature_size: float, octaves: int = 4,
     return out
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def _mix64(z):
     # splitmix64 finaliser (Steele, Lea & Flood 2014), uint64 arithmetic
     z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
@@ -231,7 +231,7 @@ def _mix64(z):
     return z ^ (z >> np.uint64(31))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def _seed_pos(i, j, k, key, jitter, dim):
     # seed of cell (i, j, k) in cell units; indices are shifted positive
     h = (np.uint64(i + 1048576) * np.uint64(0x9E3779B97F4A7C15)
@@ -250,7 +250,7 @@ def _seed_pos(i, j, k, key, jitter, dim):
     return sx, sy, sz
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def _seed_table(lo, shape, key, jitter, dim, out):
     # seed positions (cell units) of the cells lo + (0..shape-1)
     for a in prange(shape[0]):
@@ -263,14 +263,14 @@ def _seed_table(lo, shape, key, jitter, dim, out):
                 out[a, b, c, 2] = sz
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def _box_d1(p, i, half):
     # distance along one axis from p to the interval that can hold the seed
     # of cell i (cell units)
     return max(i + 0.5 - half - p, 0.0, p - (i + 0.5 + half))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def _nearest(px, py, pz, cx, cy, cz, r, rz, half, seeds, lo, best, bi, bj,
              bk):
     # nearest seed among cells within +-r (+-rz in z) of cell c, starting
@@ -297,7 +297,7 @@ def _nearest(px, py, pz, cx, cy, cz, r, rz, half, seeds, lo, best, bi, bj,
     return best, bi, bj, bk
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def _bisector(px, py, pz, cx, cy, cz, r, rz, half, seeds, lo, best, bi, bj,
               bk, bound, tau):
     # min over seeds b != a of the distance d_b to the bisector plane of a, b
@@ -354,7 +354,7 @@ def _bisector(px, py, pz, cx, cy, cz, r, rz, half, seeds, lo, best, bi, bj,
     return m, m
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def _cellular_kernel(pts, inv_c, origin, seeds, lo, jitter, dim, tau, f1,
                      dface, dsoft, cell):
     n = pts.shape[0]

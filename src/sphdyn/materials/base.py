@@ -230,7 +230,7 @@ def pack_common(values: dict) -> list[float]:
 # --------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def to_sym6(a):
     """Symmetric part of a 3x3 array as ``(xx, yy, zz, xy, yz, xz)``."""
     return (a[0, 0], a[1, 1], a[2, 2],
@@ -239,7 +239,7 @@ def to_sym6(a):
             0.5 * (a[0, 2] + a[2, 0]))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def to_mat33(s):
     """New 3x3 array from a symmetric 6-tuple (allocates; not for hot loops)."""
     a = np.empty((3, 3))
@@ -252,13 +252,13 @@ def to_mat33(s):
     return a
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def load_sym6(t, i):
     """Row ``i`` of a symmetric ``(N, 3, 3)`` field as a 6-tuple (upper triangle)."""
     return (t[i, 0, 0], t[i, 1, 1], t[i, 2, 2], t[i, 0, 1], t[i, 1, 2], t[i, 0, 2])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def store_sym6(t, i, s):
     """Write a 6-tuple into row ``i`` of an ``(N, 3, 3)`` field (both triangles)."""
     t[i, 0, 0] = s[0]
@@ -272,7 +272,7 @@ def store_sym6(t, i, s):
     t[i, 2, 0] = s[5]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def rate_split(L, i):
     """Rate of deformation and spin of particle ``i``.
 
@@ -289,26 +289,26 @@ def rate_split(L, i):
     return d, w
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def scale6(s, f):
     """``f * s`` for a 6-tuple."""
     return (f * s[0], f * s[1], f * s[2], f * s[3], f * s[4], f * s[5])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def trace6(s):
     """Trace ``s_kk`` of a symmetric 6-tuple."""
     return s[0] + s[1] + s[2]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def ddot6(a, b):
     """Double contraction ``a : b = a_ij b_ij`` of two symmetric 6-tuples."""
     return (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
             + 2.0 * (a[3] * b[3] + a[4] * b[4] + a[5] * b[5]))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def jaumann_rotate(s, w, dt):
     """Objective (Jaumann) rotation of a symmetric tensor over one step.
 
@@ -353,7 +353,7 @@ def jaumann_rotate(s, w, dt):
             sxz + dt * (a02 + a20))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def deviatoric_split(s):
     """Split ``s = dev + m I`` with ``m = tr(s)/3``.
 
@@ -368,7 +368,7 @@ def deviatoric_split(s):
     return (s[0] - m, s[1] - m, s[2] - m, s[3], s[4], s[5]), m
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def von_mises(s):
     """Von Mises equivalent stress ``q = sqrt(3 J2) = sqrt(3/2 dev:dev)`` [Pa].
 
@@ -378,7 +378,7 @@ def von_mises(s):
     return math.sqrt(1.5 * ddot6(dev, dev))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def energy_increment(s_old, s_new, d, dt, rho):
     """Specific internal energy increment of one step [J/kg].
 
@@ -405,7 +405,7 @@ def energy_increment(s_old, s_new, d, dt, rho):
     return 0.5 * dt * (ddot6(s_old, d) + ddot6(s_new, d)) / rho
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def p_wave_speed(K, G, rho):
     """``sqrt((K + 4G/3)/rho)`` [m/s]; 0 for ``rho <= 0``."""
     if rho <= 0.0:

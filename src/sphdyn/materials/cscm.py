@@ -113,7 +113,7 @@ DMAX = 0.999  # maximum damage in unconfined states [R] (notes sec. 1.9)
 # --------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def shear_surface(J1, p):
     """TXC shear failure surface ``Ff(J1) = alpha - lamda exp(-beta J1) + theta J1``.
 
@@ -133,7 +133,7 @@ def shear_surface(J1, p):
     return p[P_ALPHA] - p[P_LAMDA] * math.exp(-p[P_BETA] * J1) + p[P_THETA] * J1
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def rubin_q(J1, p):
     """Strength ratios ``Q1 = TOR/TXC`` and ``Q2 = TXE/TXC``.
 
@@ -152,7 +152,7 @@ def rubin_q(J1, p):
     return q1, q2
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def rubin_factor(q1, q2, bhat):
     """Rubin three-invariant reduction factor ``Rub(beta_hat)``.
 
@@ -179,7 +179,7 @@ def rubin_factor(q1, q2, bhat):
     return _rubin_cs(q1, q2, math.cos(bhat), math.sin(bhat))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _rubin_cs(q1, q2, cb, sb):
     """:func:`rubin_factor` with ``cos(beta_hat)``, ``sin(beta_hat)`` given."""
     a0 = 2.0 * q1 * q1 * (q2 - 1.0)
@@ -194,7 +194,7 @@ def _rubin_cs(q1, q2, cb, sb):
     return (-b1 + math.sqrt(max(b1 * b1 - 4.0 * b2 * b0, 0.0))) / (2.0 * b2)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _j2_j3(dev):
     """``J2' = dev:dev/2`` and ``J3' = det(dev)`` of a deviator 6-tuple."""
     J3 = (dev[0] * (dev[1] * dev[2] - dev[4] * dev[4])
@@ -203,7 +203,7 @@ def _j2_j3(dev):
     return 0.5 * ddot6(dev, dev), J3
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def invariants(s):
     """Invariants of a tension-positive stress 6-tuple in CSCM convention.
 
@@ -237,7 +237,7 @@ def invariants(s):
     return -3.0 * m, r, bhat, dev
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def cap_function(J1, kappa, p):
     """Elliptical cap ``Fc(J1, kappa)`` and cap location ``X(kappa)``.
 
@@ -257,7 +257,7 @@ def cap_function(J1, kappa, p):
     return (fc if fc > 0.0 else 0.0), X
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def cap_from_compaction(ev, p):
     """Cap location ``X`` from the plastic volume compaction ``ev``.
 
@@ -280,7 +280,7 @@ def cap_from_compaction(ev, p):
     return p[P_X0] + y
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def kappa_from_cap(X, kguess, p):
     """Solve ``X = kappa + R Ff(kappa)`` for ``kappa`` (Newton, monotone).
 
@@ -298,7 +298,7 @@ def kappa_from_cap(X, kguess, p):
     return k
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def surface_radius(J1, bhat, kappa, p):
     """``sqrt(J2')`` on the yield surface: ``Rub Ff sqrt(Fc)`` (0 outside
     ``[J1_apex, X]``). Yield function ``f = J2' - Rub^2 Ff^2 Fc`` (notes
@@ -306,7 +306,7 @@ def surface_radius(J1, bhat, kappa, p):
     return _radius(J1, meridian(bhat, kappa, p), p)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def meridian(bhat, kappa, p):
     """Constants of the meridian ``F(J1)`` at fixed Lode angle and cap:
     ``(cos beta_hat, sin beta_hat, L(kappa), X(kappa))`` (see
@@ -315,7 +315,7 @@ def meridian(bhat, kappa, p):
     return math.cos(bhat), math.sin(bhat), L, L + p[P_R] * shear_surface(L, p)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _radius(J1, m, p):
     """:func:`surface_radius` with the meridian constants ``m`` of :func:`meridian`."""
     cb, sb, L, X = m
@@ -332,7 +332,7 @@ def _radius(J1, m, p):
     return r * math.sqrt(max(1.0 - t * t, 0.0))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def yield_function(s, kappa, p):
     """``f = J2' - Rub^2 Ff^2 Fc`` of a tension-positive stress 6-tuple [Pa^2].
 
@@ -347,7 +347,7 @@ def yield_function(s, kappa, p):
     return r * r - F * F
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _j1_radius(s):
     """``(J1, sqrt(J2'))`` of a stress 6-tuple (CSCM convention, see
     :func:`invariants`), without the Lode angle."""
@@ -357,7 +357,7 @@ def _j1_radius(s):
     return -3.0 * m, math.sqrt(J2)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def project(J1t, rt, bhat, kappa, K, G, p):
     """Closest point of the yield surface to a trial point, energy norm.
 
@@ -385,7 +385,7 @@ def project(J1t, rt, bhat, kappa, K, G, p):
     return _project(J1t, rt, meridian(bhat, kappa, p), K, G, p)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _project(J1t, rt, m, K, G, p):
     """:func:`project` with the meridian constants ``m`` of :func:`meridian`."""
     X = m[3]
@@ -419,7 +419,7 @@ def _project(J1t, rt, m, K, G, p):
     return _project_global(J1t, rt, m, K, G, p)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _refine(lo, hi, gl, gh, J1t, rt, m, K, G, p):
     """Root of ``dphi/dJ1`` in ``[lo, hi]`` with ``gl < 0 < gh`` (Illinois regula falsi).
 
@@ -450,7 +450,7 @@ def _refine(lo, hi, gl, gh, J1t, rt, m, K, G, p):
     return mid
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def project_global(J1t, rt, bhat, kappa, K, G, p):
     """Closest point of the yield surface to a trial point, energy norm (global search).
 
@@ -470,7 +470,7 @@ def project_global(J1t, rt, bhat, kappa, K, G, p):
     return _project_global(J1t, rt, meridian(bhat, kappa, p), K, G, p)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _project_global(J1t, rt, m, K, G, p):
     """:func:`project_global` with the meridian constants ``m``."""
     X = m[3]
@@ -526,7 +526,7 @@ def _project_global(J1t, rt, m, K, G, p):
     return J1, _radius(J1, m, p)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _dphi_slope(J1, J1t, rt, m, K, G, p):
     """Half the derivative of the projection distance ``phi`` (see
     :func:`project`), ``(J1 - J1t)/(9K) + (F - rt) F'/G``, and the meridian
@@ -542,13 +542,13 @@ def _dphi_slope(J1, J1t, rt, m, K, G, p):
     return (J1 - J1t) / (9.0 * K) + (F - rt) * dF / G, dF
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _dphi(J1, J1t, rt, m, K, G, p):
     """Half the derivative of the projection distance ``phi`` (see :func:`project`)."""
     return _dphi_slope(J1, J1t, rt, m, K, G, p)[0]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _yield_fraction(s0, s1, kappa, p):
     """Fraction ``a`` in [0, 1] where ``s0 + a (s1 - s0)`` reaches the yield
     surface (bisection, 50 halvings; 0 if ``s0`` is already outside)."""
@@ -573,7 +573,7 @@ def _yield_fraction(s0, s1, kappa, p):
 # --------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def transition(J1, r, pwr):
     """``trans = (|J1| / sqrt(3 J2'))^pwr`` clipped to [0, 1] (notes sec. 1.10 [R]).
 
@@ -587,7 +587,7 @@ def transition(J1, r, pwr):
     return x ** pwr
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def brittle_softening_c(r0t, size, gf, D):
     """Brittle softening parameter ``C = r0t L (1+D) ln(1+D) / (D GF)``.
 
@@ -598,7 +598,7 @@ def brittle_softening_c(r0t, size, gf, D):
     return r0t * size * (1.0 + D) * math.log(1.0 + D) / (D * gf)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def ductile_softening_a(r0c, size, gf, B, li2mb):
     """Ductile softening parameter ``A`` (positive root of the quadratic).
 
@@ -613,7 +613,7 @@ def ductile_softening_a(r0c, size, gf, B, li2mb):
     return (bq + math.sqrt(bq * bq - 4.0 * gf * cq)) / (2.0 * gf)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def logistic_damage(tau, r0, rate, shape, dmax):
     """``d = (dmax/S) [(1 + S)/(1 + S exp(-k (tau - r0))) - 1]`` for tau > r0.
 
@@ -625,7 +625,7 @@ def logistic_damage(tau, r0, rate, shape, dmax):
     return dmax / shape * ((1.0 + shape) / (1.0 + shape * math.exp(-rate * (tau - r0))) - 1.0)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def max_principal(e):
     """Largest eigenvalue of a symmetric 6-tuple (trigonometric formula)."""
     m = (e[0] + e[1] + e[2]) / 3.0
@@ -649,7 +649,7 @@ def max_principal(e):
 # --------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def cscm_point(h, deps, dt, p, size):
     """CSCM update of one material point (state in the history row ``h``).
 
@@ -870,7 +870,7 @@ def cscm_point(h, deps, dt, p, size):
     return scale6(svp, 1.0 - d), d
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def cscm_update(idx, L, dt, rho, sig, e, c, damage, hist, params, size):
     """Group kernel of the CSCM model (common kernel signature).
 
@@ -893,7 +893,7 @@ def cscm_update(idx, L, dt, rho, sig, e, c, damage, hist, params, size):
             _update_particle(idx[k], L, dt, rho, sig, e, c, damage, hist, params, size)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _update_particle(i, L, dt, rho, sig, e, c, damage, hist, params, size):
     """One particle of :func:`cscm_update`."""
     K = params[P_K]

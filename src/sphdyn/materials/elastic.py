@@ -34,7 +34,7 @@ from .base import (
 )
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def elastic_increment(s, d, K, G):
     """Hooke increment on 6-tuples: ``s + lambda tr(d) I + 2 G d``.
 
@@ -61,7 +61,7 @@ def elastic_increment(s, d, K, G):
             s[5] + g2 * d[5])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def elastic_point(sig, deps, K, G):
     """Hypoelastic update of one material point.
 
@@ -84,7 +84,7 @@ def elastic_point(sig, deps, K, G):
     return to_mat33(elastic_increment(to_sym6(sig), to_sym6(deps), K, G))
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def elastic_update(idx, L, dt, rho, sig, e, c, damage, hist, params, size):
     """Group kernel of the hypoelastic model (common kernel signature).
 

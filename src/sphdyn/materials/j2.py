@@ -58,7 +58,7 @@ P_YIELD = N_COMMON
 P_HARDENING = N_COMMON + 1
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def j2_return(s, d, K, G, sigma_y, H, eps_p):
     """Elastic predictor and radial return on 6-tuples.
 
@@ -97,7 +97,7 @@ def j2_return(s, d, K, G, sigma_y, H, eps_p):
     return s_new, eps_p + d_gamma
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def j2_point(sig, deps, K, G, sigma_y, H, eps_p):
     """J2 radial-return update of one material point.
 
@@ -128,7 +128,7 @@ def j2_point(sig, deps, K, G, sigma_y, H, eps_p):
     return to_mat33(s_new), ep
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def j2_update(idx, L, dt, rho, sig, e, c, damage, hist, params, size):
     """Group kernel of the J2 model (common kernel signature).
 

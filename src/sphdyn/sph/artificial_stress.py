@@ -59,7 +59,7 @@ __all__ = ["artificial_stress_tensor", "artificial_stress_forces"]
 _MAX_SWEEPS = 12
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def artificial_stress_tensor(sig, rho, eps, R, Q):
     r"""Artificial stress :math:`R_i` (N, 3, 3) [Pa m^6/kg^2] of every particle.
 
@@ -136,7 +136,7 @@ def artificial_stress_tensor(sig, rho, eps, R, Q):
                 A[b, a] = val
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def artificial_stress_forces(x, m, h, R, F, offsets, idx, kid, dim, kscale, spacing,
                              n_exp, a, v, dedt):
     r"""Add the artificial-stress acceleration to ``a`` (gather form).

@@ -32,14 +32,14 @@ from ..kernels import dwdq_over_q, kernel_value, support_nb
 _DET_TOL = 1e-6
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def particle_volumes(m, rho, vol):
     """``vol = m / rho`` [m^3] (N,), the particle volumes used as quadrature weights."""
     for i in prange(m.shape[0]):
         vol[i] = m[i] / rho[i]
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def scaled_stress(sig, rho, S):
     """``S = sigma / rho^2`` (N, 3, 3) [Pa m^6/kg^2], the stress term of the momentum sum."""
     for i in prange(sig.shape[0]):
@@ -49,7 +49,7 @@ def scaled_stress(sig, rho, S):
                 S[i, a, b] = sig[i, a, b] * r2
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def velocity_gradient(x, v, h, vol, offsets, idx, kid, sigma, dim, kscale, correct,
                       F, L, B):
     r"""Velocity gradient with optional Randles-Libersky renormalisation.
@@ -195,7 +195,7 @@ def velocity_gradient(x, v, h, vol, offsets, idx, kid, sigma, dim, kscale, corre
         B[i, 2, 2] = q22
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def forces(x, v, m, rho, h, c, S, B, F, offsets, idx, dim, kscale, correct, alpha,
            beta, a, dedt_av):
     r"""Acceleration from the stress divergence and Monaghan artificial viscosity.
@@ -337,7 +337,7 @@ def forces(x, v, m, rho, h, c, S, B, F, offsets, idx, dim, kscale, correct, alph
         dedt_av[i] = heat
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def xsph_velocity(x, v, m, rho, h, offsets, idx, kid, sigma, dim, kscale, eps,
                   vs):
     r"""XSPH smoothed transport velocity (Monaghan 1992, eq. 4.3).
@@ -369,7 +369,7 @@ def xsph_velocity(x, v, m, rho, h, offsets, idx, kid, sigma, dim, kscale, eps,
         vs[i, 2] = v[i, 2] + eps * s2
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def update_density_and_h(L, dt, dim, benz, h0, hmin_factor, hmax_factor, rho, h):
     r"""Continuity equation and Benz smoothing-length evolution.
 

@@ -56,7 +56,7 @@ REL_STRESS_TOL = 1e-3
 FLAG_FRACTION = 0.5
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def stress_scale(sig, m):
     """Largest Frobenius norm ``max_k ||sigma_k||_F`` [Pa] over particles with ``m > 0``."""
     smax = 0.0
@@ -72,7 +72,7 @@ def stress_scale(sig, m):
     return np.sqrt(smax)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def swegle_indicator(x, m, h, sig, offsets, idx, kid, sigma, dim, kscale, tol, out):
     r"""Fraction of unstable neighbour pairs per particle (Swegle et al. 1995).
 
@@ -126,7 +126,7 @@ def swegle_indicator(x, m, h, sig, offsets, idx, kid, sigma, dim, kscale, tol, o
         out[i] = bad / total if total > 0 else 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def count_unstable(s, m, threshold):
     """Number of particles with ``m > 0`` and indicator ``s > threshold``."""
     c = 0

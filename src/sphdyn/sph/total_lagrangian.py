@@ -44,7 +44,7 @@ _DET_TOL = 1e-12
 PAIR_FASTMATH = {"reassoc", "contract", "arcp", "nsz"}
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _inverse3(a00, a01, a02, a10, a11, a12, a20, a21, a22, out):
     """Inverse of a 3x3 matrix into ``out`` (3, 3); identity if singular."""
     c00 = a11 * a22 - a12 * a21
@@ -69,7 +69,7 @@ def _inverse3(a00, a01, a02, a10, a11, a12, a20, a21, a22, out):
     return det
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def reference_gradients(X, h0, vol, offsets, idx, kid, sigma, dim, kscale, fac, w, B0,
                         gsum):
     r"""Reference kernel factors, kernel values, correction matrices and gradient sums.
@@ -153,7 +153,7 @@ def reference_gradients(X, h0, vol, offsets, idx, kid, sigma, dim, kscale, fac, 
         gsum[i, 2] = s2
 
 
-@njit(cache=True, parallel=True, fastmath=PAIR_FASTMATH)
+@njit(cache=True, error_model="numpy", parallel=True, fastmath=PAIR_FASTMATH)
 def deformation_gradient(rows, x, v, X, vol, offsets, idx, fac, B0, dim, Fdef, Finv, L):
     r"""Deformation gradient and velocity gradient from the reference kernel.
 
@@ -247,7 +247,7 @@ def deformation_gradient(rows, x, v, X, vol, offsets, idx, fac, B0, dim, Fdef, F
                           e00, e01, e02, e10, e11, e12, e20, e21, e22, B0, Fdef, Finv, L)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _finish_gradients(i, a00, a01, a02, a10, a11, a12, a20, a21, a22,
                       e00, e01, e02, e10, e11, e12, e20, e21, e22, B0, Fdef, Finv, L):
     r"""Row ``i`` of :func:`deformation_gradient` from the uncorrected sums A (``a..``)
@@ -277,7 +277,7 @@ def _finish_gradients(i, a00, a01, a02, a10, a11, a12, a20, a21, a22,
                 L[i, r, s] = 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _det(F, i):
     """Determinant of ``F[i]`` (3, 3)."""
     return (F[i, 0, 0] * (F[i, 1, 1] * F[i, 2, 2] - F[i, 1, 2] * F[i, 2, 1])
@@ -285,7 +285,7 @@ def _det(F, i):
             + F[i, 0, 2] * (F[i, 1, 0] * F[i, 2, 1] - F[i, 1, 1] * F[i, 2, 0]))
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def tl_density(rows, Fdef, rho0, h0, rho, h):
     r"""Mass balance of the total-Lagrangian scheme, :math:`\rho = \rho_0 / \det F`.
 
@@ -302,7 +302,7 @@ def tl_density(rows, Fdef, rho0, h0, rho, h):
         h[i] = h0[i]
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def piola_stress(rows, Fdef, Finv, sig, vol, B0, P, Q):
     r"""First Piola-Kirchhoff stress :math:`P = J \sigma F^{-T}`, :math:`J = \det F`,
     and its corrected, volume-weighted form :math:`Q = V P B`.
@@ -326,7 +326,7 @@ def piola_stress(rows, Fdef, Finv, sig, vol, B0, P, Q):
                                        + P[i, a, 2] * B0[i, 2, b])
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def _viscous_hourglass(fk, hk, d0, d1, d2, w0, w1, w2, s0, s1, s2, hij, csum, rhosum, mj,
                        av_alpha, av_beta):
     r"""Pair terms of :func:`tl_forces` beyond the stress: returns ``(mpf, coef)``.
@@ -349,7 +349,7 @@ def _viscous_hourglass(fk, hk, d0, d1, d2, w0, w1, w2, s0, s1, s2, hij, csum, rh
     return mj * pi_ij * fk, coef
 
 
-@njit(cache=True, parallel=True, fastmath=PAIR_FASTMATH)
+@njit(cache=True, error_model="numpy", parallel=True, fastmath=PAIR_FASTMATH)
 def tl_forces(rows, x, v, X, m, rho, rho0, c, h0, vol, offsets, idx, fac, hgk, gsum,
               P, Q, B0, Fdef, dim, av_alpha, av_beta, kscale, a, dedt_av):
     r"""Acceleration of the total-Lagrangian scheme with hourglass control.
@@ -535,7 +535,7 @@ def tl_forces(rows, x, v, X, m, rho, rho0, c, h0, vol, offsets, idx, fac, hgk, g
         dedt_av[i] = heat
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def hourglass_coefficients(rows, X, vol, offsets, idx, w, young, alpha, hgk):
     r"""Reference pair factors of Ganzenmüller's (2015) hourglass force.
 
