@@ -397,7 +397,8 @@ def test_plot_history_writes_pngs(tmp_path):
         ek = math.cos(1e4 * t) ** 2
         h.append({"time": t, "step": k, "dt": 1e-5 * (1 + 0.01 * k),
                   "E_kinetic": ek, "E_internal": 1.0 - ek, "W_external": 0.0,
-                  "E_total": 1.0 + 1e-4 * k, "F_wall_floor": 10.0 * k, "F_contact": -k})
+                  "E_total": 1.0 + 1e-4 * k, "F_wall_floor": 10.0 * k, "F_contact": -k,
+                  "I_wall_floor": 5.0 * k * k * 1e-5})
     csv_path = h.write_csv(tmp_path / "history.csv")
     out = tmp_path / "figs"
     paths = plot_history(csv_path, out)

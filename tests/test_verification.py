@@ -234,6 +234,24 @@ def test_wall_impulse_equals_the_momentum_change(stiffness, alpha, mu):
         records[-1]["dt"] + 1e-12 * scale
 
 
+def test_a_step_shortened_to_end_the_run_keeps_the_wall_spring_stiffness():
+    # The last step of a run is shortened to land on t_end. The mass-based
+    # spring k = alpha m / dt^2 (paper eq. 8) must use the stable step, or a
+    # step 100x shorter makes the wall force 1e4x larger (a false peak in
+    # every history and summary that ended in contact, and a huge kick after
+    # a restart). One step moves the penetrations by v dt only, so the force
+    # after the short step stays within 10 % of the force before it.
+    s, _ = _solver(_disc_on_wall("mass", 0.1))
+    while s.t < 0.4e-3:  # mid-contact (contact from 0.12 to 0.76 ms)
+        s.step()
+    before = s.wall_totals["floor"][1]
+    assert before > 0
+    dt = s._cfl()[0]
+    s.step(t_stop=s.t + 0.01 * dt)
+    after = s.wall_totals["floor"][1]
+    assert abs(after - before) < 0.1 * before, (before, after)
+
+
 def test_window_mean_force_of_a_spring_oscillation_is_its_mean():
     # F(t) = F0 (1 + sin(2 pi t / T)): I(t) = F0 t + F0 T (1 - cos(2 pi t/T)) / (2 pi).
     # Over a window of one period the mean is exactly F0 (records on a grid

@@ -89,8 +89,14 @@ def cmd_plot(args) -> int:
     if not args.snapshots:
         from .io import plot_history
 
+        from .deck.schema import Output
+
+        default = Output.model_fields["force_window"].default
         for d in args.dir:
-            for p in plot_history(Path(d) / "history.csv", Path(d) / "plots"):
+            summary = Path(d) / "summary.json"  # the run's window, if it wrote one
+            window = (json.loads(summary.read_text()).get("force_window", default)
+                      if summary.exists() else default)
+            for p in plot_history(Path(d) / "history.csv", Path(d) / "plots", window):
                 print(p)
         return 0
 

@@ -223,7 +223,7 @@ def sample_metrics(sim) -> dict:
       wall forces [N] (N/m in 2D); NaN without walls;
     * ``peak_contact_force_mean``: maximum of the same force averaged over
       ``[output] force_window`` (:func:`sphdyn.analysis.window_mean_force`),
-      free of the penalty spring's oscillation;
+      free of the spikes of first contact;
     * ``dissipated_energy``: internal energy at the end [J]: plastic and
       damage work, artificial-viscosity heat (also given alone as
       ``viscous_energy``) and the elastic energy still stored (small after

@@ -139,7 +139,8 @@ class Simulation:
         if failure is None:
             self._checkpoint()
         try:
-            plot_history(self.outdir / "history.csv", self.outdir / "plots")
+            plot_history(self.outdir / "history.csv", self.outdir / "plots",
+                         self.deck.output.force_window)
         except Exception as exc:  # plots must never lose a run
             print(f"warning: plotting failed: {exc}")
         summary = self._summary(start_step, failure)

@@ -163,6 +163,7 @@ class Solver:
         self.nl = build_neighbours(p.x, p.h, model.radius_factor, self.skin, self.dim,
                                    active=self.ul_active)
         self.dt0, _ = self._cfl()
+        self.dt_contact_step = self.dt0  # the step the contact springs use
         self._gradients()
         self._accelerations(self.dt0)
 
@@ -260,6 +261,9 @@ class Solver:
         p, model = self.p, self.model
         dt, k = self._cfl()
         check_time_step(dt, self.dt0, self.collapse_ratio, self.t, self.step_count, k, p)
+        # the contact springs use the stable step, not one shortened to end the
+        # run: k = alpha m / dt^2 (paper eq. 8) would grow by (dt / dt_short)^2
+        self.dt_contact_step = dt
         if t_stop is not None and self.t + dt > t_stop:
             dt = max(t_stop - self.t, 0.0)
         dt_kick = 0.5 * dt if self.step_count == 0 else 0.5 * (self.dt_prev + dt)
@@ -299,7 +303,7 @@ class Solver:
         for g in model.groups:
             g.model.update(g.idx, p.L, dt, p.rho, p.sig, p.e, p.c, p.damage, p.hist,
                            g.params, self.size)
-        self._accelerations(dt)
+        self._accelerations(self.dt_contact_step)
         add_heat(p.e, p.e_av, self.dedt_av, dt)
         check_particles(p, model.domain_lo, model.domain_hi, self.t, self.step_count,
                         self.guard_work)
@@ -340,7 +344,8 @@ class Solver:
     # ------------------------------------------------------------- checkpoint
     def state_scalars(self) -> dict:
         return {"t": self.t, "step": self.step_count, "dt_prev": self.dt_prev,
-                "dt0": self.dt0, "work_contact": self.work_contact,
+                "dt0": self.dt0, "dt_contact_step": self.dt_contact_step,
+                "work_contact": self.work_contact,
                 "work_external": self.work_external}
 
     def state_arrays(self) -> dict:
@@ -386,4 +391,6 @@ class Solver:
         self._swegle_step = -1
         # contact counts and wall totals of the restored state (they depend on
         # x, v and dt only; the accelerations themselves are in the checkpoint)
-        self._contact(self.dt_prev or self.dt0, np.zeros_like(self.a_contact))
+        self.dt_contact_step = float(scalars.get("dt_contact_step", 0.0)) or \
+            self.dt_prev or self.dt0  # absent in checkpoints before 2026-11-23
+        self._contact(self.dt_contact_step, np.zeros_like(self.a_contact))

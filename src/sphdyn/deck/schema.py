@@ -1297,8 +1297,8 @@ class Output(Section):
         5e-6, description="Window of the averaged wall force: summary.json and "
                           "the ensemble table report, next to the raw peak, the "
                           "peak of the mean force over this window (from the "
-                          "wall impulse I_wall_<name>), which removes the "
-                          "penalty spring's oscillation.")
+                          "wall impulse I_wall_<name>), which smooths the "
+                          "spikes of first contact.")
     progress: StrictBool = Field(True, description="Show a progress bar.")
 
 

@@ -72,14 +72,17 @@ def relative_drift(e_total: np.ndarray, energies: list[np.ndarray]) -> np.ndarra
 
 
 def plot_history(csv_path: str | os.PathLike,
-                 out_dir: str | os.PathLike | None = None) -> list[Path]:
+                 out_dir: str | os.PathLike | None = None,
+                 force_window: float = 5e-6) -> list[Path]:
     """Plot the history CSV of a run.
 
     Writes, when the needed columns exist:
 
     * ``energies.png``: every ``E_*``/``W_*`` column against ``time``, and the
       relative drift of ``E_total`` in a second panel;
-    * ``forces.png``: every ``F_*`` column against ``time``;
+    * ``forces.png``: every ``F_*`` column against ``time``, and for each
+      wall with an impulse column ``I_wall_<name>`` its force averaged over
+      ``force_window`` (:func:`sphdyn.analysis.window_mean_force`, dashed);
     * ``dt.png``: ``dt`` against ``step`` (or ``time`` if there is no step).
 
     Parameters
@@ -88,6 +91,9 @@ def plot_history(csv_path: str | os.PathLike,
         History CSV written by :meth:`sphdyn.io.history.History.write_csv`.
     out_dir : str or os.PathLike, optional
         Directory of the figures; default the directory of ``csv_path``.
+    force_window : float, optional
+        Averaging window of the wall forces [s] (the deck's
+        ``[output] force_window``; default 5 us).
 
     Returns
     -------
@@ -128,6 +134,12 @@ def plot_history(csv_path: str | os.PathLike,
         fig, (ax,) = _figure()
         for c in force_cols:
             ax.plot(time, data[c], label=c)
+        for c in columns:
+            if c.startswith("I_wall_") and f"F_wall_{c[7:]}" in data:
+                from ..analysis import window_mean_force
+
+                ax.plot(time, window_mean_force(time, data[c], force_window), "--",
+                        label=f"F_wall_{c[7:]}, {force_window * 1e6:g} us mean")
         ax.set_xlabel("time [s]")
         ax.set_ylabel("force [N] (N/m in 2D)")
         ax.set_title(f"Forces ({title})")
