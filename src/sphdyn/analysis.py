@@ -108,9 +108,8 @@ def window_mean_force(time, impulse, window: float) -> np.ndarray:
     solver accumulates every step, so the average is exact however sparsely
     the history is recorded; :math:`I(t - \tau)` is linearly interpolated
     between records and taken as 0 before the first one (no contact before
-    the run starts). A penalty wall spring oscillates with the period
-    :math:`2\pi\,\Delta t/\sqrt\alpha` (paper eq. 8); any window longer
-    than that removes the oscillation from the peak.
+    the run starts). A window of several steps smooths the spikes of the
+    penalty spring when a few particles first touch the wall.
 
     Parameters
     ----------

@@ -89,13 +89,10 @@ def cmd_plot(args) -> int:
     if not args.snapshots:
         from .io import plot_history
 
-        from .deck.schema import Output
-
-        default = Output.model_fields["force_window"].default
         for d in args.dir:
             summary = Path(d) / "summary.json"  # the run's window, if it wrote one
-            window = (json.loads(summary.read_text()).get("force_window", default)
-                      if summary.exists() else default)
+            window = (json.loads(summary.read_text()).get("force_window")
+                      if summary.exists() else None)
             for p in plot_history(Path(d) / "history.csv", Path(d) / "plots", window):
                 print(p)
         return 0

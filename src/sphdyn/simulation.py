@@ -194,9 +194,10 @@ class Simulation:
             col = f"F_wall_{w.name}"
             if col in h and h[col].size:
                 summary[f"peak_{col}"] = float(np.max(h[col]))
-            if f"I_wall_{w.name}" in h and h[col].size:
-                summary[f"peak_{col}_mean"] = float(np.max(window_mean_force(
-                    h["time"], h[f"I_wall_{w.name}"], window)))
+                impulse = h.get(f"I_wall_{w.name}")  # absent before 2026-11-23
+                if impulse is not None:
+                    summary[f"peak_{col}_mean"] = float(np.max(window_mean_force(
+                        h["time"], impulse, window)))
         if s.model.walls:
             summary["force_window"] = window
         return summary

@@ -73,7 +73,7 @@ def relative_drift(e_total: np.ndarray, energies: list[np.ndarray]) -> np.ndarra
 
 def plot_history(csv_path: str | os.PathLike,
                  out_dir: str | os.PathLike | None = None,
-                 force_window: float = 5e-6) -> list[Path]:
+                 force_window: float | None = None) -> list[Path]:
     """Plot the history CSV of a run.
 
     Writes, when the needed columns exist:
@@ -92,8 +92,8 @@ def plot_history(csv_path: str | os.PathLike,
     out_dir : str or os.PathLike, optional
         Directory of the figures; default the directory of ``csv_path``.
     force_window : float, optional
-        Averaging window of the wall forces [s] (the deck's
-        ``[output] force_window``; default 5 us).
+        Averaging window of the wall forces [s]; default the deck's default
+        ``[output] force_window``.
 
     Returns
     -------
@@ -134,6 +134,10 @@ def plot_history(csv_path: str | os.PathLike,
         fig, (ax,) = _figure()
         for c in force_cols:
             ax.plot(time, data[c], label=c)
+        if force_window is None:
+            from ..deck.schema import Output
+
+            force_window = Output.model_fields["force_window"].default
         for c in columns:
             if c.startswith("I_wall_") and f"F_wall_{c[7:]}" in data:
                 from ..analysis import window_mean_force
