@@ -1,0 +1,80 @@
+"""Every deck in examples/ run for a few steps at a coarse resolution.
+
+The regression test (tests/test_examples_regression.py) compares the final
+particle arrays and every history row with the stored results in
+``tests/data/regression/<deck>.npz``. Those were written by this module on
+the code before the architecture change (issue 13) and are rewritten only on
+purpose, after a deliberate change of results::
+
+    python tests/regression_cases.py            # all decks
+    python tests/regression_cases.py disc_impact # one
+
+Runs use one Numba thread: the threaded energy sums of the kick are
+reductions whose order depends on the thread count.
+"""
+
+from __future__ import annotations
+
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = Path(__file__).resolve().parent / "data" / "regression"
+
+#: deck stem -> (steps, overrides). Coarse spacings keep every case at about
+#: 1,000 particles or fewer, so the whole set runs in well under 3 minutes.
+COMMON = ["output.history_every=1", "output.vtk=false", "output.progress=false",
+          "output.checkpoint_every=0"]
+CASES: dict[str, tuple[int, list[str]]] = {
+    "disc_impact": (60, ['body.disc.dx="6.25 mm"']),
+    "disc_impact_crack": (60, ['body.disc.dx="6.25 mm"']),
+    "disc_impact_j2": (60, ['body.disc.dx="6.25 mm"']),
+    "disc_impact_random_mass": (60, ['body.disc.dx="6.25 mm"']),
+    "elastic_disc_bounce": (80, []),
+    "rings_gray2001": (60, ['body.0.dx="2.5 mm"', 'body.1.dx="2.5 mm"']),
+    "rings_gray2001_artificial_stress": (60, ['body.0.dx="2.5 mm"', 'body.1.dx="2.5 mm"']),
+    "rings_gray2001_total_lagrangian": (60, ['body.0.dx="2.5 mm"', 'body.1.dx="2.5 mm"']),
+    "two_boxes": (60, ['body.0.dx="0.5 mm"', 'body.1.dx="0.5 mm"']),
+    "two_boxes_close": (60, ['body.0.dx="0.5 mm"', 'body.1.dx="0.5 mm"']),
+    "ucs_cylinder": (30, ['body.0.dx="8 mm"', 'body.0.mesostructure.itz_thickness="8 mm"',
+                          "body.0.mesostructure.aggregate_fraction=0.2"]),
+    "ucs_cylinder_homogeneous": (40, ['body.0.dx="12.5 mm"']),
+    "ucs_homogeneous": (40, ['body.0.dx="5 mm"']),
+    "ucs_mesostructure": (40, ['body.0.dx="5 mm"',
+                               'body.0.mesostructure.itz_thickness="5 mm"']),
+}
+
+
+def run_case(name: str, outdir: Path) -> dict[str, np.ndarray]:
+    """Run one example deck; returns ``particle/<field>`` and ``history/<column>``."""
+    import numba
+
+    from sphdyn.deck import load_deck
+    from sphdyn.simulation import Simulation
+
+    steps, overrides = CASES[name]
+    numba.set_num_threads(1)
+    deck = load_deck(ROOT / "examples" / f"{name}.toml", COMMON + overrides)
+    sim = Simulation.from_deck(deck, outdir)
+    sim.run(max_steps=steps, progress=False)
+    out = {f"particle/{k}": np.array(v) for k, v in sim.solver.p.arrays().items()}
+    for k, v in sim.history.as_arrays().items():
+        out[f"history/{k}"] = np.asarray(v, dtype=float)
+    return out
+
+
+def write(names: list[str]) -> None:
+    DATA.mkdir(parents=True, exist_ok=True)
+    for name in names:
+        with tempfile.TemporaryDirectory() as tmp:
+            res = run_case(name, Path(tmp) / name)
+        np.savez_compressed(DATA / f"{name}.npz", **res)
+        n = res["particle/x"].shape[0]
+        print(f"{name}: {n} particles, {res['history/time'].size} history rows")
+
+
+if __name__ == "__main__":
+    write(sys.argv[1:] or list(CASES))

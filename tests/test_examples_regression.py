@@ -1,0 +1,69 @@
+"""Every example deck still gives the stored results (issue 13: results unchanged).
+
+Each deck of ``examples/`` runs a few steps at a coarse spacing
+(:mod:`regression_cases`); its final particle arrays and every history row
+are compared with ``tests/data/regression/<deck>.npz``, written on the code
+before the parts/interactions/events architecture. The comparison is
+bitwise: the reshaping moved code, not arithmetic. A case may be given a
+relative tolerance in ``TOLERANCE`` only where the order of a floating-point
+reduction had to change, with the reason next to it.
+"""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from regression_cases import CASES, DATA, run_case
+
+#: deck -> relative tolerance (scaled by the array's largest magnitude) and why.
+#: Empty: every case is bitwise identical.
+TOLERANCE: dict[str, float] = {}
+
+
+def _differences(name: str, got: dict, want: dict) -> list[str]:
+    tol = TOLERANCE.get(name, 0.0)
+    problems = []
+    missing = sorted(set(want) - set(got))
+    extra = sorted(set(got) - set(want))
+    if missing or extra:
+        problems.append(f"keys differ: missing {missing}, new {extra}")
+    for key in sorted(set(want) & set(got)):
+        a, b = np.asarray(got[key]), np.asarray(want[key])
+        if a.shape != b.shape:
+            problems.append(f"{key}: shape {a.shape} != stored {b.shape}")
+            continue
+        if np.array_equal(a, b, equal_nan=a.dtype.kind == "f"):
+            continue
+        if tol and a.dtype.kind == "f":
+            scale = float(np.nanmax(np.abs(b))) if b.size else 0.0
+            err = float(np.nanmax(np.abs(a - b))) if a.size else 0.0
+            if err <= tol * scale:
+                continue
+        diff = np.abs(a.astype(float) - b.astype(float))
+        problems.append(f"{key}: max |diff| {np.nanmax(diff):.3e} "
+                        f"(max |stored| {np.nanmax(np.abs(b.astype(float))):.3e})")
+    return problems
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_example_matches_stored_result(name, tmp_path):
+    assert (Path(__file__).parents[1] / "examples" / f"{name}.toml").exists()
+    want = dict(np.load(DATA / f"{name}.npz"))
+    got = run_case(name, tmp_path / name)
+    problems = _differences(name, got, want)
+    assert not problems, f"{name} changed:\n" + "\n".join(problems)
+
+
+def test_every_example_has_a_case():
+    """A new deck in examples/ must join the regression set."""
+    decks = {p.stem for p in (Path(__file__).parents[1] / "examples").glob("*.toml")}
+    assert decks == set(CASES)
+
+
+def test_comparison_catches_a_last_bit_change():
+    """The check is bitwise: one ulp in one entry fails it."""
+    a = {"particle/x": np.array([1.0, 2.0])}
+    b = {"particle/x": np.array([1.0, np.nextafter(2.0, 3.0)])}
+    assert _differences("none", a, b)
+    assert not _differences("none", a, {"particle/x": a["particle/x"].copy()})
