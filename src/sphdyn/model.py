@@ -85,6 +85,29 @@ class Model:
     photo_targets: dict = field(default_factory=dict)
     #: (N,) factor of the [material.variation] parameter (1 without variation)
     variation: np.ndarray = field(repr=False, default=None)
+    #: body name -> MassDraw of bodies with a random mass field ([body.mass])
+    mass_draws: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class MassDraw:
+    """The random mass field a body was given (paper sec. 4.1), as drawn.
+
+    ``rows`` (n,) particle indices of the body; ``solid`` (n,) bool (False
+    for initial-crack particles); ``factors`` (n_solid,) the drawn factors
+    :math:`f_j` of the solid particles; ``scale`` the rescaling factor
+    :math:`s = N_s / \\sum f` of :func:`sphdyn.heterogeneity.mass.mass_field`;
+    ``m0`` the homogeneous particle mass of the body's material,
+    :math:`\\rho\\,\\Delta x^d` [kg] (kg/m in 2D). A solid particle's mass is
+    ``m0 * scale * factor`` (times rho_phase / rho with a mesostructure).
+    """
+
+    rows: np.ndarray
+    solid: np.ndarray
+    factors: np.ndarray
+    scale: float
+    m0: float
+    spec: dict
 
 
 def _material_params(mat) -> dict:
@@ -184,7 +207,7 @@ def build_model(deck) -> Model:
 
     density_of = np.array([m.density for m in deck.material])
     parts, phase_parts = [], []
-    photos = {}
+    photos, draws, start = {}, {}, 0
     for b, body in enumerate(deck.body):
         x = lattice_from_shape(body.geometry.model_dump(), body.dx, dim)
         n = x.shape[0]
@@ -209,11 +232,17 @@ def build_model(deck) -> Model:
         solid = ~crack_mask(x, cracks, body.dx, body.name)
         spec = None if body.mass is None else body.mass.model_dump()
         if ph is not None:  # phases of different densities: factors times rho_i dx^d
-            factors, _ = mass_field(1.0, spec, solid, body_rng(deck.run.seed, b))
+            factors, scale = mass_field(1.0, spec, solid, body_rng(deck.run.seed, b))
             p.m[:] = factors * p.rho0 * vol
         else:
-            p.m[:], _ = mass_field(mat.density * vol, spec, solid,
-                                   body_rng(deck.run.seed, b))
+            p.m[:], scale = mass_field(mat.density * vol, spec, solid,
+                                       body_rng(deck.run.seed, b))
+            factors = p.m / (mat.density * vol)
+        if spec is not None:
+            draws[body.name] = MassDraw(np.arange(start, start + n), solid,
+                                        factors[solid] / scale, scale,
+                                        mat.density * vol, spec)
+        start += n
         p.h[:] = deck.sph.h_factor * body.dx
         p.h0[:] = p.h
         p.body[:] = b
@@ -288,4 +317,4 @@ def build_model(deck) -> Model:
         kernel_id=kid, kernel_sigma=kernels.normalisation(kid, dim),
         radius_factor=kernels.support(kid) * deck.sph.support_scale,
         bulk_modulus=kb, probes=probes, phase=np.concatenate(phase_parts),
-        photo_targets=photos, variation=factor)
+        photo_targets=photos, variation=factor, mass_draws=draws)
