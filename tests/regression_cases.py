@@ -60,7 +60,7 @@ def run_case(name: str, outdir: Path) -> dict[str, np.ndarray]:
     deck = load_deck(ROOT / "examples" / f"{name}.toml", COMMON + overrides)
     sim = Simulation.from_deck(deck, outdir)
     sim.run(max_steps=steps, progress=False)
-    out = {f"particle/{k}": np.array(v) for k, v in sim.solver.p.arrays().items()}
+    out = {f"particle/{k}": np.array(v) for k, v in sim.particles.arrays().items()}
     for k, v in sim.history.as_arrays().items():
         out[f"history/{k}"] = np.asarray(v, dtype=float)
     return out

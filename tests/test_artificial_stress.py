@@ -6,11 +6,10 @@ import pytest
 from sphdyn import kernels
 from sphdyn.deck import DeckError, loads_deck
 from sphdyn.geometry import box_lattice
-from sphdyn.model import build_model
 from sphdyn.neighbours import build_neighbours
-from sphdyn.solver import Solver
-from sphdyn.sph.artificial_stress import artificial_stress_forces, artificial_stress_tensor
-from sphdyn.sph.passes import particle_volumes, velocity_gradient
+from stepping import build_stepper, step
+from sphdyn.parts.sph.artificial_stress import artificial_stress_forces, artificial_stress_tensor
+from sphdyn.parts.sph.passes import particle_volumes, velocity_gradient
 
 RHO = 1000.0
 EPS = 0.3
@@ -180,7 +179,7 @@ def test_deck_defaults_and_bounds():
     assert d.sph.artificial_stress.epsilon == 0.3
     assert d.sph.artificial_stress.n == 4.0
     off = loads_deck(DECK.format(eps=0.0))
-    assert Solver(build_model(off), off).R is None  # off costs nothing
+    assert not build_stepper(off).part("sph").as_on  # off costs nothing
     with pytest.raises(DeckError):
         loads_deck(DECK.format(eps=-0.1))
 
@@ -188,8 +187,8 @@ def test_deck_defaults_and_bounds():
 def test_solver_with_artificial_stress_conserves_momentum():
     # free body in uniform motion: total momentum unchanged to round-off
     d = loads_deck(DECK.format(eps=0.3))
-    s = Solver(build_model(d), d)
-    p = s.p
+    s = build_stepper(d)
+    p = s.particles
     p.v[:, 1] = 0.3 * np.sin(300.0 * p.x[:, 0])  # shear, tension and compression
     p0 = (p.m[:, None] * p.v).sum(axis=0)
     for _ in range(30):
@@ -212,17 +211,17 @@ artificial_stress = 0.0
 geometry = { shape = "box", lo = [0.02, 0], hi = [0.03, 0.01] }
 """
     d = loads_deck(second)
-    s = Solver(build_model(d), d)
-    p = s.p
-    assert np.array_equal(s.as_eps, np.where(p.body == 0, 0.3, 0.0))
+    s = build_stepper(d)
+    p = s.particles
+    assert np.array_equal(s.particles.as_eps, np.where(p.body == 0, 0.3, 0.0))
     p.sig[:, 0, 0] = 1e5  # uniaxial tension everywhere
-    s._accelerations(1e-7)
-    assert np.all(s.R[p.body == 1] == 0.0)
-    assert np.all(s.R[p.body == 0, 0, 0] < 0.0)
+    s.part("sph")._accelerations()
+    assert np.all(s.particles.R[p.body == 1] == 0.0)
+    assert np.all(s.particles.R[p.body == 0, 0, 0] < 0.0)
     only = DECK.format(eps=0.0).replace("velocity = [1.0, 0]",
                                         "velocity = [1.0, 0]\nartificial_stress = 0.2")
     d = loads_deck(only)
-    assert Solver(build_model(d), d).R is not None
+    assert build_stepper(d).part("sph").as_on
 
 
 def test_artificial_stress_power_is_booked_as_heat():

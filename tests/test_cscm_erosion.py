@@ -22,7 +22,7 @@ import numpy as np
 from sphdyn.deck import loads_deck
 from sphdyn.materials import cscm
 from sphdyn.model import build_model
-from sphdyn.solver import Solver
+from stepping import build_stepper, step
 
 ERODE_STRAIN = 0.01
 V0 = 5.0  # m/s, each half
@@ -62,7 +62,7 @@ def test_bar_pulled_apart_erodes_by_the_criterion_and_conserves_mass_momentum():
     p = model.particles
     assert p.n == 400
     p.v[:, 0] = np.where(p.x[:, 0] > 0.0, V0, -V0)   # halves move apart
-    solver = Solver(model, deck)
+    solver = build_stepper(deck, model)
     m0 = p.m.copy()
     vscale = float(np.sum(p.m * np.abs(p.v[:, 0])))     # |momentum| of one half x 2
     eroded_prev = np.zeros(p.n, bool)

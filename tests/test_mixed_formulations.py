@@ -3,8 +3,7 @@
 import numpy as np
 
 from sphdyn.deck import loads_deck
-from sphdyn.model import build_model
-from sphdyn.solver import Solver
+from stepping import build_stepper, step
 
 DECK = """
 [run]
@@ -44,14 +43,14 @@ def test_mixed_bodies_keep_separate_lists_and_collide_through_contact():
     # list TL particles only; the bars then interact through the particle
     # contact (on by default because one body is total-Lagrangian).
     d = loads_deck(DECK)
-    s = Solver(build_model(d), d)
-    p = s.p
+    s = build_stepper(d)
+    p = s.particles
     tl = p.body == 1
-    assert s.tl is not None and s.cnl is not None
-    ul_rows = np.repeat(np.arange(p.n), np.diff(s.nl.offsets))
-    assert not tl[ul_rows].any() and not tl[s.nl.idx].any()
-    tl_rows = np.repeat(np.arange(p.n), np.diff(s.tl.offsets))
-    assert tl[tl_rows].all() and tl[s.tl.idx].all()
+    assert s.part("sph").tl is not None and s.interactions[0].name == "contact"
+    ul_rows = np.repeat(np.arange(p.n), np.diff(s.part("sph").nl.offsets))
+    assert not tl[ul_rows].any() and not tl[s.part("sph").nl.idx].any()
+    tl_rows = np.repeat(np.arange(p.n), np.diff(s.part("sph").tl.offsets))
+    assert tl[tl_rows].all() and tl[s.part("sph").tl.idx].all()
     e0 = _kinetic(p)
     mom0 = (p.m[:, None] * p.v).sum(axis=0)
     # the facing particle rows are 2 mm apart, contact distance 1 mm: contact
@@ -59,8 +58,8 @@ def test_mixed_bodies_keep_separate_lists_and_collide_through_contact():
     # (L = 20 mm, c = 5.9 km/s); by 40 us the bars have separated again
     touched = 0.0
     while s.t < 4e-5:
-        touched = max(touched, s.step()["contacts_bodies"])
-    rec = s.energies(_kinetic(p), 0.0)
+        touched = max(touched, step(s)["contacts_bodies"])
+    rec = s.record(kinetic=_kinetic(p), dt=0.0)
     assert np.isfinite(p.x).all() and np.isfinite(p.sig).all()
     assert touched > 0 and rec["contacts_bodies"] == 0
     # both bars bounced back (equal elastic bars would exchange velocities
@@ -83,8 +82,8 @@ def test_reference_update_restarts_F_and_keeps_L_exact():
     # (corrected gradients, 1e-9) before and after the update.
     d = loads_deck(DECK.replace('formulation = "total_lagrangian"\n', "").replace(
         "[sph]", '[sph]\nformulation = "total_lagrangian"'))
-    s = Solver(build_model(d), d)
-    p, tl = s.p, s.tl
+    s = build_stepper(d)
+    p, tl = s.particles, s.part("sph").tl
     A = np.array([[1.2, 0.3, 0.0], [-0.1, 0.9, 0.0], [0.0, 0.0, 1.0]])
     W = np.array([[0.0, 2.0, 0.0], [-1.0, 0.5, 0.0], [0.0, 0.0, 0.0]])
     p.x[:] = p.x0 @ A.T

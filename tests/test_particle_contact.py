@@ -1,8 +1,8 @@
-"""Penalty contact between particles of different bodies (sphdyn.contact.particles)."""
+"""Penalty contact between particles of different bodies (sphdyn.interactions.particle_contact)."""
 
 import numpy as np
 
-from sphdyn.contact.particles import contact_time_step, particle_contact
+from sphdyn.interactions.particle_contact import contact_time_step, particle_contact
 from sphdyn.integrate import drift, kick
 from sphdyn.neighbours import build_neighbours, update_neighbours
 

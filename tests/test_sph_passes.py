@@ -1,4 +1,4 @@
-"""Patch tests and conservation checks of the SPH passes (sphdyn.sph.passes)."""
+"""Patch tests and conservation checks of the SPH passes (sphdyn.parts.sph.passes)."""
 
 import numpy as np
 import pytest
@@ -6,7 +6,7 @@ import pytest
 from sphdyn import kernels
 from sphdyn.geometry import box_lattice
 from sphdyn.neighbours import build_neighbours
-from sphdyn.sph.passes import (forces, particle_volumes, scaled_stress,
+from sphdyn.parts.sph.passes import (forces, particle_volumes, scaled_stress,
                                update_density_and_h, velocity_gradient, xsph_velocity)
 
 

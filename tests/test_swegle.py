@@ -1,4 +1,4 @@
-"""Swegle et al. (1995) tensile-instability indicator (sphdyn.sph.swegle)."""
+"""Swegle et al. (1995) tensile-instability indicator (sphdyn.parts.sph.swegle)."""
 
 import numpy as np
 import pytest
@@ -7,10 +7,9 @@ from sphdyn import kernels
 from sphdyn.deck import loads_deck
 from sphdyn.geometry import box_lattice
 from sphdyn.io import particle_fields
-from sphdyn.model import build_model
 from sphdyn.neighbours import build_neighbours
-from sphdyn.solver import Solver
-from sphdyn.sph.swegle import (FLAG_FRACTION, REL_STRESS_TOL, count_unstable, stress_scale,
+from stepping import build_stepper, step
+from sphdyn.parts.sph.swegle import (FLAG_FRACTION, REL_STRESS_TOL, count_unstable, stress_scale,
                                swegle_indicator)
 
 DX = 1e-3
@@ -135,21 +134,21 @@ fields = ["swegle"]
 
 def test_solver_output_field_and_history_column():
     d = loads_deck(DECK)
-    s = Solver(build_model(d), d)
-    s.p.sig[:] = _uniform(s.p.n, sxx=S)
-    f = particle_fields(s.p, ["swegle"], s.output_fields())["swegle"]
-    assert f.shape == (s.p.n,)
+    s = build_stepper(d)
+    s.particles.sig[:] = _uniform(s.particles.n, sxx=S)
+    f = particle_fields(s.particles, ["swegle"], s.part("sph").fields())["swegle"]
+    assert f.shape == (s.particles.n,)
     assert np.all(f > FLAG_FRACTION)
-    rec = s.energies(0.0, 0.0)
-    assert rec["swegle_unstable"] == s.p.n
+    rec = s.record(kinetic=0.0, dt=0.0)
+    assert rec["swegle_unstable"] == s.particles.n
     # the field is a copy; a stress-free state after a step flags nothing
     f[:] = -1.0
-    s.p.sig[:] = 0.0
-    s.p.v[:] = 0.0
+    s.particles.sig[:] = 0.0
+    s.particles.v[:] = 0.0
     s.step()
-    s.p.sig[:] = 0.0
-    assert np.all(particle_fields(s.p, ["swegle"], s.output_fields())["swegle"] == 0.0)
-    assert s.energies(0.0, 0.0)["swegle_unstable"] == 0.0
+    s.particles.sig[:] = 0.0
+    assert np.all(particle_fields(s.particles, ["swegle"], s.part("sph").fields())["swegle"] == 0.0)
+    assert s.record(kinetic=0.0, dt=0.0)["swegle_unstable"] == 0.0
 
 
 def test_quadratic_kernel_is_stable_in_compression_at_any_spacing():

@@ -1,4 +1,4 @@
-"""Total-Lagrangian SPH passes (sphdyn.sph.total_lagrangian): exactness and conservation."""
+"""Total-Lagrangian SPH passes (sphdyn.parts.sph.total_lagrangian): exactness and conservation."""
 
 import numpy as np
 import pytest
@@ -6,7 +6,7 @@ import pytest
 from sphdyn import kernels
 from sphdyn.geometry import box_lattice
 from sphdyn.neighbours import build_neighbours
-from sphdyn.sph.total_lagrangian import (deformation_gradient, hourglass_coefficients,
+from sphdyn.parts.sph.total_lagrangian import (deformation_gradient, hourglass_coefficients,
                                          piola_stress, reference_gradients, tl_forces)
 
 
@@ -172,7 +172,7 @@ def test_uniform_stress_gives_zero_interior_force():
 
 def test_same_body_pairs_keeps_only_pairs_inside_each_body():
     from sphdyn.neighbours import brute_force_neighbours
-    from sphdyn.sph.tl_scheme import same_body_pairs
+    from sphdyn.parts.sph.tl_scheme import same_body_pairs
 
     rng = np.random.default_rng(2)
     x = rng.uniform(0, 1, (200, 3))

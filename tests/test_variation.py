@@ -185,7 +185,7 @@ def test_variation_is_an_output_field(tmp_path):
         sim = Simulation.from_deck(deck, tmp_path / name)
         sim.run(max_steps=1)
         f = read_frame(list_frames(tmp_path / name)[0])[2]
-        assert np.array_equal(f["variation"], sim.solver.model.variation)
+        assert np.array_equal(f["variation"], sim.model.variation)
         assert np.all(f["variation"][f["material"] == 0] == 1.0)
         assert np.any(f["variation"] != 1.0) == (name == "var")
 

@@ -8,7 +8,7 @@ import pytest
 
 from sphdyn.deck import loads_deck
 from sphdyn.model import build_model
-from sphdyn.solver import Solver
+from stepping import build_stepper, step, wall
 
 ELASTIC = """
 [[material]]
@@ -22,13 +22,13 @@ nu = {nu}
 
 def _solver(text):
     deck = loads_deck(text)
-    return Solver(build_model(deck), deck), deck
+    return build_stepper(deck), deck
 
 
 def _run_until(solver, t_end, probe=None):
     out = []
     while solver.t < t_end:
-        rec = solver.step()
+        rec = step(solver)
         if probe is not None:
             out.append((solver.t, probe(solver)))
     return out
@@ -64,13 +64,13 @@ velocity = [{v0}, 0, 0]
 
 def _front_arrival(solver, deck_dx, positions, v0, t_end):
     """Times at which the particle velocity on the centre line reaches v0/2."""
-    p = solver.p
+    p = solver.particles
     x0 = p.x0
     yc = 0.5 * (x0[:, 1].min() + x0[:, 1].max())
     zc = 0.5 * (x0[:, 2].min() + x0[:, 2].max())
     probes = [np.argmin((x0[:, 0] - xp) ** 2 + (x0[:, 1] - yc) ** 2 + (x0[:, 2] - zc) ** 2)
               for xp in positions]
-    hist = _run_until(solver, t_end, lambda s: s.p.v[probes, 0].copy())
+    hist = _run_until(solver, t_end, lambda s: s.particles.v[probes, 0].copy())
     t = np.array([h[0] for h in hist])
     v = np.array([h[1] for h in hist])
     arrivals = []
@@ -158,16 +158,16 @@ def test_elastic_disc_bounces_with_energy_conserved(stiffness, alpha):
     # of the disc and to artificial viscosity only) and at most 100.5 %.
     # Measured: drift 0.55 % (mass) / 0.39 % (bulk), rebound 95 % / 96 %.
     s, _ = _solver(_disc_on_wall(stiffness, alpha))
-    m = s.p.m
+    m = s.particles.m
     vel0 = 5.0
     records = []
     t_end = 0.003  # contact lasts from 0.12 to 0.76 ms
     while s.t < t_end:
-        records.append(s.step())
+        records.append(step(s))
     e = np.array([r["E_total"] for r in records])
     ke0 = records[0]["E_kinetic"]
     assert np.abs(e - e[0]).max() < 0.02 * ke0
-    vcm = (m[:, None] * s.p.v).sum(axis=0) / m.sum()
+    vcm = (m[:, None] * s.particles.v).sum(axis=0) / m.sum()
     assert vcm[1] > 0.8 * vel0 and vcm[1] < 1.005 * vel0, vcm
     assert max(r["F_wall_floor"] for r in records) > 0
     assert records[-1]["contacts_floor"] == 0  # it has left the wall
@@ -184,14 +184,14 @@ def test_bulk_wall_with_random_masses_keeps_the_time_step_and_energy():
     text = _disc_on_wall("bulk", 0.5).replace(
         "[[wall]]", '[body.mass]\ndistribution = "uniform"\nlow = 0.0\nhigh = 2.0\n[[wall]]')
     s, _ = _solver(text)
-    assert s.p.m.min() < 0.01 * s.p.m.mean()  # some very light particles
+    assert s.particles.m.min() < 0.01 * s.particles.m.mean()  # some very light particles
     assert s.dt_contact == hom.dt_contact
     records = []
     while s.t < 0.003:
-        records.append(s.step())
+        records.append(step(s))
     e = np.array([r["E_total"] for r in records])
     assert np.abs(e - e[0]).max() < 0.02 * records[0]["E_kinetic"]
-    vcm = (s.p.m[:, None] * s.p.v).sum(axis=0) / s.p.m.sum()
+    vcm = (s.particles.m[:, None] * s.particles.v).sum(axis=0) / s.particles.m.sum()
     assert vcm[1] > 0.5 * 5.0  # bounced
 
 
@@ -203,7 +203,7 @@ def test_friction_slows_sliding_but_not_without_it():
         s, _ = _solver(_disc_on_wall(friction=mu, vx=3.0))
         while s.t < 0.006:
             s.step()
-        vt.append((s.p.m * s.p.v[:, 0]).sum() / s.p.m.sum())
+        vt.append((s.particles.m * s.particles.v[:, 0]).sum() / s.particles.m.sum())
     assert abs(vt[0] - 3.0) < 1e-9
     assert vt[1] < 2.9
 
@@ -217,20 +217,20 @@ def test_wall_impulse_equals_the_momentum_change(stiffness, alpha, mu):
     # momentum (round-off over ~700 steps; measured 5e-15 and 7e-15). Oblique
     # impact with friction, so the tangential component is checked too.
     s, _ = _solver(_disc_on_wall(stiffness, alpha, friction=mu, vx=2.0))
-    p0 = (s.p.m[:, None] * s.p.v).sum(axis=0)
+    p0 = (s.particles.m[:, None] * s.particles.v).sum(axis=0)
     records = []
     while s.t < 0.002:
-        records.append(s.step())
-    dp = (s.p.m[:, None] * s.p.v).sum(axis=0) - p0
+        records.append(step(s))
+    dp = (s.particles.m[:, None] * s.particles.v).sum(axis=0) - p0
     scale = np.linalg.norm(p0)
-    assert np.abs(dp - s.wall_impulse[0]).max() < 1e-9 * scale
+    assert np.abs(dp - wall(s, "floor").impulse).max() < 1e-9 * scale
     assert dp[1] > 1.5 * abs(p0[1])  # it bounced: the impulse is no trivial 0
     if mu > 0:
         assert dp[0] < -0.01 * p0[0]  # friction took tangential momentum
     # the history column is the normal component, running with the steps
     imp = np.array([r["I_wall_floor"] for r in records])
     assert np.all(np.diff(imp) >= 0)  # a wall can only push
-    assert abs(imp[-1] - s.wall_impulse[0, 1]) <= abs(records[-1]["F_wall_floor"]) * \
+    assert abs(imp[-1] - wall(s, "floor").impulse[1]) <= abs(records[-1]["F_wall_floor"]) * \
         records[-1]["dt"] + 1e-12 * scale
 
 
@@ -244,11 +244,11 @@ def test_a_step_shortened_to_end_the_run_keeps_the_wall_spring_stiffness():
     s, _ = _solver(_disc_on_wall("mass", 0.1))
     while s.t < 0.4e-3:  # mid-contact (contact from 0.12 to 0.76 ms)
         s.step()
-    before = s.wall_totals["floor"][1]
+    before = wall(s, "floor").total[1]
     assert before > 0
-    dt = s._cfl()[0]
+    dt = s.stable_dt()[0]
     s.step(t_stop=s.t + 0.01 * dt)
-    after = s.wall_totals["floor"][1]
+    after = wall(s, "floor").total[1]
     assert abs(after - before) < 0.1 * before, (before, after)
 
 
@@ -279,7 +279,7 @@ def test_moving_wall_unit_behaviour():
     # when the plane is within thickness_factor * size = 0.5 mm, i.e. at
     # t = 2.5 ms; friction acts on the velocity relative to the wall, so a
     # particle sliding with the wall's tangential velocity feels none.
-    from sphdyn.contact.wall import STIFFNESS_MASS, wall_contact
+    from sphdyn.interactions.wall_contact import STIFFNESS_MASS, wall_contact
     x = np.array([[0.0, 3e-3, 0.0]])
     one = np.ones(1)
     args = (one, np.full(1, 1e-6), one, one, 2)
@@ -391,15 +391,15 @@ velocity = [-4.0, 0, 0]
 geometry = {{ shape = "ring", centre = [0.0085, 0, 0], inner_radius = 0.003, outer_radius = 0.007, length = 1 }}
 """
     s, _ = _solver(text)
-    p0 = (s.p.m[:, None] * s.p.v).sum(axis=0)
-    scale = (s.p.m * np.linalg.norm(s.p.v, axis=1)).sum()
-    body_a = s.p.body == 0
-    pa0 = (s.p.m[body_a, None] * s.p.v[body_a]).sum(axis=0)
+    p0 = (s.particles.m[:, None] * s.particles.v).sum(axis=0)
+    scale = (s.particles.m * np.linalg.norm(s.particles.v, axis=1)).sum()
+    body_a = s.particles.body == 0
+    pa0 = (s.particles.m[body_a, None] * s.particles.v[body_a]).sum(axis=0)
     while s.t < 0.002:
         s.step()
-    p1 = (s.p.m[:, None] * s.p.v).sum(axis=0)
+    p1 = (s.particles.m[:, None] * s.particles.v).sum(axis=0)
     assert np.abs(p1 - p0).max() < 1e-12 * scale
-    pa1 = (s.p.m[body_a, None] * s.p.v[body_a]).sum(axis=0)
+    pa1 = (s.particles.m[body_a, None] * s.particles.v[body_a]).sum(axis=0)
     assert abs(pa1[0] - pa0[0]) > 0.1 * abs(pa0[0])  # they did collide
 
 
@@ -439,11 +439,11 @@ def test_thesis_two_boxes(gap_in_dx, interacts):
     # facing particle rows are 2.4 dx apart never see each other (lateral
     # momentum exchanged exactly zero), at 1.0 dx apart they interact.
     s, _ = _solver(_boxes(gap_in_dx))
-    lower = s.p.body == 0
+    lower = s.particles.body == 0
     while s.t < 12e-6:
         s.step()
-    py = (s.p.m[lower] * s.p.v[lower, 1]).sum()
-    scale = (s.p.m[lower] * 300.0).sum()
+    py = (s.particles.m[lower] * s.particles.v[lower, 1]).sum()
+    scale = (s.particles.m[lower] * 300.0).sum()
     if interacts:
         assert abs(py) > 1e-6 * scale
     else:

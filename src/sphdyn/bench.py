@@ -109,33 +109,30 @@ def case_deck(case: str, particles: int | None = None):
 def run_bench(case: str, steps: int = 1000, threads: int | None = None,
               particles: int | None = None, warmup: int = 3) -> dict:
     """Run ``steps`` time steps of a case and time them (compilation excluded)."""
-    from .model import build_model
-    from .neighbours import mean_neighbours
-    from .solver import Solver
+    from .assembly import build_stepper
 
     if threads:
         numba.set_num_threads(threads)
     deck = case_deck(case, particles)
     t0 = time.perf_counter()
-    solver = Solver(build_model(deck), deck)
+    stepper = build_stepper(deck)
     for _ in range(warmup):
-        solver.step()
+        stepper.step()
     compile_s = time.perf_counter() - t0
     t1 = time.perf_counter()
     for _ in range(steps):
-        solver.step()
+        stepper.step()
     seconds = time.perf_counter() - t1
-    n = solver.p.n
-    nl = solver.nl if solver.tl is None else solver.tl
+    n = stepper.particles.n
+    sph = stepper.part("sph")
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # Linux: KiB
     return {
         "case": case, "particles": n, "steps": steps,
         "threads": numba.get_num_threads(), "seconds": seconds,
         "compile_seconds": compile_s,
         "particle_steps_per_s": n * steps / seconds,
-        "neighbour_builds": solver.nl.n_builds,
-        "neighbours_mean": (mean_neighbours(nl) if solver.tl is None
-                            else solver.tl.mean_neighbours),
+        "neighbour_builds": sph.nl.n_builds,
+        "neighbours_mean": sph.mean_neighbours,
         "peak_rss_mb": peak / 2**20,
         "bytes_per_particle": peak / n,
     }

@@ -60,6 +60,7 @@ Hušek, M. SPH for concrete under impact (PhD thesis), eq. 2.2.2, Fig. 2.4.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 from numba import njit
 
@@ -523,3 +524,34 @@ def second_derivative(kid, sigma, dim, r, h):
         ``d2W/dr2`` [1/m^(d+2)].
     """
     return sigma / h ** (dim + 2) * d2wdq2(kid, r / h)
+
+
+@dataclass(frozen=True)
+class KernelContext:
+    r"""The smoothing kernel of a part, passed as one thing.
+
+    ``kid`` the kernel id, ``sigma`` its normalisation :math:`\sigma_d` in
+    ``dim`` dimensions and ``support_scale`` the paper's :math:`\kappa`
+    (deck key ``sph.support_scale``): pair quantities use
+    :math:`h_{ij} = \kappa (h_i + h_j)/2`, so the support radius is
+    ``radius_factor * h`` with ``radius_factor`` :math:`= q_{max} \kappa`.
+    """
+
+    kid: int
+    dim: int
+    support_scale: float = 1.0
+
+    @classmethod
+    def named(cls, name: str, dim: int, support_scale: float = 1.0) -> "KernelContext":
+        """The context of the kernel called ``name`` (see :data:`KERNEL_IDS`)."""
+        return cls(kernel_id(name), dim, float(support_scale))
+
+    @property
+    def sigma(self) -> float:
+        """Normalisation constant :math:`\\sigma_d` (see :func:`normalisation`)."""
+        return normalisation(self.kid, self.dim)
+
+    @property
+    def radius_factor(self) -> float:
+        """Support radius in units of h: :math:`q_{max}\\,\\kappa`."""
+        return support(self.kid) * self.support_scale

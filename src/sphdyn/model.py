@@ -1,7 +1,8 @@
 """Deck -> model: particles of every body, material groups, sets, walls, guard box.
 
-This is the only place where deck objects are turned into arrays; the solver
-below it sees arrays and scalars only.
+With :mod:`sphdyn.assembly` (parts, interactions, stepper) this is the only
+place that reads the deck and turns deck objects into arrays; the parts and
+interactions below it see settings, arrays and scalars only.
 """
 
 from __future__ import annotations
@@ -10,14 +11,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import kernels
-from .contact.wall import STIFFNESS_BULK, STIFFNESS_MASS
 from .geometry import lattice_from_shape, select
 from .heterogeneity.cracks import crack_mask
 from .heterogeneity.mass import body_rng, mass_field
 from .heterogeneity.mesostructure import AGGREGATE, ITZ, MORTAR, generate_phases
 from .heterogeneity.photo import photo_targets
 from .heterogeneity.variation import factor_of, quantise, standard_normal_field, variation_rng
+from .interactions.wall import STIFFNESS, WallSpec
 from .materials import get_model
 from .probes import Probe, quantity
 from .state import BC_FIXED, BC_VELOCITY, Particles
@@ -25,58 +25,28 @@ from .state import BC_FIXED, BC_VELOCITY, Particles
 
 @dataclass
 class MaterialGroup:
-    """Particles sharing one material: the model's group kernel runs over ``idx``."""
+    """Particles sharing one material: the model's group kernel runs over ``idx``.
+
+    ``material`` is the index in the deck's ``[[material]]`` list (a material
+    with ``[material.variation]`` has one group per class).
+    """
 
     name: str
     model: object  # materials.base.MaterialModel
     params: np.ndarray
     idx: np.ndarray  # int64 particle indices
-
-
-@dataclass
-class Wall:
-    """A rigid planar wall in array form (see :mod:`sphdyn.contact.wall`)."""
-
-    name: str
-    point: np.ndarray
-    normal: np.ndarray
-    method: int
-    alpha: float
-    friction: float
-    thickness_factor: float
-    kbulk: np.ndarray  # (N,) bulk modulus used by the bulk method [Pa]
-    velocity: np.ndarray = field(default_factory=lambda: np.zeros(3))  # [m/s]
-    ramp_time: float = 0.0  # [s] linear velocity ramp from rest
-
-    def travel(self, t: float) -> float:
-        """Distance travelled in units of the final velocity [s]:
-        ``t^2 / (2 T)`` during the ramp ``t < T``, ``t - T/2`` after it."""
-        T = self.ramp_time
-        return t * t / (2.0 * T) if t < T else t - 0.5 * T
-
-    def point_at(self, t: float) -> np.ndarray:
-        """A point of the wall plane at time ``t`` [s]: point + velocity travel(t)."""
-        return self.point + self.velocity * self.travel(t)
-
-    def velocity_at(self, t: float) -> np.ndarray:
-        """Wall velocity at time ``t`` [s]: velocity min(t / T, 1)."""
-        T = self.ramp_time
-        return self.velocity * (min(t / T, 1.0) if T > 0.0 else 1.0)
+    material: int = 0
 
 
 @dataclass
 class Model:
     particles: Particles
     groups: list[MaterialGroup]
-    walls: list[Wall]
+    walls: list[WallSpec]
     sets: dict[str, np.ndarray]
     body_names: list[str]
     domain_lo: np.ndarray
     domain_hi: np.ndarray
-    kernel_id: int
-    kernel_sigma: float
-    radius_factor: float
-    bulk_modulus: np.ndarray = field(repr=False, default=None)  # (N,) per particle
     probes: list[Probe] = field(default_factory=list)
     #: (N,) int8 mesostructure phase (0 mortar, 1 aggregate, 2 ITZ; -1 for
     #: bodies without [body.mesostructure])
@@ -108,6 +78,17 @@ class MassDraw:
     scale: float
     m0: float
     spec: dict
+
+
+def wall_specs(deck) -> list[WallSpec]:
+    """The ``[[wall]]`` tables as :class:`~sphdyn.interactions.wall.WallSpec`."""
+    return [WallSpec(
+        name=w.name, point=np.asarray(w.point, float),
+        normal=np.asarray(w.normal, float) / np.linalg.norm(w.normal),
+        method=STIFFNESS[w.stiffness], alpha=w.alpha, friction=w.friction,
+        thickness_factor=w.thickness_factor, bulk_modulus=w.bulk_modulus,
+        velocity=np.asarray(w.velocity, float), ramp_time=w.ramp_time)
+        for w in deck.wall]
 
 
 def _material_params(mat) -> dict:
@@ -170,7 +151,7 @@ def _material_groups(deck, particles: Particles, models: dict,
             continue
         var = m.variation
         if var is None or var.cov == 0.0:
-            groups.append(MaterialGroup(m.name, models[m.name], params[m.name], idx))
+            groups.append(MaterialGroup(m.name, models[m.name], params[m.name], idx, k))
             continue
         rng = variation_rng(deck.run.seed, k)
         if var.scope == "sample":
@@ -184,7 +165,7 @@ def _material_groups(deck, particles: Particles, models: dict,
             sub = idx[cls == c]
             values = {**base, var.parameter: base[var.parameter] * f[c]}
             groups.append(MaterialGroup(f"{m.name}#{c}", models[m.name],
-                                        models[m.name].pack(values), sub))
+                                        models[m.name].pack(values), sub, k))
             factor[sub] = f[c]
     return groups, factor
 
@@ -192,7 +173,6 @@ def _material_groups(deck, particles: Particles, models: dict,
 def build_model(deck) -> Model:
     """Create the particle model described by a validated deck."""
     dim = deck.run.dimension
-    kid = kernels.kernel_id(deck.sph.kernel)
     mats = {m.name: m for m in deck.material}
     mat_index = {m.name: k for k, m in enumerate(deck.material)}
     models = {m.name: get_model(m.model) for m in deck.material}
@@ -253,9 +233,7 @@ def build_model(deck) -> Model:
 
     groups, factor = _material_groups(deck, particles, models, params)
 
-    kb = np.zeros(particles.n)
     for g in groups:
-        kb[g.idx] = g.model.bulk_modulus(g.params)
         particles.c[g.idx] = g.model.wave_speed(g.params, particles.rho0[g.idx[0]])  # one density per material
         h0 = g.model.initial_history(g.params)
         if len(h0):
@@ -289,16 +267,6 @@ def build_model(deck) -> Model:
                 raise ValueError(f"probe on set {pr.set!r}: {exc}") from None
         probes.append(probe)
 
-    walls = []
-    for w in deck.wall:
-        kbw = kb.copy() if w.bulk_modulus is None else np.full(particles.n, w.bulk_modulus)
-        walls.append(Wall(
-            name=w.name, point=np.asarray(w.point, float),
-            normal=np.asarray(w.normal, float) / np.linalg.norm(w.normal),
-            method=STIFFNESS_MASS if w.stiffness == "mass" else STIFFNESS_BULK,
-            alpha=w.alpha, friction=w.friction, thickness_factor=w.thickness_factor,
-            kbulk=kbw, velocity=np.asarray(w.velocity, float), ramp_time=w.ramp_time))
-
     lo_b = particles.x.min(axis=0)
     hi_b = particles.x.max(axis=0)
     # the same distance on every side: a thin body (the paper's disc is 20 mm
@@ -312,9 +280,7 @@ def build_model(deck) -> Model:
         lo[2], hi[2] = -np.inf, np.inf
 
     return Model(
-        particles=particles, groups=groups, walls=walls, sets=sets,
+        particles=particles, groups=groups, walls=wall_specs(deck), sets=sets,
         body_names=[b.name for b in deck.body], domain_lo=lo, domain_hi=hi,
-        kernel_id=kid, kernel_sigma=kernels.normalisation(kid, dim),
-        radius_factor=kernels.support(kid) * deck.sph.support_scale,
-        bulk_modulus=kb, probes=probes, phase=np.concatenate(phase_parts),
+        probes=probes, phase=np.concatenate(phase_parts),
         photo_targets=photos, variation=factor, mass_draws=draws)

@@ -1,4 +1,4 @@
-"""The main loop: solver steps, then output, checkpoints, guards and progress.
+"""The main loop: stepper steps, watched by monitors (guards, output, checkpoints, progress).
 
 Output directory layout::
 
@@ -17,7 +17,6 @@ or failed run leaves only complete files behind.
 from __future__ import annotations
 
 import json
-import math
 import time
 from pathlib import Path
 
@@ -30,47 +29,64 @@ from .io import (FrameWriter, History, atomic_write_text, particle_fields,
                  plot_history, read_checkpoint, write_checkpoint)
 from .analysis import window_mean_force
 from .io.plots import energy_columns, relative_drift
-from .model import build_model
+from .assembly import build_stepper
+from .monitors import Checkpoints, FrameOutput, Guards, HistoryRecorder, Progress
 from .neighbours import max_neighbours, mean_neighbours
-from .solver import Solver
+from .stepper import Stepper
 
 RESOLVED = "deck.resolved.toml"
 CHECKPOINT = "checkpoint.h5"
 
 
 class Simulation:
-    """A deck, its model and solver, and the output directory.
+    """A deck, its stepper (parts, interactions, events) and the output directory.
 
     Use :meth:`from_deck` for a new run and :meth:`from_directory` to restart.
+    The run's output is written by monitors attached to the stepper
+    (:mod:`sphdyn.monitors`): guards, history rows and probes, frames and
+    checkpoints.
     """
 
-    def __init__(self, deck, outdir: Path, solver: Solver, history: History,
+    def __init__(self, deck, outdir: Path, stepper: Stepper, history: History,
                  frames: FrameWriter, next_frame: float):
         self.deck = deck
         self.outdir = Path(outdir)
-        self.solver = solver
+        self.stepper = stepper
+        self.model = stepper.model
         self.history = history
         self.frames = frames
-        self.next_frame = next_frame
         out = deck.output
-        self.frame_every = deck.frame_interval()
         self.fields = list(out.fields)
         self.wall_seconds = 0.0
+        self.output = FrameOutput(self._write_frame, deck.frame_interval(), next_frame,
+                                  deck.run.t_end)
+        self.recorder = HistoryRecorder(history, out.history_every, self.model.probes)
+        for monitor in (Guards(self.model.domain_lo, self.model.domain_hi,
+                               deck.time.collapse_ratio),
+                        self.recorder, self.output,
+                        Checkpoints(self._checkpoint, out.checkpoint_every)):
+            stepper.add_monitor(monitor)
+
+    @property
+    def particles(self):
+        """The particles of the SPH part."""
+        return self.stepper.particles
 
     # ---------------------------------------------------------------- set-up
     @classmethod
-    def from_deck(cls, deck, outdir) -> "Simulation":
+    def from_deck(cls, deck, outdir, events=()) -> "Simulation":
+        """A new run of ``deck`` in ``outdir``; ``events`` are added to the deck's."""
         outdir = Path(outdir)
         outdir.mkdir(parents=True, exist_ok=True)
         dump_resolved(deck, outdir / RESOLVED)
-        solver = Solver(build_model(deck), deck)
-        sim = cls(deck, outdir, solver, History(), FrameWriter(outdir, vtk=deck.output.vtk),
-                  next_frame=0.0)
-        return sim
+        stepper = build_stepper(deck, events=events)
+        return cls(deck, outdir, stepper, History(), FrameWriter(outdir, vtk=deck.output.vtk),
+                   next_frame=0.0)
 
     @classmethod
-    def from_directory(cls, outdir) -> "Simulation":
-        """Restart from ``DIR/checkpoint.h5`` with the deck saved in ``DIR``."""
+    def from_directory(cls, outdir, events=()) -> "Simulation":
+        """Restart from ``DIR/checkpoint.h5`` with the deck saved in ``DIR``
+        (and the ``events`` the run was started with)."""
         outdir = Path(outdir)
         ck = outdir / CHECKPOINT
         if not ck.exists():
@@ -78,15 +94,15 @@ class Simulation:
                                     "written with output.checkpoint_every > 0 or an "
                                     "interrupted run")
         deck = load_deck(outdir / RESOLVED)
-        arrays, scalars, groups = read_checkpoint(ck)
-        solver = Solver(build_model(deck), deck)
-        solver.restore(scalars, groups["solver"], groups["particles"])
-        t = solver.t
+        _, scalars, groups = read_checkpoint(ck)
+        stepper = build_stepper(deck, events=events)
+        stepper.restore(scalars, groups)
+        t = stepper.t
         hist_path = outdir / "history.csv"
         history = History.from_csv(hist_path) if hist_path.exists() else History()
         history.truncate_after(np.nextafter(t, -np.inf))  # the next step records t
         frames = FrameWriter(outdir, vtk=deck.output.vtk, start_after=t)
-        return cls(deck, outdir, solver, history, frames,
+        return cls(deck, outdir, stepper, history, frames,
                    next_frame=float(scalars["next_frame"]))
 
     # ------------------------------------------------------------------- run
@@ -97,12 +113,13 @@ class Simulation:
         Returns the run summary. Raises :class:`SimulationFailed` after writing
         all output when a guard stops the run.
         """
-        deck, s = self.deck, self.solver
+        deck, s = self.deck, self.stepper
         t_end = deck.run.t_end if t_end is None else t_end
+        self.output.t_end = t_end
         show = deck.output.progress if progress is None else progress
-        every_hist = deck.output.history_every
-        every_ck = deck.output.checkpoint_every
-        bar = _progress(show, s.t, t_end)
+        bar = Progress(s.t, t_end) if show else None
+        if bar is not None:
+            s.add_monitor(bar)
         start_step = s.step_count
         failure = None
         t0 = time.perf_counter()
@@ -112,21 +129,14 @@ class Simulation:
             while s.t < t_end * (1 - 1e-12):
                 if max_steps is not None and s.step_count - start_step >= max_steps:
                     break
-                record = s.step(t_stop=t_end)
-                if (s.step_count - 1) % every_hist == 0:
-                    self.history.append(record)
-                if s.t >= self.next_frame - 1e-12 * t_end:
-                    self._write_frame()
-                if every_ck and s.step_count % every_ck == 0:
-                    self._checkpoint()
-                if bar is not None:
-                    bar.update(s.t - bar.n)
+                s.step(t_stop=t_end)
         except SimulationFailed as exc:
             failure = exc
         finally:
             self.wall_seconds += time.perf_counter() - t0
             if bar is not None:
                 bar.close()
+                s.monitors.remove(bar)
         if failure is None and s.t >= t_end * (1 - 1e-12) and (
                 not self.frames.frames_on_disk()
                 or abs(self.frames.last_time - s.t) > 1e-12 * t_end):
@@ -134,7 +144,8 @@ class Simulation:
         if failure is not None:
             self._write_frame()
         if failure is None and s.t >= t_end * (1 - 1e-12):
-            self.history.append(s.energies(self._kinetic_now(), s.dt_prev))
+            self.history.append(self.recorder.row(s, kinetic=s.kinetic_now(),
+                                                  dt=s.dt_prev))
         self.history.write_csv(self.outdir / "history.csv")
         if failure is None:
             self._checkpoint()
@@ -150,39 +161,38 @@ class Simulation:
         return summary
 
     # --------------------------------------------------------------- helpers
-    def _kinetic_now(self) -> float:
-        p = self.solver.p
-        return float(0.5 * np.sum(p.m * np.sum(p.v * p.v, axis=1)))
-
     def _write_frame(self):
-        s = self.solver
-        fields = particle_fields(s.p, self.fields, s.output_fields())
+        s = self.stepper
+        computed = {}
+        for part in s.parts:
+            computed.update(part.fields())
+        fields = particle_fields(s.particles, self.fields, computed)
         self.frames.write(s.t, s.step_count, fields)
-        k = math.floor(s.t / self.frame_every + 1e-9) + 1
-        self.next_frame = k * self.frame_every
+        self.output.written(s.t)
 
     def _checkpoint(self):
-        s = self.solver
-        scalars = dict(s.state_scalars(), next_frame=self.next_frame,
-                       version=__version__)
-        groups = {"particles": s.p.arrays(), "solver": s.state_arrays()}
+        scalars, groups = self.stepper.state()
+        scalars.update(next_frame=self.output.next_frame, version=__version__)
         write_checkpoint(self.outdir / CHECKPOINT, {}, scalars, groups)
         self.history.write_csv(self.outdir / "history.csv")
 
     def _summary(self, start_step: int, failure) -> dict:
-        s, deck = self.solver, self.deck
+        s, deck = self.stepper, self.deck
         steps = s.step_count - start_step
+        n = sum(part.kin.n for part in s.parts)
+        sph = s.part("sph")
         h = self.history.as_arrays() if len(self.history.columns) else {}
         summary = {
             "sphdyn": __version__, "title": deck.run.title, "status":
             "completed" if failure is None and s.t >= deck.run.t_end * (1 - 1e-12)
             else ("failed" if failure is not None else "stopped"),
             "diagnosis": None if failure is None else failure.diagnosis,
-            "particles": s.p.n, "dimension": s.dim, "time": s.t, "steps": s.step_count,
-            "steps_this_run": steps, "wall_seconds": self.wall_seconds,
-            "particle_steps_per_s": s.p.n * steps / max(self.wall_seconds, 1e-12),
-            "initial_dt": s.dt0, "neighbours_mean": mean_neighbours(s.nl),
-            "neighbours_max": max_neighbours(s.nl), "neighbour_builds": s.nl.n_builds,
+            "particles": n, "dimension": s.particles.dim, "time": s.t,
+            "steps": s.step_count, "steps_this_run": steps,
+            "wall_seconds": self.wall_seconds,
+            "particle_steps_per_s": n * steps / max(self.wall_seconds, 1e-12),
+            "initial_dt": s.dt0, "neighbours_mean": mean_neighbours(sph.nl),
+            "neighbours_max": max_neighbours(sph.nl), "neighbour_builds": sph.nl.n_builds,
         }
         if "E_total" in h and h["E_total"].size:
             # the drift drawn in plots/energies.png: relative to the largest
@@ -190,7 +200,7 @@ class Simulation:
             drift = relative_drift(h["E_total"], [h[c] for c in energy_columns(list(h))])
             summary["energy_error_max_rel"] = float(np.max(np.abs(drift)))
         window = deck.output.force_window
-        for w in s.model.walls:
+        for w in self.model.walls:
             col = f"F_wall_{w.name}"
             if col in h and h[col].size:
                 summary[f"peak_{col}"] = float(np.max(h[col]))
@@ -198,19 +208,9 @@ class Simulation:
                 if impulse is not None:
                     summary[f"peak_{col}_mean"] = float(np.max(window_mean_force(
                         h["time"], impulse, window)))
-        if s.model.walls:
+        if self.model.walls:
             summary["force_window"] = window
         return summary
-
-
-def _progress(show: bool, t: float, t_end: float):
-    if not show:
-        return None
-    from tqdm import tqdm
-
-    return tqdm(total=t_end, initial=t, unit="s(sim)", unit_scale=True,
-                bar_format="{l_bar}{bar}| t={n:.3e}/{total:.3e} s [{elapsed}<{remaining}]",
-                mininterval=0.5)
 
 
 def run_deck(path, outdir=None, overrides=None, **kw) -> dict:

@@ -14,7 +14,7 @@ its own mass), its velocity gradient, density and stress follow its
 neighbours, so it travels with the material around it as an interpolation
 point. The wall contact must then use the bulk-modulus stiffness (paper
 eq. 9), because the mass-based spring of eq. 8 vanishes with the mass; see
-:mod:`sphdyn.contact.wall`.
+:mod:`sphdyn.interactions.wall_contact`.
 
 Crack shapes (``shape`` of a ``[[body.crack]]`` table), each thickened to
 ``rows`` particle rows, i.e. the particles whose centre lies closer than

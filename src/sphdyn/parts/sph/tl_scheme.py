@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..neighbours import build_neighbours
+from ...neighbours import build_neighbours
 from .total_lagrangian import (deformation_gradient, hourglass_coefficients, piola_stress,
                                reference_gradients, tl_density, tl_forces)
 

@@ -45,7 +45,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ..kernels import d2wdq2, support_nb
+from ...kernels import d2wdq2, support_nb
 
 __all__ = ["REL_STRESS_TOL", "FLAG_FRACTION", "stress_scale", "swegle_indicator",
            "count_unstable"]

@@ -31,7 +31,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ..kernels import dwdq_over_q, kernel_value, support_nb
+from ...kernels import dwdq_over_q, kernel_value, support_nb
 
 _DET_TOL = 1e-12
 

@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ..kernels import dwdq_over_q, kernel_value, support_nb
+from ...kernels import dwdq_over_q, kernel_value, support_nb
 
 # Determinant below which the correction matrix is treated as singular
 # (isolated particle or a neighbourhood on a line); the raw gradient is used then.

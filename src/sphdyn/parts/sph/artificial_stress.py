@@ -50,7 +50,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ..kernels import w
+from ...kernels import w
 
 __all__ = ["artificial_stress_tensor", "artificial_stress_forces"]
 

@@ -1,0 +1,61 @@
+"""Deck -> stepper: the SPH part, walls, contact, events and the time-step limits.
+
+With :mod:`sphdyn.model` (particles, materials, sets, probes) this is the
+only place that reads the deck; parts, interactions and the stepper see
+settings objects, arrays and scalars.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .interactions import ParticleContact, Wall
+from .kernels import KernelContext
+from .model import Model, build_model
+from .parts import SPHPart, SPHSettings
+from .stepper import Stepper
+
+
+def sph_settings(deck) -> SPHSettings:
+    """The SPH scheme's settings from ``[sph]``, ``[time]`` and the bodies."""
+    sph = deck.sph
+    tl = tuple((b.formulation or sph.formulation) == "total_lagrangian" for b in deck.body)
+    eps = tuple(sph.artificial_stress.epsilon if b.artificial_stress is None
+                else b.artificial_stress for b in deck.body)
+    return SPHSettings(
+        correction=bool(sph.correction), alpha=sph.viscosity.alpha,
+        beta=sph.viscosity.beta, xsph=sph.xsph,
+        benz=sph.smoothing_length.mode == "benz",
+        h_min_factor=sph.smoothing_length.min_factor,
+        h_max_factor=sph.smoothing_length.max_factor,
+        skin_factor=sph.neighbours.skin_factor, cfl=deck.time.cfl,
+        stress_exponent=sph.artificial_stress.n, epsilon=eps, total_lagrangian=tl,
+        hourglass=sph.hourglass, reference_update_every=sph.reference_update_every)
+
+
+def contact_on(deck) -> bool:
+    """``[contact] enabled``, by default on with two or more bodies of which one
+    is total-Lagrangian (their kernels never see the other bodies)."""
+    c = deck.contact
+    if c.enabled is not None:
+        return bool(c.enabled)
+    tl = sph_settings(deck).total_lagrangian
+    return len(deck.body) >= 2 and any(tl)
+
+
+def build_stepper(deck, model: Model | None = None, events=(), monitors=()) -> Stepper:
+    """The stepper of a validated deck (the model is built if not given)."""
+    model = build_model(deck) if model is None else model
+    p = model.particles
+    kernel = KernelContext.named(deck.sph.kernel, p.dim, deck.sph.support_scale)
+    part = SPHPart(p, model.groups, kernel, sph_settings(deck), phase=model.phase,
+                   variation=model.variation)
+    interactions = []
+    if contact_on(deck) and p.n:
+        interactions.append(ParticleContact(part, deck.contact.alpha,
+                                            deck.contact.distance_factor))
+    interactions += [Wall(spec, part) for spec in model.walls]
+    dt_max = deck.time.dt_max if deck.time.dt_max is not None else np.inf
+    stepper = Stepper([part], interactions, events, monitors, dt_max=dt_max)
+    stepper.model = model
+    return stepper

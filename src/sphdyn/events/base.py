@@ -1,0 +1,23 @@
+"""The Event protocol: a change of the model between two steps.
+
+After each step the :class:`~sphdyn.stepper.Stepper` asks every event
+``due(stepper)`` and, if so, calls ``apply(stepper)``. An event may add
+items to a part (``part.kin.grow(k)``: every per-item array, the neighbour
+lists and the material groups follow, see :mod:`sphdyn.state.store`).
+Erosion of elements into particles (the erosion issue) is an event;
+:mod:`.inject` proves the mechanism. ``state()`` / ``restore()`` keep what
+an event must remember across a restart (whether it fired).
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+
+class Event(Protocol):
+    name: str
+
+    def due(self, stepper) -> bool: ...
+    def apply(self, stepper) -> None: ...
+    def state(self) -> dict: ...
+    def restore(self, scalars: dict) -> None: ...

@@ -1,0 +1,56 @@
+"""The Interaction protocol: forces between parts, or between a part and the world.
+
+Walls, particle-particle contact and (with the FEM issue) the SPH-FEM
+couplings. The :class:`~sphdyn.stepper.Stepper` asks each interaction
+
+* ``stable_dt()``: its stability limit (``inf`` if it needs none);
+* ``update_geometry(t)``: after the drift (contact neighbour lists);
+* ``forces(t, dt, a_out)``: accelerations **added** to ``a_out``, the
+  ``a_ext`` of the part it acts on (``dt`` is the stable step, which
+  mass-based penalty springs use); it also refreshes what it reports;
+* ``after_kick(dt_kick)``: bookkeeping over the kick (impulses);
+* ``constrain(t)``: a hook after the kick where tied couplings correct
+  velocities (none of today's interactions needs it);
+* ``columns(t)``: its history columns; ``state()`` / ``restore()``.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+import numpy as np
+
+
+class Interaction(Protocol):
+    name: str
+
+    def stable_dt(self) -> float: ...
+    def update_geometry(self, t: float) -> None: ...
+    def forces(self, t: float, dt: float, a_out: np.ndarray) -> None: ...
+    def after_kick(self, dt_kick: float) -> None: ...
+    def constrain(self, t: float) -> None: ...
+    def columns(self, t: float) -> dict[str, float]: ...
+    def state(self) -> tuple[dict, dict[str, np.ndarray]]: ...
+    def restore(self, scalars: dict, arrays: dict[str, np.ndarray]) -> None: ...
+
+
+class InteractionBase:
+    """Defaults for the optional hooks: nothing to do, nothing to keep."""
+
+    def stable_dt(self) -> float:
+        return np.inf
+
+    def update_geometry(self, t: float) -> None:
+        return None
+
+    def after_kick(self, dt_kick: float) -> None:
+        return None
+
+    def constrain(self, t: float) -> None:
+        return None
+
+    def state(self) -> tuple[dict, dict[str, np.ndarray]]:
+        return {}, {}
+
+    def restore(self, scalars: dict, arrays: dict[str, np.ndarray]) -> None:
+        return None

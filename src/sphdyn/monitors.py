@@ -1,0 +1,102 @@
+"""Monitors: what watches the step from outside it (guards, history, output cadence).
+
+A monitor has any of the hooks the :class:`~sphdyn.stepper.Stepper` calls:
+``before_step(stepper, dt, k, part)`` with the step about to be taken,
+``after_kick(stepper)`` with the state at the kick's time :math:`t^n`, and
+``after_step(stepper)`` at :math:`t^{n+1}`. They are attached in this order
+by :class:`~sphdyn.simulation.Simulation`: guards, history (with probes),
+frames, checkpoints, progress.
+"""
+
+from __future__ import annotations
+
+import math
+
+from .guards import check_particles, check_time_step
+from .probes import record as probe_record
+
+
+class Guards:
+    """Stop the run with a diagnosis: time-step collapse, NaN, particles leaving
+    the domain box ``[lo, hi]`` (see :mod:`sphdyn.guards`)."""
+
+    def __init__(self, lo, hi, collapse_ratio: float):
+        self.lo, self.hi, self.collapse_ratio = lo, hi, collapse_ratio
+
+    def before_step(self, s, dt, k, part) -> None:
+        check_time_step(dt, s.dt0, self.collapse_ratio, s.t, s.step_count, k, part.kin)
+
+    def after_step(self, s) -> None:
+        for part in s.parts:
+            q = part.kin
+            check_particles(q, self.lo, self.hi, s.t, s.step_count,
+                            q.add("guard_work", (), "int8"))
+
+
+class HistoryRecorder:
+    """Append a history row (the stepper's record and the probes) every
+    ``every`` steps, taken at the kick's time and kept once the step has
+    passed the guards."""
+
+    def __init__(self, history, every: int, probes=()):
+        self.history, self.every, self.probes = history, every, list(probes)
+        self._row = None
+
+    def row(self, s, **kw) -> dict:
+        rec = s.record(**kw)
+        rec.update(probe_record(s.particles, self.probes))
+        return rec
+
+    def after_kick(self, s) -> None:
+        self._row = self.row(s) if s.step_count % self.every == 0 else None
+
+    def after_step(self, s) -> None:
+        if self._row is not None:
+            self.history.append(self._row)
+            self._row = None
+
+
+class FrameOutput:
+    """Write a frame whenever the time passes the next multiple of ``every``."""
+
+    def __init__(self, write, every: float, next_frame: float, t_end: float):
+        self.write, self.every = write, every
+        self.next_frame, self.t_end = next_frame, t_end
+
+    def due(self, t: float) -> bool:
+        return t >= self.next_frame - 1e-12 * self.t_end
+
+    def written(self, t: float) -> None:
+        self.next_frame = (math.floor(t / self.every + 1e-9) + 1) * self.every
+
+    def after_step(self, s) -> None:
+        if self.due(s.t):
+            self.write()
+
+
+class Checkpoints:
+    """Write a checkpoint every ``every`` steps (0: never)."""
+
+    def __init__(self, write, every: int):
+        self.write, self.every = write, every
+
+    def after_step(self, s) -> None:
+        if self.every and s.step_count % self.every == 0:
+            self.write()
+
+
+class Progress:
+    """A progress bar with an ETA in simulated time (tqdm)."""
+
+    def __init__(self, t: float, t_end: float):
+        from tqdm import tqdm
+
+        self.bar = tqdm(total=t_end, initial=t, unit="s(sim)", unit_scale=True,
+                        bar_format="{l_bar}{bar}| t={n:.3e}/{total:.3e} s "
+                                   "[{elapsed}<{remaining}]", mininterval=0.5)
+
+    def after_step(self, s) -> None:
+        self.bar.update(s.t - self.bar.n)
+
+    def close(self) -> None:
+        self.bar.close()

@@ -1,0 +1,321 @@
+"""The SPH part: particles, their material groups and the order of the SPH passes.
+
+One step of the part (the stepper calls these in this order, state at
+:math:`t^n`: :math:`\\mathbf x^n,\\ \\mathbf v^{n-1/2},\\ \\sigma^n,\\
+\\mathbf a^n`):
+
+1. :meth:`SPHPart.drift` to :math:`\\mathbf x^{n+1}` (XSPH-smoothed velocity
+   if enabled);
+2. :meth:`SPHPart.update_geometry`: neighbour list update (only when the
+   Verlet skin is exhausted), total-Lagrangian reference update every
+   ``reference_update_every`` steps, velocity gradient, density and
+   smoothing length (total-Lagrangian bodies take L and the density from
+   their deformation gradient, :mod:`.tl_scheme`);
+3. :meth:`SPHPart.internal_forces`: material update of every group
+   (:math:`\\sigma^{n+1}`, internal energy), stress divergence and artificial
+   viscosity (plus the artificial stress of :mod:`.artificial_stress` when
+   ``epsilon > 0``; the first Piola-Kirchhoff form with hourglass control on
+   total-Lagrangian bodies) into ``a``, and the viscous heat.
+
+The Swegle indicator (:mod:`.swegle`) is evaluated on demand: the output
+field ``swegle`` and the history column ``swegle_unstable``.
+
+Per-particle arrays the part derives (particle size, bulk modulus,
+artificial-stress epsilon, the total-Lagrangian mask, the mesostructure
+phase and the variation factor) and its work arrays live in the particles'
+:class:`~sphdyn.state.ArrayStore`; when particles are added, :meth:`_grown`
+refreshes them, the material groups and the neighbour lists.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...integrate import add_heat, cfl_time_step, drift, internal_energies
+from ...kernels import KernelContext
+from ...neighbours import build_neighbours, mean_neighbours, update_neighbours
+from ...state import Particles
+from ..base import register_part
+from .artificial_stress import artificial_stress_forces, artificial_stress_tensor
+from .passes import (forces, particle_volumes, scaled_stress, update_density_and_h,
+                     velocity_gradient, xsph_velocity)
+from .swegle import FLAG_FRACTION, REL_STRESS_TOL, count_unstable, stress_scale, swegle_indicator
+from .tl_scheme import TotalLagrangian
+
+
+@dataclass(frozen=True)
+class SPHSettings:
+    """The SPH scheme's settings, resolved from the deck by :mod:`sphdyn.assembly`.
+
+    Per-body tuples are indexed by ``particles.body``.
+    """
+
+    correction: bool = False  # Randles-Libersky gradient correction
+    alpha: float = 1.0  # artificial viscosity (Monaghan 1992)
+    beta: float = 2.0
+    xsph: float = 0.0  # XSPH epsilon (0: off)
+    benz: bool = True  # smoothing length from the density (else constant)
+    h_min_factor: float = 0.0  # h bounds in units of h0
+    h_max_factor: float = np.inf
+    skin_factor: float = 0.1  # Verlet skin in units of the support radius
+    cfl: float = 0.3
+    stress_exponent: float = 4.0  # artificial stress n (Monaghan 2000)
+    epsilon: tuple = (0.0,)  # artificial stress epsilon per body
+    total_lagrangian: tuple = (False,)  # per body
+    hourglass: float = 0.0  # total-Lagrangian hourglass coefficient
+    reference_update_every: int = 0  # total-Lagrangian reference update (0: never)
+
+
+@register_part("sph")
+class SPHPart:
+    """SPH particles of one or more bodies and the passes that move them.
+
+    Parameters
+    ----------
+    particles : the particle state.
+    groups : material groups (``model.MaterialGroup``), dispatched once each.
+    kernel : the kernel context.
+    settings : the scheme's settings.
+    phase, variation : (N,) mesostructure phase (int8, -1 outside one) and
+        material variation factor, or None; kept as output fields.
+    """
+
+    name = "sph"
+
+    def __init__(self, particles: Particles, groups: list, kernel: KernelContext,
+                 settings: SPHSettings, phase=None, variation=None):
+        p = self.p = self.kin = particles
+        self.groups = groups
+        self.kernel = kernel
+        self.s = settings
+        self.dim = p.dim
+        self.has_phase, self.has_variation = phase is not None, variation is not None
+        p.add("phase", (), np.int8, fill=-1)
+        p.add("variation", (), np.float64, fill=1.0)
+        if phase is not None:
+            p.phase = phase
+        if variation is not None:
+            p.variation = variation
+        for name, tail in (("B", (3, 3)), ("dedt_av", ()), ("S", (3, 3)), ("vol", ()),
+                           ("size", ()), ("bulk_modulus", ()), ("young", ()),
+                           ("as_eps", ()), ("swegle", ())):
+            p.add(name, tail)
+        p.add("tl", (), np.bool_, fill=False)
+        self.as_on = any(e > 0 for e, tl in zip(settings.epsilon, settings.total_lagrangian)
+                         if not tl)
+        if self.as_on:
+            p.add("R", (3, 3))
+            p.add("Q", (3, 3))
+        if settings.xsph > 0:
+            p.add("vs", (3,))
+        self.F = np.zeros(0)  # pair gradient factors of the current list
+        self.swegle_unstable = 0
+        self._swegle_at = None  # (t, step) the indicator was evaluated at
+        self.step = 0
+        self._derive(0, p.n)
+        r0 = kernel.radius_factor * float(p.h.max()) if p.n else 0.0
+        self.skin = settings.skin_factor * r0
+        self.nl = build_neighbours(p.x, p.h, kernel.radius_factor, self.skin, self.dim,
+                                   active=self.ul_active)
+        self.tl = None
+        if p.tl.any():
+            self.tl = TotalLagrangian(p, np.flatnonzero(p.tl), kernel.kid, kernel.sigma,
+                                      kernel.radius_factor, kernel.support_scale, p.young,
+                                      settings.hourglass, settings.alpha, settings.beta)
+        p.on_grow(self._grown)
+
+    # ------------------------------------------------------- derived arrays
+    def _derive(self, lo: int, hi: int) -> None:
+        """Per-particle data derived from body and material, rows ``lo:hi``."""
+        p, s = self.p, self.s
+        rows = slice(lo, hi)
+        p.size[rows] = p.vol0[rows] ** (1.0 / p.dim)  # particle size, initial dx [m]
+        tl_body = np.asarray(s.total_lagrangian, bool)
+        p.tl[rows] = tl_body[p.body[rows]]
+        eps = np.asarray(s.epsilon, float)
+        p.as_eps[rows] = np.where(p.tl[rows], 0.0, eps[p.body[rows]])
+        for g in self.groups:
+            sel = g.idx[(g.idx >= lo) & (g.idx < hi)]
+            k, mu = g.model.bulk_modulus(g.params), g.model.shear_modulus(g.params)
+            p.bulk_modulus[sel] = k
+            p.young[sel] = 9.0 * k * mu / (3.0 * k + mu)
+        self.ul_active = ~p.tl if p.tl.any() else None
+        self.has_ul = not p.tl.all()  # False: the updated-Lagrangian passes are skipped
+
+    def _grown(self, n_old: int, n_new: int) -> None:
+        """Particles ``n_old:n_new`` were added: groups, derived data, neighbours.
+
+        New particles join the first group of their material (``mat``) and,
+        in total-Lagrangian bodies, take their current position as reference.
+        Their accelerations are zero until the next step computes them.
+        """
+        p = self.p
+        new = np.arange(n_old, n_new)
+        for mat in np.unique(p.mat[new]):
+            g = next((g for g in self.groups if g.material == mat), None)
+            if g is None:
+                raise ValueError(f"added particles of material {mat} have no group; "
+                                 "add particles of a material the model already has")
+            g.idx = np.concatenate([g.idx, new[p.mat[new] == mat]])
+        self._derive(n_old, n_new)
+        self.nl = build_neighbours(p.x, p.h, self.kernel.radius_factor, self.skin,
+                                   self.dim, active=self.ul_active)
+        if self.tl is not None or p.tl.any():
+            X = p.x.copy() if self.tl is None else np.concatenate([self.tl.X, p.x[n_old:]])
+            rho_ref = p.rho.copy() if self.tl is None else np.concatenate(
+                [self.tl.rho_ref, p.rho[n_old:]])
+            if self.tl is None:
+                self.tl = TotalLagrangian(p, np.flatnonzero(p.tl), self.kernel.kid,
+                                          self.kernel.sigma, self.kernel.radius_factor,
+                                          self.kernel.support_scale, p.young,
+                                          self.s.hourglass, self.s.alpha, self.s.beta)
+            self.tl.rows = np.flatnonzero(p.tl).astype(np.int64)
+            self.tl.young = p.young
+            self.tl.rebuild(p, X, rho_ref)
+        self._swegle_at = None
+
+    # ----------------------------------------------------------- protocol
+    def stable_dt(self) -> tuple[float, int]:
+        """CFL step :math:`C \\min h / (c + |v|)` and the controlling particle."""
+        p = self.p
+        return cfl_time_step(p.h, p.c, p.v, min(1.0, self.kernel.support_scale), self.s.cfl)
+
+    def start(self, dt: float) -> None:
+        """Accelerations of the initial state (gradients and divergence, no update)."""
+        self._gradients()
+        self._accelerations()
+
+    def drift(self, dt: float) -> None:
+        p, k = self.p, self.kernel
+        if self.s.xsph > 0:
+            xsph_velocity(p.x, p.v, p.m, p.rho, p.h, self.nl.offsets, self.nl.idx, k.kid,
+                          k.sigma, self.dim, k.support_scale, self.s.xsph, p.vs)
+            drift(p.x, p.vs, dt)
+        else:
+            drift(p.x, p.v, dt)
+        self.step += 1
+
+    def update_geometry(self, t: float, dt: float) -> None:
+        p, s = self.p, self.s
+        self.nl = update_neighbours(self.nl, p.x, p.h, self.dim, self.ul_active)
+        if self.tl is not None and s.reference_update_every and \
+                self.step % s.reference_update_every == 0:
+            self.tl.update_reference(p)
+        self._gradients()
+        if self.has_ul:
+            update_density_and_h(p.L, dt, self.dim, s.benz, p.h0, s.h_min_factor,
+                                 s.h_max_factor, p.rho, p.h)
+        if self.tl is not None:
+            self.tl.density(p)
+
+    def internal_forces(self, t: float, dt: float) -> None:
+        p = self.p
+        for g in self.groups:
+            g.model.update(g.idx, p.L, dt, p.rho, p.sig, p.e, p.c, p.damage, p.hist,
+                           g.params, p.size)
+        self._accelerations()
+        add_heat(p.e, p.e_av, p.dedt_av, dt)
+
+    def energies(self) -> tuple[float, float]:
+        """Internal energy and its artificial-viscosity part [J] (J/m in 2D)."""
+        return internal_energies(self.p.m, self.p.e, self.p.e_av)
+
+    def columns(self) -> dict[str, float]:
+        """``swegle_unstable``: particles flagged by the Swegle criterion now."""
+        self.swegle_field()
+        return {"swegle_unstable": float(self.swegle_unstable)}
+
+    def fields(self) -> dict:
+        """Output fields the part evaluates on demand (for ``particle_fields``)."""
+        out = {"swegle": self.swegle_field}
+        if self.has_phase:
+            out["phase"] = lambda: self.p.phase
+        if self.has_variation:
+            out["variation"] = lambda: self.p.variation
+        return out
+
+    def state(self) -> tuple[dict, dict[str, np.ndarray]]:
+        p = self.p
+        arrays = {"B": p.B, "dedt_av": p.dedt_av, "nl_offsets": self.nl.offsets,
+                  "nl_idx": self.nl.idx, "nl_x_ref": self.nl.x_ref,
+                  "nl_h_ref": self.nl.h_ref}
+        if self.tl is not None:  # the reference configuration may have been updated
+            arrays.update({"tl_X": self.tl.X, "tl_rho_ref": self.tl.rho_ref})
+        return {"step": self.step}, arrays
+
+    def restore(self, scalars: dict, arrays: dict) -> None:
+        """Continue from a checkpoint (bitwise identical continuation)."""
+        p = self.p
+        self.step = int(scalars["step"])
+        p.B = arrays["B"]
+        p.dedt_av = arrays["dedt_av"]
+        nl = self.nl
+        nl.offsets = arrays["nl_offsets"].copy()
+        nl.idx = arrays["nl_idx"].copy()
+        nl.x_ref = arrays["nl_x_ref"].copy()
+        nl.h_ref = arrays["nl_h_ref"].copy()
+        if self.tl is not None:
+            if "tl_X" in arrays and not (np.array_equal(arrays["tl_X"], self.tl.X) and
+                                         np.array_equal(arrays["tl_rho_ref"],
+                                                        self.tl.rho_ref)):
+                self.tl.rebuild(p, arrays["tl_X"].copy(), arrays["tl_rho_ref"].copy())
+            self.tl.velocity_gradient(p)  # F of the restored state
+        self._swegle_at = None
+
+    # ------------------------------------------------------------- passes
+    def _gradients(self) -> None:
+        """Pair kernel gradients (once per step) and the velocity gradient L."""
+        p, nl, k = self.p, self.nl, self.kernel
+        if self.F.shape[0] != nl.idx.shape[0]:
+            self.F = np.empty(nl.idx.shape[0])  # only after a neighbour rebuild
+        if self.has_ul:
+            particle_volumes(p.m, p.rho, p.vol)
+            velocity_gradient(p.x, p.v, p.h, p.vol, nl.offsets, nl.idx, k.kid, k.sigma,
+                              self.dim, k.support_scale, self.s.correction, self.F, p.L,
+                              p.B)
+        if self.tl is not None:
+            self.tl.velocity_gradient(p)
+
+    def _accelerations(self) -> None:
+        """Stress divergence and artificial viscosity (and stress) into ``a``.
+
+        Uses the pair gradients of :meth:`_gradients` (smoothing length of the
+        start of the step; h changes slowly, by design of the Benz update).
+        """
+        p, nl, k, s = self.p, self.nl, self.kernel, self.s
+        if self.has_ul:
+            scaled_stress(p.sig, p.rho, p.S)
+            forces(p.x, p.v, p.m, p.rho, p.h, p.c, p.S, p.B, self.F, nl.offsets, nl.idx,
+                   self.dim, k.support_scale, s.correction, s.alpha, s.beta, p.a,
+                   p.dedt_av)
+        if self.as_on:
+            artificial_stress_tensor(p.sig, p.rho, p.as_eps, p.R, p.Q)
+            artificial_stress_forces(p.x, p.m, p.h, p.R, self.F, nl.offsets, nl.idx,
+                                     k.kid, self.dim, k.support_scale, p.size,
+                                     s.stress_exponent, p.a, p.v, p.dedt_av)
+        if self.tl is not None:
+            self.tl.accelerations(p, p.dedt_av)
+
+    def swegle_field(self) -> np.ndarray:
+        """Swegle indicator (N,) of the current state (see :mod:`.swegle`).
+
+        Computed at most once per state; also updates ``swegle_unstable``, the
+        number of particles with more than ``FLAG_FRACTION`` unstable pairs.
+        Returns the part's array (not a copy).
+        """
+        if self._swegle_at != self.step:
+            p, nl, k = self.p, self.nl, self.kernel
+            tol = REL_STRESS_TOL * stress_scale(p.sig, p.m)
+            swegle_indicator(p.x, p.m, p.h, p.sig, nl.offsets, nl.idx, k.kid, k.sigma,
+                             self.dim, k.support_scale, tol, p.swegle)
+            self.swegle_unstable = int(count_unstable(p.swegle, p.m, FLAG_FRACTION))
+            self._swegle_at = self.step
+        return self.p.swegle
+
+    @property
+    def mean_neighbours(self) -> float:
+        """Mean neighbours per particle: of the total-Lagrangian reference lists
+        if the part has total-Lagrangian bodies, else of the current list."""
+        return self.tl.mean_neighbours if self.tl is not None else mean_neighbours(self.nl)

@@ -1,0 +1,247 @@
+r"""One explicit step over parts, interactions and events; the stepper knows no physics.
+
+Central differences (leapfrog, :mod:`sphdyn.integrate`), state at
+:math:`t^n`: :math:`\mathbf x^n,\ \mathbf v^{n-1/2},\ \mathbf a^n`:
+
+1. time step: the smallest of the parts' and interactions' stable steps and
+   ``dt_max`` (monitors' ``before_step`` see it: the collapse guard);
+2. kick of every part to :math:`\mathbf v^{n+1/2}` with its boundary
+   conditions, booking the kinetic energy at :math:`t^n`, the work of the
+   interaction accelerations ``a_ext`` and of the boundary reactions;
+   interactions' ``after_kick`` (impulses) and ``constrain`` (tied DOFs);
+   monitors' ``after_kick`` see the state at :math:`t^n` (history records);
+3. drift of every part to :math:`\mathbf x^{n+1}`;
+4. parts' ``update_geometry``, interactions' ``update_geometry``;
+5. parts' ``internal_forces`` (:math:`\sigma^{n+1}` and ``a``), then the
+   interactions' forces into ``a_ext``, added to ``a``: :math:`\mathbf a^{n+1}`;
+6. events (a change of the model between steps), then monitors'
+   ``after_step`` (guards, history, frames, checkpoints).
+
+The energy balance :math:`E_{total} = E_{kin} + E_{int} + E_{contact} -
+W_{ext}`, with :math:`E_{contact} = -W_{contact}` the negative work of the
+interaction forces, is recorded by :meth:`Stepper.record`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .integrate import kick
+
+
+def _add(total, value):
+    """``total + value``, with the first value taken as it is (no ``0.0 +``)."""
+    return value if total is None else total + value
+
+
+class Stepper:
+    """Advance parts, interactions and events in time.
+
+    Parameters
+    ----------
+    parts : the parts (each with ``kin``; see :mod:`sphdyn.parts.base`).
+    interactions : see :mod:`sphdyn.interactions.base`; each acts on one part
+        (``interaction.part``) and adds into that part's ``a_ext``.
+    events : see :mod:`sphdyn.events.base`.
+    monitors : objects with any of ``before_step(stepper, dt, k, part)``,
+        ``after_kick(stepper)``, ``after_step(stepper)``.
+    dt_max : largest step [s].
+    """
+
+    def __init__(self, parts, interactions=(), events=(), monitors=(), dt_max=np.inf):
+        self.parts = list(parts)
+        self.interactions = list(interactions)
+        self.events = list(events)
+        self.monitors = list(monitors)
+        self.dt_max = dt_max
+        self.t = 0.0
+        self.step_count = 0
+        self.dt_prev = 0.0  # 0 before the first kick (half kick)
+        self.dt_step = 0.0  # the last step taken (shortened to land on t_stop)
+        self.kinetic = 0.0  # kinetic energy at the last kick's time [J]
+        self.work_contact = 0.0  # work of the interaction forces [J]
+        self.work_external = 0.0  # work of the boundary-condition reactions [J]
+        for part in self.parts:
+            part.kin.add("v_mid", (3,))
+        self.dt0, _, _ = self.stable_dt()
+        self.dt_contact_step = self.dt0  # the step the penalty springs use
+        for part in self.parts:
+            part.start(self.dt0)
+        self._interaction_forces(self.dt0)
+
+    # ------------------------------------------------------------- access
+    def part(self, name: str):
+        """The part called ``name``."""
+        for p in self.parts:
+            if p.name == name:
+                return p
+        raise KeyError(f"no part {name!r}; parts: {[p.name for p in self.parts]}")
+
+    @property
+    def particles(self):
+        """The particles of the first SPH part (the common case)."""
+        return next(p.p for p in self.parts if p.kind == "sph")
+
+    def add_monitor(self, monitor) -> None:
+        self.monitors.append(monitor)
+
+    def _notify(self, hook: str, *args) -> None:
+        for m in self.monitors:
+            fn = getattr(m, hook, None)
+            if fn is not None:
+                fn(self, *args)
+
+    # --------------------------------------------------------------- step
+    def stable_dt(self) -> tuple[float, int, object]:
+        """Smallest stable step, the controlling item and its part."""
+        dt, k, which = np.inf, 0, None
+        for part in self.parts:
+            d, i = part.stable_dt()
+            if d < dt or which is None:
+                dt, k, which = d, i, part
+        for inter in self.interactions:
+            dt = min(dt, inter.stable_dt())
+        return min(dt, self.dt_max), k, which
+
+    def _interaction_forces(self, dt: float) -> None:
+        for part in self.parts:
+            part.kin.a_ext[:] = 0.0
+        for inter in self.interactions:
+            inter.forces(self.t, dt, inter.part.kin.a_ext)
+        for part in self.parts:
+            part.kin.a += part.kin.a_ext
+
+    def step(self, t_stop: float | None = None) -> None:
+        """Advance one step; ``t_stop`` shortens it so that the run ends there."""
+        dt, k, part = self.stable_dt()
+        self._notify("before_step", dt, k, part)
+        # penalty springs use the stable step, not one shortened to end the
+        # run: k = alpha m / dt^2 (paper eq. 8) would grow by (dt / dt_short)^2
+        self.dt_contact_step = dt
+        if t_stop is not None and self.t + dt > t_stop:
+            dt = max(t_stop - self.t, 0.0)
+        dt_kick = 0.5 * dt if self.step_count == 0 else 0.5 * (self.dt_prev + dt)
+        ke = wc = we = None
+        for part in self.parts:
+            q = part.kin
+            k_, c_, e_ = kick(q.v, q.a, q.a_ext, q.m, q.bc, q.bc_v, dt_kick, q.v_mid)
+            ke, wc, we = _add(ke, k_), _add(wc, c_), _add(we, e_)
+        self.work_contact += wc
+        self.work_external += we
+        self.kinetic, self.dt_step = ke, dt
+        for inter in self.interactions:
+            inter.after_kick(dt_kick)
+        for inter in self.interactions:
+            inter.constrain(self.t)
+        self._notify("after_kick")
+
+        for part in self.parts:
+            part.drift(dt)
+        self.t += dt
+        self.step_count += 1
+        self.dt_prev = dt
+        for part in self.parts:
+            part.update_geometry(self.t, dt)
+        for inter in self.interactions:
+            inter.update_geometry(self.t)
+        for part in self.parts:
+            part.internal_forces(self.t, dt)
+        self._interaction_forces(self.dt_contact_step)
+        for event in self.events:
+            if event.due(self):
+                event.apply(self)
+        self._notify("after_step")
+
+    # ------------------------------------------------------------ records
+    def record(self, kinetic: float | None = None, dt: float | None = None) -> dict:
+        """Energy balance (J, J/m in 2D) and the parts' and interactions' columns.
+
+        At the last kick's time by default (``kinetic`` and ``dt`` of that
+        kick); the run's final row passes the kinetic energy of the current
+        velocities.
+        """
+        kinetic = self.kinetic if kinetic is None else kinetic
+        ie = iav = None
+        for part in self.parts:
+            a, b = part.energies()
+            ie, iav = _add(ie, a), _add(iav, b)
+        e_contact = -self.work_contact
+        rec = {
+            "time": self.t, "step": float(self.step_count),
+            "dt": self.dt_step if dt is None else dt,
+            "E_kinetic": kinetic, "E_internal": ie, "E_viscous": iav,
+            "E_contact": e_contact, "W_external": self.work_external,
+            "E_total": kinetic + ie + e_contact - self.work_external,
+        }
+        for part in self.parts:
+            rec.update(part.columns())
+        for inter in self.interactions:
+            rec.update(inter.columns(self.t))
+        return rec
+
+    def kinetic_now(self) -> float:
+        """Kinetic energy of the current (mid-step) velocities [J]."""
+        return float(sum(0.5 * np.sum(p.kin.m * np.sum(p.kin.v * p.kin.v, axis=1))
+                         for p in self.parts))
+
+    # --------------------------------------------------------- checkpoint
+    def state(self) -> tuple[dict, dict[str, dict[str, np.ndarray]]]:
+        """Scalars and array groups of a checkpoint (parts, interactions, events)."""
+        scalars = {"t": self.t, "step": self.step_count, "dt_prev": self.dt_prev,
+                   "dt0": self.dt0, "dt_contact_step": self.dt_contact_step,
+                   "dt_step": self.dt_step, "work_contact": self.work_contact,
+                   "work_external": self.work_external}
+        groups = {}
+        for kind, items in (("part", self.parts), ("interaction", self.interactions)):
+            for item in items:
+                sc, arrays = item.state()
+                scalars.update({f"{kind}.{item.name}.{k}": v for k, v in sc.items()})
+                groups[f"{kind}.{item.name}"] = arrays
+        for ev in self.events:
+            scalars.update({f"event.{ev.name}.{k}": v for k, v in ev.state().items()})
+        for part in self.parts:
+            groups[f"kin.{part.name}"] = part.kin.arrays()
+        return scalars, groups
+
+    def restore(self, scalars: dict, groups: dict) -> None:
+        """Continue from :meth:`state` (bitwise identical continuation).
+
+        Parts grown by events during the run are grown to the checkpoint's
+        size first (the listeners run after the arrays are restored).
+        """
+        for part in self.parts:
+            arrays = groups[f"kin.{part.name}"]
+            q = part.kin
+            n_old, n_new = q.n, arrays["x"].shape[0]
+            if n_new < n_old:
+                raise ValueError(f"checkpoint has {n_new} items in part {part.name!r}, "
+                                 f"the model {n_old}: it was written by another deck")
+            if n_new > n_old:
+                q.grow(n_new - n_old, notify=False)
+            for name, arr in arrays.items():
+                if name == "hist" and arr.shape[1] != q.hist.shape[1]:
+                    raise ValueError("checkpoint history width differs from the model's")
+                setattr(q, name, arr)
+            if n_new > n_old:
+                q.notify_grown(n_old, n_new)
+        self.t = float(scalars["t"])
+        self.step_count = int(scalars["step"])
+        self.dt_prev = float(scalars["dt_prev"])
+        self.dt0 = float(scalars["dt0"])
+        self.dt_contact_step = float(scalars["dt_contact_step"])
+        self.dt_step = float(scalars.get("dt_step", self.dt_prev))
+        self.work_contact = float(scalars["work_contact"])
+        self.work_external = float(scalars["work_external"])
+        for kind, items in (("part", self.parts), ("interaction", self.interactions)):
+            for item in items:
+                pre = f"{kind}.{item.name}."
+                item.restore({k[len(pre):]: v for k, v in scalars.items()
+                              if k.startswith(pre)}, groups.get(f"{kind}.{item.name}", {}))
+        for ev in self.events:
+            pre = f"event.{ev.name}."
+            ev.restore({k[len(pre):]: v for k, v in scalars.items() if k.startswith(pre)})
+        # what interactions report (counts, totals) depends on x, v and dt only;
+        # the accelerations themselves are in the checkpoint
+        scratch = {id(p.kin): np.zeros_like(p.kin.a_ext) for p in self.parts}
+        for inter in self.interactions:
+            inter.forces(self.t, self.dt_contact_step, scratch[id(inter.part.kin)])
