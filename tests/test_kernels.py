@@ -285,3 +285,13 @@ def test_grad_factor_and_second_derivative_vs_fd(kid, dim):
         assert K.second_derivative(kid, sig, dim, r, H) == pytest.approx(
             d2Wdr2, abs=1e-3 * scale_ww
         )
+
+
+def test_kernel_context_holds_the_kernel_as_one_thing():
+    # cubic spline: q_max = 2, so kappa = 1.5 gives a support of 3 h
+    k = K.KernelContext.named("cubic_spline", 3, 1.5)
+    assert k.kid == K.kernel_id("cubic_spline") and k.dim == 3
+    assert k.sigma == K.normalisation(k.kid, 3)  # its value is tested above
+    assert k.radius_factor == 3.0 and k.support_scale == 1.5
+    with pytest.raises(ValueError, match="unknown kernel"):
+        K.KernelContext.named("bogus", 3)

@@ -276,15 +276,15 @@ def test_pair_viscosity_and_hourglass_match_their_formulas(approach):
     offsets, idx = np.array([0, 1, 2]), np.array([1, 0], dtype=np.int32)
     eye = np.broadcast_to(np.eye(3), (2, 3, 3)).copy()
     zero = np.zeros((2, 3, 3))
-    alpha, beta, kscale = 1.0, 2.0, 1.0
+    alpha, beta, support_scale = 1.0, 2.0, 1.0
     a = np.zeros((2, 3))
     heat = np.zeros(2)
     tl_forces(np.arange(2), x, v, X, m, rho, rho, c, h0, m / rho, offsets, idx, fac, hgk,
-              np.zeros((2, 3)), zero, zero, eye, eye, 2, alpha, beta, kscale, a, heat)
+              np.zeros((2, 3)), zero, zero, eye, eye, 2, alpha, beta, support_scale, a, heat)
     d = x[0] - x[1]
     r2 = d @ d
     vx = min((v[0] - v[1]) @ d, 0.0)
-    h = kscale * 0.5 * (h0[0] + h0[1])
+    h = support_scale * 0.5 * (h0[0] + h0[1])
     mu = h * vx / (r2 + 0.01 * h * h)
     pi = (-alpha * 0.5 * (c[0] + c[1]) * mu + beta * mu**2) / (0.5 * (rho[0] + rho[1]))
     f = float(fac[0])

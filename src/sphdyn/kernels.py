@@ -60,7 +60,7 @@ Hušek, M. SPH for concrete under impact (PhD thesis), eq. 2.2.2, Fig. 2.4.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from numba import njit
 
@@ -531,27 +531,25 @@ class KernelContext:
     r"""The smoothing kernel of a part, passed as one thing.
 
     ``kid`` the kernel id, ``sigma`` its normalisation :math:`\sigma_d` in
-    ``dim`` dimensions and ``support_scale`` the paper's :math:`\kappa`
-    (deck key ``sph.support_scale``): pair quantities use
-    :math:`h_{ij} = \kappa (h_i + h_j)/2`, so the support radius is
+    ``dim`` dimensions (:func:`normalisation`) and ``support_scale`` the
+    paper's :math:`\kappa` (deck key ``sph.support_scale``): pair quantities
+    use :math:`h_{ij} = \kappa (h_i + h_j)/2`, so the support radius is
     ``radius_factor * h`` with ``radius_factor`` :math:`= q_{max} \kappa`.
+    Python code passes the context; the Numba passes take its fields as
+    scalars (thin wrappers unpack it).
     """
 
     kid: int
     dim: int
     support_scale: float = 1.0
+    sigma: float = field(init=False)
+    radius_factor: float = field(init=False)
+
+    def __post_init__(self):
+        object.__setattr__(self, "sigma", normalisation(self.kid, self.dim))
+        object.__setattr__(self, "radius_factor", support(self.kid) * self.support_scale)
 
     @classmethod
     def named(cls, name: str, dim: int, support_scale: float = 1.0) -> "KernelContext":
         """The context of the kernel called ``name`` (see :data:`KERNEL_IDS`)."""
         return cls(kernel_id(name), dim, float(support_scale))
-
-    @property
-    def sigma(self) -> float:
-        """Normalisation constant :math:`\\sigma_d` (see :func:`normalisation`)."""
-        return normalisation(self.kid, self.dim)
-
-    @property
-    def radius_factor(self) -> float:
-        """Support radius in units of h: :math:`q_{max}\\,\\kappa`."""
-        return support(self.kid) * self.support_scale

@@ -137,7 +137,7 @@ def artificial_stress_tensor(sig, rho, eps, R, Q):
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def artificial_stress_forces(x, m, h, R, F, offsets, idx, kid, dim, kscale, spacing,
+def artificial_stress_forces(x, m, h, R, F, offsets, idx, kid, dim, support_scale, spacing,
                              n_exp, a, v, dedt):
     r"""Add the artificial-stress acceleration to ``a`` (gather form).
 
@@ -160,7 +160,7 @@ def artificial_stress_forces(x, m, h, R, F, offsets, idx, kid, dim, kscale, spac
         :func:`sphdyn.sph.passes.velocity_gradient` [1/m^(d+2)]
         (``grad_i W_ij = F_ij (x_i - x_j)``).
     offsets, idx : CSR neighbour list.
-    kid, dim, kscale : kernel id, dimension, support scale kappa.
+    kid, dim, support_scale : kernel id, dimension, support scale kappa.
     spacing : (N,) initial particle spacing vol0**(1/dim) [m].
     n_exp : float, exponent n (4 in Gray et al.).
     a : (N, 3) in/out, acceleration [m/s^2].
@@ -200,7 +200,7 @@ def artificial_stress_forces(x, m, h, R, F, offsets, idx, kid, dim, kscale, spac
             d0 = x[i, 0] - x[j, 0]
             d1 = x[i, 1] - x[j, 1]
             d2 = x[i, 2] - x[j, 2] if three else 0.0
-            hij = kscale * 0.5 * (hi + h[j])
+            hij = support_scale * 0.5 * (hi + h[j])
             ih = 1.0 / hij
             w_ref = w(kid, 0.5 * (spacing[i] + spacing[j]) * ih)
             if w_ref <= 0.0:

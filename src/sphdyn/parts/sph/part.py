@@ -121,8 +121,7 @@ class SPHPart:
                                    active=self.ul_active)
         self.tl = None
         if p.tl.any():
-            self.tl = TotalLagrangian(p, np.flatnonzero(p.tl), kernel.kid, kernel.sigma,
-                                      kernel.radius_factor, kernel.support_scale, p.young,
+            self.tl = TotalLagrangian(p, np.flatnonzero(p.tl), kernel, p.young,
                                       settings.hourglass, settings.alpha, settings.beta)
         p.on_grow(self._grown)
 
@@ -167,9 +166,7 @@ class SPHPart:
             rho_ref = p.rho.copy() if self.tl is None else np.concatenate(
                 [self.tl.rho_ref, p.rho[n_old:]])
             if self.tl is None:
-                self.tl = TotalLagrangian(p, np.flatnonzero(p.tl), self.kernel.kid,
-                                          self.kernel.sigma, self.kernel.radius_factor,
-                                          self.kernel.support_scale, p.young,
+                self.tl = TotalLagrangian(p, np.flatnonzero(p.tl), self.kernel, p.young,
                                           self.s.hourglass, self.s.alpha, self.s.beta)
             self.tl.rows = np.flatnonzero(p.tl).astype(np.int64)
             self.tl.young = p.young

@@ -50,7 +50,7 @@ def scaled_stress(sig, rho, S):
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def velocity_gradient(x, v, h, vol, offsets, idx, kid, sigma, dim, kscale, correct,
+def velocity_gradient(x, v, h, vol, offsets, idx, kid, sigma, dim, support_scale, correct,
                       F, L, B):
     r"""Velocity gradient with optional Randles-Libersky renormalisation.
 
@@ -81,7 +81,7 @@ def velocity_gradient(x, v, h, vol, offsets, idx, kid, sigma, dim, kscale, corre
     h : (N,) smoothing length [m].
     vol : (N,) particle volumes m/rho [m^3] (0 for zero-mass particles).
     offsets, idx : CSR neighbour list.
-    kid, sigma, dim, kscale : kernel id, normalisation, dimension (2: z
+    kid, sigma, dim, support_scale : kernel id, normalisation, dimension (2: z
         terms skipped), support scale kappa.
     correct : bool, apply the renormalisation.
     F : (nnz,) out, pair gradient factors [1/m^(d+2)], aligned with ``idx``.
@@ -108,7 +108,7 @@ def velocity_gradient(x, v, h, vol, offsets, idx, kid, sigma, dim, kscale, corre
             d1 = xi1 - x[j, 1]
             d2 = xi2 - x[j, 2] if three else 0.0
             r2 = d0 * d0 + d1 * d1 + d2 * d2
-            hij = kscale * 0.5 * (hi + h[j])
+            hij = support_scale * 0.5 * (hi + h[j])
             if r2 >= (qmax * hij) ** 2:
                 F[k] = 0.0
                 continue
@@ -196,7 +196,7 @@ def velocity_gradient(x, v, h, vol, offsets, idx, kid, sigma, dim, kscale, corre
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def forces(x, v, m, rho, h, c, S, B, F, offsets, idx, dim, kscale, correct, alpha,
+def forces(x, v, m, rho, h, c, S, B, F, offsets, idx, dim, support_scale, correct, alpha,
            beta, a, dedt_av):
     r"""Acceleration from the stress divergence and Monaghan artificial viscosity.
 
@@ -319,7 +319,7 @@ def forces(x, v, m, rho, h, c, S, B, F, offsets, idx, dim, kscale, correct, alph
             # artificial viscosity, approaching pairs only
             vx = w0 * d0 + w1 * d1 + w2 * d2
             if vx < 0.0:
-                hij = kscale * 0.5 * (hi + h[j])
+                hij = support_scale * 0.5 * (hi + h[j])
                 r2 = d0 * d0 + d1 * d1 + d2 * d2
                 mu = hij * vx / (r2 + 0.01 * hij * hij)
                 pi_ij = (-alpha * 0.5 * (ci + c[j]) * mu + beta * mu * mu) / (
@@ -338,7 +338,7 @@ def forces(x, v, m, rho, h, c, S, B, F, offsets, idx, dim, kscale, correct, alph
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def xsph_velocity(x, v, m, rho, h, offsets, idx, kid, sigma, dim, kscale, eps,
+def xsph_velocity(x, v, m, rho, h, offsets, idx, kid, sigma, dim, support_scale, eps,
                   vs):
     r"""XSPH smoothed transport velocity (Monaghan 1992, eq. 4.3).
 
@@ -359,7 +359,7 @@ def xsph_velocity(x, v, m, rho, h, offsets, idx, kid, sigma, dim, kscale, eps,
             d1 = x[i, 1] - x[j, 1]
             d2 = x[i, 2] - x[j, 2]
             r = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-            hij = kscale * 0.5 * (h[i] + h[j])
+            hij = support_scale * 0.5 * (h[i] + h[j])
             w = kernel_value(kid, sigma, dim, r, hij) * m[j] / (0.5 * (rho[i] + rho[j]))
             s0 += w * (v[j, 0] - v[i, 0])
             s1 += w * (v[j, 1] - v[i, 1])

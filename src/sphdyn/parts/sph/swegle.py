@@ -73,7 +73,7 @@ def stress_scale(sig, m):
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def swegle_indicator(x, m, h, sig, offsets, idx, kid, sigma, dim, kscale, tol, out):
+def swegle_indicator(x, m, h, sig, offsets, idx, kid, sigma, dim, support_scale, tol, out):
     r"""Fraction of unstable neighbour pairs per particle (Swegle et al. 1995).
 
     .. math::
@@ -89,7 +89,7 @@ def swegle_indicator(x, m, h, sig, offsets, idx, kid, sigma, dim, kscale, tol, o
     m, h : (N,) mass (zero-mass neighbours are skipped), smoothing length [m].
     sig : (N, 3, 3) Cauchy stress [Pa], tension positive.
     offsets, idx : CSR neighbour list.
-    kid, sigma, dim, kscale : kernel id, normalisation (only its sign
+    kid, sigma, dim, support_scale : kernel id, normalisation (only its sign
         matters, so it is unused), dimension, support scale kappa.
     tol : float, absolute stress threshold [Pa] below which a pair is not
         flagged (use ``REL_STRESS_TOL * stress_scale(sig, m)``).
@@ -110,7 +110,7 @@ def swegle_indicator(x, m, h, sig, offsets, idx, kid, sigma, dim, kscale, tol, o
             d1 = x[i, 1] - x[j, 1]
             d2 = x[i, 2] - x[j, 2] if three else 0.0
             r2 = d0 * d0 + d1 * d1 + d2 * d2
-            hij = kscale * 0.5 * (hi + h[j])
+            hij = support_scale * 0.5 * (hi + h[j])
             if r2 >= (qmax * hij) ** 2 or r2 == 0.0:
                 continue
             total += 1

@@ -38,8 +38,7 @@ class TotalLagrangian:
     p : Particles (initial reference configuration ``p.x0``, ``p.h0``,
         ``p.rho0``).
     rows : (n_tl,) int64, the particles of total-Lagrangian bodies.
-    kid, sigma, radius_factor, kscale : kernel id, normalisation, support
-        radius factor (q_max * kappa) and support scale kappa.
+    kernel : the kernel context (:class:`sphdyn.kernels.KernelContext`).
     young : (N,) Young's modulus per particle for the hourglass stiffness [Pa].
     hourglass : hourglass coefficient alpha (Ganzenmueller 2015; 0 = off).
     alpha, beta : artificial viscosity coefficients (Monaghan 1992).
@@ -51,13 +50,10 @@ class TotalLagrangian:
     carries over, F restarts from I).
     """
 
-    def __init__(self, p, rows, kid, sigma, radius_factor, kscale, young, hourglass,
-                 alpha=0.0, beta=0.0):
+    def __init__(self, p, rows, kernel, young, hourglass, alpha=0.0, beta=0.0):
         self.dim = p.dim
         self.rows = np.ascontiguousarray(rows, dtype=np.int64)
-        self.kid, self.sigma = kid, sigma
-        self.radius_factor = radius_factor
-        self.kscale = float(kscale)
+        self.kernel = kernel
         self.young = np.ascontiguousarray(young, dtype=float)
         self.hourglass = float(hourglass)
         self.alpha = float(alpha)
@@ -72,7 +68,8 @@ class TotalLagrangian:
         self.rho_ref = rho_ref
         active = np.zeros(n, dtype=bool)
         active[self.rows] = True
-        full = build_neighbours(X, p.h0, self.radius_factor, 0.0, dim, active=active)
+        k = self.kernel
+        full = build_neighbours(X, p.h0, k.radius_factor, 0.0, dim, active=active)
         self.offsets, self.idx = same_body_pairs(full.offsets, full.idx, p.body)
         self.vol = np.divide(p.m, rho_ref, out=np.zeros(n), where=rho_ref > 0)
         nnz = self.idx.size
@@ -80,8 +77,8 @@ class TotalLagrangian:
         w = np.zeros(nnz)
         self.B0 = np.zeros((n, 3, 3))
         self.gsum = np.zeros((n, 3))
-        reference_gradients(X, p.h0, self.vol, self.offsets, self.idx, self.kid,
-                            self.sigma, dim, self.kscale, self.fac, w, self.B0, self.gsum)
+        reference_gradients(X, p.h0, self.vol, self.offsets, self.idx, k.kid, k.sigma,
+                            dim, k.support_scale, self.fac, w, self.B0, self.gsum)
         self.F = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
         self.Finv = self.F.copy()
         self.P = np.zeros((n, 3, 3))
@@ -117,7 +114,7 @@ class TotalLagrangian:
         piola_stress(self.rows, self.F, self.Finv, p.sig, self.vol, self.B0, self.P, self.Q)
         tl_forces(self.rows, p.x, p.v, self.X, p.m, p.rho, self.rho_ref, p.c, p.h0,
                   self.vol, self.offsets, self.idx, self.fac, self.hgk, self.gsum, self.P,
-                  self.Q, self.B0, self.F, self.dim, self.alpha, self.beta, self.kscale,
+                  self.Q, self.B0, self.F, self.dim, self.alpha, self.beta, self.kernel.support_scale,
                   p.a, dedt_av)
 
     @property

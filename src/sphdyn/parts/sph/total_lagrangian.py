@@ -70,7 +70,7 @@ def _inverse3(a00, a01, a02, a10, a11, a12, a20, a21, a22, out):
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def reference_gradients(X, h0, vol, offsets, idx, kid, sigma, dim, kscale, fac, w, B0,
+def reference_gradients(X, h0, vol, offsets, idx, kid, sigma, dim, support_scale, fac, w, B0,
                         gsum):
     r"""Reference kernel factors, kernel values, correction matrices and gradient sums.
 
@@ -90,7 +90,7 @@ def reference_gradients(X, h0, vol, offsets, idx, kid, sigma, dim, kscale, fac, 
     h0 : (N,) reference smoothing lengths [m].
     vol : (N,) reference volumes m / rho0 [m^dim] (0 for zero-mass particles).
     offsets, idx : the fixed (reference) CSR neighbour list.
-    kid, sigma, dim, kscale : kernel id, normalisation, dimension, support scale.
+    kid, sigma, dim, support_scale : kernel id, normalisation, dimension, support scale.
     fac : (nnz,) float32 out, :math:`W'(R)/R` [1/m^(d+2)].
     w : (nnz,) out, :math:`W_{ij}` [1/m^d] (for hourglass control).
     B0 : (N, 3, 3) out, correction matrices
@@ -111,7 +111,7 @@ def reference_gradients(X, h0, vol, offsets, idx, kid, sigma, dim, kscale, fac, 
             d1 = X[i, 1] - X[j, 1]
             d2 = X[i, 2] - X[j, 2]
             r = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-            hij = kscale * 0.5 * (h0[i] + h0[j])
+            hij = support_scale * 0.5 * (h0[i] + h0[j])
             if r >= qmax * hij:
                 fac[k] = 0.0
                 w[k] = 0.0
@@ -351,7 +351,7 @@ def _viscous_hourglass(fk, hk, d0, d1, d2, w0, w1, w2, s0, s1, s2, hij, csum, rh
 
 @njit(cache=True, error_model="numpy", parallel=True, fastmath=PAIR_FASTMATH)
 def tl_forces(rows, x, v, X, m, rho, rho0, c, h0, vol, offsets, idx, fac, hgk, gsum,
-              P, Q, B0, Fdef, dim, av_alpha, av_beta, kscale, a, dedt_av):
+              P, Q, B0, Fdef, dim, av_alpha, av_beta, support_scale, a, dedt_av):
     r"""Acceleration of the total-Lagrangian scheme with hourglass control.
 
     Momentum balance :math:`\rho_0 \dot{\mathbf v} = \nabla_X\cdot P` in the
@@ -421,7 +421,7 @@ def tl_forces(rows, x, v, X, m, rho, rho0, c, h0, vol, offsets, idx, fac, hgk, g
     P, Q : (N, 3, 3) first Piola-Kirchhoff stress [Pa] and V P B (:func:`piola_stress`).
     Fdef : (N, 3, 3) deformation gradient.
     dim : 2 or 3 (2: z components skipped; they are zero).
-    av_alpha, av_beta : artificial viscosity coefficients; kscale: support scale.
+    av_alpha, av_beta : artificial viscosity coefficients; support_scale: support scale.
     a : (N, 3) out, acceleration [m/s^2].
     dedt_av : (N,) out, viscous + hourglass heating rate [W/kg].
     """
@@ -481,7 +481,7 @@ def tl_forces(rows, x, v, X, m, rho, rho0, c, h0, vol, offsets, idx, fac, hgk, g
                 w2 = vi2 - v[j, 2]
                 mpf, coef = _viscous_hourglass(
                     fk, np.float64(hgk[k]), d0, d1, d2, w0, w1, w2, s0, s1, s2,
-                    kscale * 0.5 * (hi + h0[j]), ci + c[j], rhoi + rho[j], m[j],
+                    support_scale * 0.5 * (hi + h0[j]), ci + c[j], rhoi + rho[j], m[j],
                     av_alpha, av_beta)
                 q0 -= mpf * d0
                 q1 -= mpf * d1
@@ -506,7 +506,7 @@ def tl_forces(rows, x, v, X, m, rho, rho0, c, h0, vol, offsets, idx, fac, hgk, g
                 w1 = vi1 - v[j, 1]
                 mpf, coef = _viscous_hourglass(
                     fk, np.float64(hgk[k]), d0, d1, 0.0, w0, w1, 0.0, s0, s1, 0.0,
-                    kscale * 0.5 * (hi + h0[j]), ci + c[j], rhoi + rho[j], m[j],
+                    support_scale * 0.5 * (hi + h0[j]), ci + c[j], rhoi + rho[j], m[j],
                     av_alpha, av_beta)
                 q0 -= mpf * d0
                 q1 -= mpf * d1
