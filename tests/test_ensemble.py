@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from sphdyn.cli import main
-from sphdyn.deck import load_deck
+from sphdyn.deck import load_deck, loads_deck
 from sphdyn.ensemble import (count_main_cracks, default_layout, parse_vary,
-                             plan_samples, sample_seed)
+                             plan_samples, plot_mass_histograms, sample_seed)
 from sphdyn.io import read_frame
 from sphdyn.io.frames import list_frames
 from sphdyn.simulation import Simulation
@@ -91,6 +91,88 @@ def test_main_crack_count_counts_separate_crossings_of_the_mid_section():
     m2[col == 28] = 0.0
     assert count_main_cracks(x0, d, m2, 1.0, dim=2) == 1
     assert count_main_cracks(x0, np.zeros(len(x0)), m, 1.0, dim=2) == 0
+
+
+# A body with phases of different densities (a mesostructure) and an initial
+# crack, with a random mass field: 30 x 30 particles, elastic.
+MESO = """
+[run]
+dimension = 2
+t_end = 1e-5
+seed = 5
+[[material]]
+name = "mortar"
+model = "elastic"
+density = 2200.0
+E = 2.5e10
+nu = 0.2
+[[material]]
+name = "stone"
+model = "elastic"
+density = 2700.0
+E = 5.0e10
+nu = 0.2
+[[body]]
+name = "specimen"
+material = "mortar"
+dx = 1e-3
+geometry = { shape = "box", lo = [0, 0], hi = [0.03, 0.03] }
+mass = { distribution = "uniform", low = 0.5, high = 1.5 }
+[[body.crack]]
+shape = "box"
+lo = [0.01, 0.01, 0]
+hi = [0.02, 0.012, 0]
+[body.mesostructure]
+aggregate_fraction = 0.3
+max_aggregate_size = "6 mm"
+aggregate = "stone"
+[output]
+progress = false
+vtk = false
+"""
+CRACKED = TINY.replace("[[wall]]", """[[body.crack]]
+shape = "box"
+lo = ["-10 mm", "40 mm", 0]
+hi = ["10 mm", "45 mm", 0]
+[[wall]]""")
+
+
+@pytest.mark.parametrize("text", [CRACKED, MESO], ids=["cracked", "mesostructure"])
+def test_mass_histogram_plots_the_field_the_model_drew(text, tmp_path, monkeypatch):
+    # The histogram shows the masses the model drew (m0 f s of the solid
+    # particles, the axes of the requested law), read from the model: no
+    # second draw. Without a mesostructure they are the particle masses;
+    # with one, the masses are those times rho_phase / rho of the body's
+    # material. Initial-crack particles (zero mass) are left out.
+    from sphdyn.heterogeneity import mass, plots
+
+    sim = Simulation.from_deck(loads_deck(text), tmp_path / "run")
+    drawn = []
+    real = plots.plot_mass_histogram
+
+    def spy(masses, path, **kw):
+        drawn.append((np.array(masses), kw))
+        return real(masses, path, **kw)
+
+    def no_second_draw(*args, **kwargs):
+        raise AssertionError("the histogram drew the mass field again")
+
+    monkeypatch.setattr(plots, "plot_mass_histogram", spy)
+    monkeypatch.setattr(mass, "mass_field", no_second_draw)
+    monkeypatch.setattr(mass, "body_rng", no_second_draw)
+    paths = plot_mass_histograms(sim, tmp_path / "run")
+    assert paths == [tmp_path / "run" / "plots" / "mass_histogram.png"]
+    assert paths[0].stat().st_size > 5000
+    (masses, kw), = drawn
+    (draw,) = sim.model.mass_draws.values()
+    p = sim.particles
+    rows = draw.rows[draw.solid]
+    assert 0 < rows.size < draw.rows.size and np.all(p.m[draw.rows[~draw.solid]] == 0)
+    assert kw["m0"] == draw.m0 and kw["scale"] == draw.scale
+    phase_over_body = p.rho0[rows] * p.vol0[rows] / draw.m0
+    assert np.allclose(masses * phase_over_body, p.m[rows], rtol=1e-12, atol=0)
+    if text is MESO:
+        assert len(np.unique(p.rho0[rows])) == 2  # both phases carry a drawn mass
 
 
 @pytest.fixture(scope="module")
