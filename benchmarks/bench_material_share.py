@@ -2,7 +2,7 @@
 
 Runs a deck (default ``examples/disc_impact.toml``, the paper's concrete
 disc, 10,112 particles, CSCM) for a fixed number of steps with the plain
-:class:`sphdyn.solver.Solver` loop (no output), and times every material
+:class:`sphdyn.stepper.Stepper` loop (no output), and times every material
 group's ``update`` call separately from the rest of the step. The solver is
 not modified: each ``MaterialGroup.model`` is replaced by a thin proxy whose
 ``update`` forwards to the registered kernel and accumulates its wall time
@@ -33,8 +33,8 @@ import time
 import numba
 
 from sphdyn.deck import load_deck
+from sphdyn.assembly import build_stepper
 from sphdyn.model import build_model
-from sphdyn.solver import Solver
 
 
 class TimedModel:
@@ -63,7 +63,7 @@ def measure(deck_path: str, steps: int, warmup: int = 1,
     """Run ``warmup + steps`` solver steps and return the timing record."""
     deck = load_deck(deck_path, overrides)
     model = build_model(deck)
-    solver = Solver(model, deck)
+    solver = build_stepper(deck, model)
     for _ in range(warmup):
         solver.step()
     timers = []

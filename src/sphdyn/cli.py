@@ -28,8 +28,8 @@ def cmd_run(args) -> int:
     out = Path(args.out) if args.out else Path("out") / Path(args.deck).stem
     _threads(args.threads)
     sim = Simulation.from_deck(deck, out)
-    print(f"sphdyn: {sim.solver.p.n} particles, {deck.run.dimension}D, "
-          f"t_end = {deck.run.t_end:g} s, initial dt = {sim.solver.dt0:.3e} s -> {out}")
+    print(f"sphdyn: {sim.particles.n} particles, {deck.run.dimension}D, "
+          f"t_end = {deck.run.t_end:g} s, initial dt = {sim.stepper.dt0:.3e} s -> {out}")
     return _finish(sim.run(max_steps=args.max_steps, progress=not args.quiet and None))
 
 
@@ -38,8 +38,8 @@ def cmd_restart(args) -> int:
 
     _threads(args.threads)
     sim = Simulation.from_directory(args.dir)
-    print(f"sphdyn: restarting {args.dir} at t = {sim.solver.t:.6e} s "
-          f"(step {sim.solver.step_count})")
+    print(f"sphdyn: restarting {args.dir} at t = {sim.stepper.t:.6e} s "
+          f"(step {sim.stepper.step_count})")
     return _finish(sim.run(t_end=args.t_end, max_steps=args.max_steps,
                            progress=not args.quiet and None))
 

@@ -24,7 +24,7 @@ and here), and the momentum equation gains
 
 (Monaghan 2000, eq. 4.6). :math:`\Delta p_{ij}` is the mean initial particle
 spacing of the pair (``vol0**(1/dim)``) and :math:`h_{ij}` the same pair
-smoothing length as in :mod:`sphdyn.sph.passes` (support scale included), so
+smoothing length as in :mod:`sphdyn.parts.sph.passes` (support scale included), so
 the normalisation :math:`\sigma_d/h^d` cancels in :math:`f_{ij}`. Because
 :math:`R_i` is negative definite where the material is in tension, the term
 is an extra pressure that grows steeply (:math:`f^n`) when two particles
@@ -157,7 +157,7 @@ def artificial_stress_forces(x, m, h, R, F, offsets, idx, kid, dim, support_scal
     m, h : (N,) mass [kg] (kg/m in 2D), smoothing length [m].
     R : (N, 3, 3) from :func:`artificial_stress_tensor` [Pa m^6/kg^2].
     F : (nnz,) pair gradient factors from
-        :func:`sphdyn.sph.passes.velocity_gradient` [1/m^(d+2)]
+        :func:`sphdyn.parts.sph.passes.velocity_gradient` [1/m^(d+2)]
         (``grad_i W_ij = F_ij (x_i - x_j)``).
     offsets, idx : CSR neighbour list.
     kid, dim, support_scale : kernel id, dimension, support scale kappa.
@@ -176,6 +176,8 @@ def artificial_stress_forces(x, m, h, R, F, offsets, idx, kid, dim, support_scal
     # integer exponents (the usual n = 4) by repeated squaring, not pow()
     n_int = int(n_exp)
     is_int = float(n_int) == n_exp
+    # the pair-loop prologue (skip zero gradients and zero masses) is that of
+    # ``passes.forces``: same gather pattern over the same pair factors F
     for i in prange(n):
         a0 = a1 = a2 = 0.0
         hi = h[i]

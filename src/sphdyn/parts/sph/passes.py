@@ -127,6 +127,8 @@ def velocity_gradient(x, v, h, vol, offsets, idx, kid, sigma, dim, support_scale
             g1 = f * d1
             u0 = v[j, 0] - vi0
             u1 = v[j, 1] - vi1
+            # components unrolled: the in-plane terms here and the z terms
+            # below (3D only) have the same shape (a deliberate pair)
             l00 += u0 * g0
             l01 += u0 * g1
             l10 += u1 * g0

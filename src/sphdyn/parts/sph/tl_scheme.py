@@ -1,10 +1,10 @@
 """The total-Lagrangian scheme: reference data built once, two calls per step.
 
-The solver calls :meth:`TotalLagrangian.velocity_gradient` (deformation
+The SPH part calls :meth:`TotalLagrangian.velocity_gradient` (deformation
 gradient, velocity gradient, density ``rho0 / det F``) before the material
 update and :meth:`TotalLagrangian.accelerations` (first Piola-Kirchhoff
 stress, momentum balance, hourglass control) after it. See
-:mod:`sphdyn.sph.total_lagrangian` for the equations.
+:mod:`sphdyn.parts.sph.total_lagrangian` for the equations.
 """
 
 from __future__ import annotations

@@ -174,6 +174,8 @@ def deformation_gradient(rows, x, v, X, vol, offsets, idx, fac, B0, dim, Fdef, F
     Cauchy stress).
     """
     three = dim == 3
+    # the row prologue (state of i unpacked into scalars) has the shape of the
+    # updated-Lagrangian ``passes.forces``: same gather pattern, other scheme
     for t in prange(rows.shape[0]):
         i = rows[t]
         xi0 = x[i, 0]
@@ -192,7 +194,8 @@ def deformation_gradient(rows, x, v, X, vol, offsets, idx, fac, B0, dim, Fdef, F
         e02 = e12 = e20 = e21 = e22 = 0.0
         k0 = offsets[i]
         k1 = offsets[i + 1]
-        # two loops instead of a dimension test per pair (about 1.5x faster)
+        # deliberate 2D/3D variant pair (``duplicates`` lists it): two loops
+        # instead of a dimension test per pair (about 1.5x faster)
         if three:
             for k in range(k0, k1):
                 j = idx[k]
@@ -371,7 +374,7 @@ def tl_forces(rows, x, v, X, m, rho, rho0, c, h0, vol, offsets, idx, fac, hgk, g
     reads one 4-byte factor per pair.
 
     *Artificial viscosity* (Monaghan 1992, as in the updated-Lagrangian
-    :func:`sphdyn.sph.passes.forces`) with the current pair separation
+    :func:`sphdyn.parts.sph.passes.forces`) with the current pair separation
     :math:`\mathbf x_{ij}`, velocity :math:`\mathbf v_{ij}`, density
     :math:`\rho = \rho_0/J` and the reference smoothing length, acting along
     the current line of centres with the reference kernel factor,
@@ -455,7 +458,8 @@ def tl_forces(rows, x, v, X, m, rho, rho0, c, h0, vol, offsets, idx, fac, hgk, g
         heat = 0.0
         k0 = offsets[i]
         k1 = offsets[i + 1]
-        # two loops instead of a dimension test per pair (about 1.5x faster)
+        # deliberate 2D/3D variant pair (``duplicates`` lists it): two loops
+        # instead of a dimension test per pair (about 1.5x faster)
         if three:
             for k in range(k0, k1):
                 j = idx[k]

@@ -1,0 +1,68 @@
+"""Side-by-side speed of two source trees (old commit against new), one run.
+
+This VM's speed changes 2-3x from day to day, so a speed claim is a ratio
+measured in one sitting. Each case runs in a fresh process per tree, the two
+trees alternating (A B A B ...) so that a drift of the machine's speed hits
+both alike; the best of the repeats is kept. Usage::
+
+    git worktree add /tmp/old 7e739c7
+    python benchmarks/compare_commits.py /tmp/old/src src --repeats 3 > compare.md
+
+Cases: ``sphdyn bench rings2d``, ``rings2d_tl``, ``block3d --particles
+100000`` (particle-steps per second of the stepping alone) and the paper's
+CSCM disc (``sphdyn run examples/disc_impact.toml --max-steps 150``,
+particle-steps per second from its summary, output of the first frame
+included in both).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+CASES = [("rings2d", ["bench", "rings2d", "--steps", "500"]),
+         ("rings2d_tl", ["bench", "rings2d_tl", "--steps", "500"]),
+         ("block3d 100k", ["bench", "block3d", "--particles", "100000", "--steps", "30"]),
+         ("CSCM disc", ["run", "examples/disc_impact.toml", "-q", "--max-steps", "150"])]
+
+
+def measure(src: str, args: list[str], threads: int) -> float:
+    """Particle-steps per second of one fresh process running ``sphdyn args``."""
+    env = dict(os.environ, PYTHONPATH=str(Path(src).resolve()))
+    with tempfile.TemporaryDirectory() as tmp:
+        extra = ["--out", tmp] if args[0] == "run" else []
+        cmd = [sys.executable, "-m", "sphdyn", *args, *extra, "--threads", str(threads)]
+        out = subprocess.run(cmd, check=True, capture_output=True, text=True, env=env)
+        if args[0] == "run":
+            summary = json.loads((Path(tmp) / "summary.json").read_text())
+            return summary["particle_steps_per_s"]
+    return json.loads(out.stdout.strip().splitlines()[-1])["particle_steps_per_s"]
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("old")
+    ap.add_argument("new")
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--threads", type=int, default=2)
+    a = ap.parse_args()
+    print(f"| case | old particle-steps/s | new particle-steps/s | new / old |")
+    print("|---|---|---|---|")
+    for name, args in CASES:
+        for src in (a.old, a.new):  # compile / fill the Numba caches first
+            measure(src, args[:-1] + ["3" if args[0] == "bench" else "5"], a.threads)
+        best = {a.old: 0.0, a.new: 0.0}
+        for _ in range(a.repeats):
+            for src in (a.old, a.new):
+                best[src] = max(best[src], measure(src, args, a.threads))
+        print(f"| {name} | {best[a.old]:.4g} | {best[a.new]:.4g} | "
+              f"{best[a.new] / best[a.old]:.3f} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
