@@ -120,7 +120,7 @@ def test_crack_particles_get_zero_mass_the_rest_keep_theirs():
 def _run_bar(tmp_path, name, crack):
     """Run the bar; return (onset time, onset position, final state)."""
     sim = Simulation.from_deck(loads_deck(BAR.replace("CRACK", crack)), tmp_path / name)
-    s, p = sim.solver, sim.solver.p
+    s, p = sim.stepper, sim.particles
     onset = None
     while s.t < sim.deck.run.t_end * (1 - 1e-12):
         s.step()
@@ -170,7 +170,7 @@ hi = ["-23 mm", "52 mm", 0]
     text = concrete_disc_2d("2.5 mm", "60 us", "20 us", ["damage", "mass", "velocity"],
                             body=cracks, stiffness=stiffness)
     sim = Simulation.from_deck(loads_deck(text), tmp_path / stiffness)
-    p = sim.solver.p
+    p = sim.particles
     zero = p.m == 0
     assert zero.sum() > 20
     summary = sim.run()

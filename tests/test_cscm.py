@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from sphdyn.materials import cscm, get_model
-from sphdyn.materials.cscm_params import default_parameters, elastic_moduli
+from sphdyn.materials.cscm import default_parameters, elastic_moduli
 from sphdyn.materials.driver import drive
 
 numba.set_num_threads(1)

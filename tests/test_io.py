@@ -11,8 +11,9 @@ import meshio
 import numpy as np
 import pytest
 
+from sphdyn.fields import FIELDS
 from sphdyn.io import (
-    DERIVED_FIELDS, FrameWriter, History, atomic_path, atomic_write_bytes,
+    FrameWriter, History, atomic_path, atomic_write_bytes,
     atomic_write_text, export_csv, export_vtk, particle_fields, plot_history,
     read_checkpoint, read_frame, read_history_csv, read_pvd, write_checkpoint,
     write_frame, write_pvd, write_vtu,
@@ -287,7 +288,7 @@ class TestFields:
 
     def test_all_fields(self):
         p = _particles(5)
-        names = list(DERIVED_FIELDS) + p.hist_names
+        names = [n for n, f in FIELDS.items() if f.shape != "history"] + p.hist_names
         f = particle_fields(p, names)
         assert list(f) == names  # position first, then in the order asked
         np.testing.assert_array_equal(f["position"], p.x)

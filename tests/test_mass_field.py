@@ -139,11 +139,11 @@ def test_mass_field_output_and_histogram_plot(tmp_path):
     sim = Simulation.from_deck(deck, tmp_path / "run")
     sim.run(max_steps=1)
     fields = read_frame(list_frames(tmp_path / "run")[0])[2]
-    assert np.array_equal(fields["mass"], sim.solver.p.m)
+    assert np.array_equal(fields["mass"], sim.particles.m)
     m0 = 2400.0 * 0.0025 ** 2
-    m, scale = mass_field(m0, LAWS["uniform"], np.ones(sim.solver.p.n, bool),
+    m, scale = mass_field(m0, LAWS["uniform"], np.ones(sim.particles.n, bool),
                           body_rng(5, 0))
-    assert np.array_equal(m, sim.solver.p.m)
+    assert np.array_equal(m, sim.particles.m)
     png = plot_mass_histogram(m, tmp_path / "hist.png", law=distribution(LAWS["uniform"]),
                               scale=scale, m0=m0)
     assert png.stat().st_size > 5000

@@ -68,11 +68,11 @@ def test_run_writes_everything_paraview_can_read(tmp_path):
     mesh = meshio.read(out / entries[-1][1])
     t, step, fields, _ = read_frame(sorted((out / "frames").glob("*.h5"))[-1])
     assert np.allclose(mesh.points, fields["position"])
-    assert mesh.point_data["stress"].shape == (sim.solver.p.n, 9)
-    assert np.allclose(mesh.point_data["plastic_strain"], sim.solver.p.hist[:, 0])
+    assert mesh.point_data["stress"].shape == (sim.particles.n, 9)
+    assert np.allclose(mesh.point_data["plastic_strain"], sim.particles.hist[:, 0])
     hist = read_history_csv(out / "history.csv")
     assert hist["F_wall_floor"].max() > 0
-    assert sim.solver.p.hist[:, 0].max() > 0  # it yielded at the contact
+    assert sim.particles.hist[:, 0].max() > 0  # it yielded at the contact
 
 
 TL_TWO_BODIES = {
@@ -140,7 +140,7 @@ def test_particles_leaving_the_domain_stop_the_run_with_a_diagnosis(tmp_path):
 
 def test_nan_is_caught_with_the_quantity_named(tmp_path):
     sim = _sim(tmp_path, "nan")
-    sim.solver.p.sig[3, 0, 0] = np.nan
+    sim.particles.sig[3, 0, 0] = np.nan
     with pytest.raises(SimulationFailed) as err:
         sim.run()
     assert "non-finite" in err.value.diagnosis and "#3" in err.value.diagnosis
@@ -148,7 +148,7 @@ def test_nan_is_caught_with_the_quantity_named(tmp_path):
 
 def test_time_step_collapse_is_caught(tmp_path):
     sim = _sim(tmp_path, "collapse")
-    sim.solver.p.c[7] = 1e12  # a wave speed that makes dt collapse
+    sim.particles.c[7] = 1e12  # a wave speed that makes dt collapse
     with pytest.raises(SimulationFailed) as err:
         sim.run()
     assert "time step collapsed" in err.value.diagnosis
@@ -220,7 +220,7 @@ reduce = "max"
     assert h["probe_all_velocity_y"][0] == -5.0
     assert h["probe_all_plastic_strain"][0] == 0.0
     assert h["probe_all_plastic_strain"][-1] > 0.0
-    assert h["probe_all_plastic_strain"][-1] == sim.solver.p.hist[:, 0].max()
+    assert h["probe_all_plastic_strain"][-1] == sim.particles.hist[:, 0].max()
 
 
 def test_probe_of_a_missing_history_variable_is_rejected_before_running(tmp_path):

@@ -1,8 +1,10 @@
 """Probes: time histories of a quantity reduced over a named particle set.
 
 Each ``[[probe]]`` of the deck adds history columns ``probe_<set>_<quantity>``
-(the LS-DYNA nodout/elout equivalent). Values are reduced over the set's
-particles with ``mean``, ``min`` or ``max``.
+(the LS-DYNA nodout/elout equivalent). The quantities are those of the output
+field registry (:func:`sphdyn.fields.probe_values`: scalar fields, components
+of vector and tensor fields, history variables); values are reduced over the
+set's particles with ``mean``, ``min`` or ``max``.
 """
 
 from __future__ import annotations
@@ -11,11 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .io.fields import pressure, von_mises
+from .fields import probe_values
 
-_AXES = {"x": 0, "y": 1, "z": 2}
-_STRESS = {"xx": (0, 0), "yy": (1, 1), "zz": (2, 2), "xy": (0, 1), "yz": (1, 2),
-           "xz": (0, 2)}
 _REDUCE = {"mean": np.mean, "min": np.min, "max": np.max}
 
 
@@ -29,38 +28,18 @@ class Probe:
     reduce: str
 
 
-def quantity(p, idx: np.ndarray, name: str) -> np.ndarray:
-    """Per-particle values of a probe quantity for particles ``idx`` (SI units)."""
-    kind, _, comp = name.rpartition("_")
-    if kind == "velocity":
-        return p.v[idx, _AXES[comp]]
-    if kind == "displacement":
-        return p.x[idx, _AXES[comp]] - p.x0[idx, _AXES[comp]]
-    if kind == "stress":
-        a, b = _STRESS[comp]
-        return p.sig[idx, a, b]
-    if name == "speed":
-        return np.linalg.norm(p.v[idx], axis=1)
-    if name == "pressure":
-        return pressure(p.sig[idx])
-    if name == "von_mises":
-        return von_mises(p.sig[idx])
-    simple = {"density": p.rho, "damage": p.damage, "internal_energy": p.e,
-              "smoothing_length": p.h}
-    if name in simple:
-        return simple[name][idx]
-    if name in p.hist_names:
-        return p.hist[idx, p.hist_names.index(name)]
-    raise ValueError(f"probe quantity {name!r} is not available: no material of "
-                     f"this model has it (history variables: {p.hist_names or 'none'})")
+def quantity(p, idx: np.ndarray, name: str, computed=None) -> np.ndarray:
+    """Values of probe quantity ``name`` for particles ``idx`` (SI units);
+    ``ValueError`` if the model has no such quantity."""
+    return probe_values(p, name, computed)[idx]
 
 
-def record(p, probes: list[Probe]) -> dict[str, float]:
+def record(p, probes: list[Probe], computed=None) -> dict[str, float]:
     """History columns of every probe at the current state."""
     out = {}
     for pr in probes:
         fn = _REDUCE[pr.reduce]
         for q in pr.quantities:
-            vals = quantity(p, pr.idx, q)
+            vals = quantity(p, pr.idx, q, computed)
             out[f"probe_{pr.name}_{q}"] = float(fn(vals)) if vals.size else float("nan")
     return out

@@ -16,11 +16,20 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from .schema import (ALLOWED_FIELDS, Deck, ExistingFile, explain,
-                     format_problem, suggest)
+from .errors import explain, format_problem
+from .messages import suggest
+from .schema import DeckSections, deck_model
+from .values import ExistingFile
 
-__all__ = ["ALLOWED_FIELDS", "Deck", "DeckError", "ExistingFile",
-           "deck_to_dict", "dump_resolved", "load_deck", "loads_deck"]
+__all__ = ["Deck", "DeckError", "ExistingFile", "deck_model", "deck_to_dict",
+           "dump_resolved", "load_deck", "loads_deck"]
+
+
+def __getattr__(name: str):
+    """``Deck``: the deck model for the registered materials (:func:`deck_model`)."""
+    if name == "Deck":
+        return deck_model()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 class DeckError(ValueError):
@@ -41,7 +50,7 @@ class DeckError(ValueError):
         return (type(self), (self.problems,))
 
 
-def load_deck(path: str | Path, overrides: list[str] | None = None) -> Deck:
+def load_deck(path: str | Path, overrides: list[str] | None = None) -> DeckSections:
     """Read, override and validate a TOML deck file.
 
     Parameters
@@ -56,6 +65,7 @@ def load_deck(path: str | Path, overrides: list[str] | None = None) -> Deck:
     Returns
     -------
     Deck
+        An instance of :func:`deck_model`.
 
     Raises
     ------
@@ -80,7 +90,7 @@ def load_deck(path: str | Path, overrides: list[str] | None = None) -> Deck:
 
 def loads_deck(text: str, base_dir: str | Path = ".",
                overrides: list[str] | None = None,
-               source: str = "<deck>") -> Deck:
+               source: str = "<deck>") -> DeckSections:
     """Validate a deck given as TOML text.
 
     Parameters
@@ -121,10 +131,11 @@ def loads_deck(text: str, base_dir: str | Path = ".",
             _apply_override(raw, item)
         except _OverrideError as exc:
             problems.append(str(exc))
+    model = deck_model()
     try:
-        deck = Deck.model_validate(raw, context={"base_dir": Path(base_dir)})
+        deck = model.model_validate(raw, context={"base_dir": Path(base_dir)})
     except ValidationError as exc:
-        problems += explain(exc, raw)
+        problems += explain(exc, raw, model)
     if problems:
         raise DeckError(problems)
     return deck
@@ -193,7 +204,7 @@ def _index(items: list, part: str, key: str) -> int:
                              f"{', '.join(known)}")))
 
 
-def deck_to_dict(deck: Deck) -> dict:
+def deck_to_dict(deck: DeckSections) -> dict:
     """Return the fully resolved deck as plain TOML-compatible data.
 
     Every default is filled in, quantities are SI floats, vectors lists,
@@ -202,7 +213,7 @@ def deck_to_dict(deck: Deck) -> dict:
     return deck.model_dump(mode="json", exclude_none=True)
 
 
-def dump_resolved(deck: Deck, path: str | Path) -> None:
+def dump_resolved(deck: DeckSections, path: str | Path) -> None:
     """Write the fully resolved deck as TOML; loading it gives an equal deck.
 
     Parameters

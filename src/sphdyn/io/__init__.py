@@ -6,7 +6,8 @@ directory and atomically renamed onto its destination
 
 * :mod:`~sphdyn.io.hdf5` -- native frames and bitwise-exact checkpoints,
 * :mod:`~sphdyn.io.vtk` -- ``.vtu`` particle files and ``.pvd`` time series,
-* :mod:`~sphdyn.io.fields` -- output fields computed from the state,
+* :mod:`~sphdyn.io.fields` -- the fields of a frame, from the state and the
+  field registry :mod:`sphdyn.fields`,
 * :mod:`~sphdyn.io.frames` -- numbered frames of a run directory, restart,
   VTK/CSV export,
 * :mod:`~sphdyn.io.history` -- global time histories (CSV),
@@ -15,7 +16,7 @@ directory and atomically renamed onto its destination
 """
 
 from .atomic import atomic_path, atomic_write_bytes, atomic_write_text
-from .fields import DERIVED_FIELDS, particle_fields
+from .fields import particle_fields
 from .frames import FrameWriter, export_csv, export_vtk, list_frames
 from .hdf5 import (read_checkpoint, read_frame, read_frame_header,
                    write_checkpoint, write_frame)
@@ -27,7 +28,7 @@ from .vtk import read_pvd, write_pvd, write_vtu
 
 __all__ = [
     "atomic_path", "atomic_write_bytes", "atomic_write_text",
-    "DERIVED_FIELDS", "particle_fields",
+    "particle_fields",
     "FrameWriter", "export_csv", "export_vtk", "list_frames",
     "read_checkpoint", "read_frame", "read_frame_header",
     "write_checkpoint", "write_frame",

@@ -2,9 +2,11 @@
 
 Every model provides a point function and a group kernel with the common
 signature ``update(idx, L, dt, rho, sig, e, c, damage, hist, params)``
-(see :mod:`sphdyn.materials.base`). Importing this package registers the
-built-in models ``"elastic"``, ``"j2"`` and ``"cscm"`` (concrete, LS-DYNA
-MAT_159 re-implementation, :mod:`sphdyn.materials.cscm`).
+(see :mod:`sphdyn.materials.base`) and owns its deck table (keys, defaults,
+checks). Importing this package registers the built-in models
+``"elastic"``, ``"j2"`` and ``"cscm"`` (concrete, LS-DYNA MAT_159
+re-implementation, :mod:`sphdyn.materials.cscm`); models of other packages
+register through entry points (:mod:`sphdyn.materials.registry`).
 """
 
 from .base import (
@@ -19,28 +21,35 @@ from .base import (
     register,
     von_mises,
 )
-from .elastic import ELASTIC, elastic_point, elastic_update
-from .j2 import J2, j2_point, j2_update
-from .cscm import CSCM, cscm_point, cscm_update
+from .registry import ENTRY_POINT_GROUP, load_entry_points, material_schemas
+from .elastic import ELASTIC, ElasticParams, elastic_point, elastic_update
+from .j2 import J2, J2Params, j2_point, j2_update
+from .cscm import CSCM, CscmParams, cscm_point, cscm_update
 
 __all__ = [
+    "ENTRY_POINT_GROUP",
     "KERNEL_SIGNATURE_DOC",
     "REGISTRY",
     "MaterialModel",
     "available_models",
     "get_model",
+    "load_entry_points",
+    "material_schemas",
     "register",
     "jaumann_rotate",
     "deviatoric_split",
     "von_mises",
     "energy_increment",
     "ELASTIC",
+    "ElasticParams",
     "elastic_point",
     "elastic_update",
     "J2",
+    "J2Params",
     "j2_point",
     "j2_update",
     "CSCM",
+    "CscmParams",
     "cscm_point",
     "cscm_update",
 ]

@@ -7,7 +7,9 @@ A material model is
 * a *group kernel* ``update(idx, L, dt, rho, sig, e, c, damage, hist, params)``
   with the same signature for every model (see :data:`KERNEL_SIGNATURE_DOC`),
 
-bundled in a :class:`MaterialModel` and registered by name.
+bundled with its parameter packing and deck table in a
+:class:`~sphdyn.materials.registry.MaterialModel` and registered by name
+(:mod:`sphdyn.materials.registry`; the names are re-exported here).
 
 Parameter vectors
 -----------------
@@ -28,17 +30,12 @@ nothing. The spin tensor is carried as ``(w_xy, w_yz, w_xz)`` with
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 from numba import njit
 
-# Common leading block of every parameter vector.
-P_DENSITY = 0
-P_K = 1
-P_G = 2
-N_COMMON = 3
+from .registry import (N_COMMON, P_DENSITY, P_G, P_K, REGISTRY,  # noqa: F401
+                       MaterialModel, available_models, get_model, register)
 
 KERNEL_SIGNATURE_DOC = """\
 update(idx, L, dt, rho, sig, e, c, damage, hist, params, size) -> None
@@ -56,107 +53,6 @@ params : float64[:]          packed parameters (``MaterialModel.pack``)
 size   : float64[:]          (N,) particle size V0^(1/dim) [m] (fracture-energy
                              regularisation; unused by elastic and j2)
 """
-
-
-# --------------------------------------------------------------------------
-# Model description and registry
-# --------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class MaterialModel:
-    """A registered constitutive model.
-
-    Attributes
-    ----------
-    name : str
-        Registry key (e.g. ``"elastic"``, ``"j2"``).
-    history_names : tuple of str
-        Names of the model's history columns ``hist[:, 0:nh]``.
-    pack : callable
-        ``pack(values: dict) -> float64 array``; values in SI units. Raises
-        ``ValueError`` naming a missing or invalid key.
-    update : numba dispatcher
-        Group kernel with the common signature (:data:`KERNEL_SIGNATURE_DOC`).
-    history_init : callable or None
-        ``history_init(params) -> (nh,) array`` of initial history values;
-        ``None`` means all zeros.
-    """
-
-    name: str
-    history_names: tuple[str, ...]
-    pack: Callable[[dict], np.ndarray]
-    update: Callable
-    history_init: Callable[[np.ndarray], np.ndarray] | None = None
-
-    @property
-    def n_history(self) -> int:
-        """Number of history columns the model uses."""
-        return len(self.history_names)
-
-    def initial_history(self, params: np.ndarray) -> np.ndarray:
-        """Initial history values, shape ``(nh,)``."""
-        if self.history_init is None:
-            return np.zeros(self.n_history)
-        return np.asarray(self.history_init(params), dtype=np.float64)
-
-    @staticmethod
-    def density(params: np.ndarray) -> float:
-        """Reference density [kg/m^3] stored in the parameter vector."""
-        return float(params[P_DENSITY])
-
-    @staticmethod
-    def bulk_modulus(params: np.ndarray) -> float:
-        """Elastic bulk modulus K [Pa]."""
-        return float(params[P_K])
-
-    @staticmethod
-    def shear_modulus(params: np.ndarray) -> float:
-        """Elastic shear modulus G [Pa]."""
-        return float(params[P_G])
-
-    @staticmethod
-    def wave_speed(params: np.ndarray, rho: float) -> float:
-        """Longitudinal (P-wave) speed ``c = sqrt((K + 4G/3) / rho)`` [m/s].
-
-        Parameters
-        ----------
-        params : float64 array
-            Packed parameters.
-        rho : float
-            Density [kg/m^3], > 0.
-        """
-        return math.sqrt((params[P_K] + 4.0 * params[P_G] / 3.0) / rho)
-
-
-REGISTRY: dict[str, MaterialModel] = {}
-
-
-def register(model: MaterialModel, *, replace: bool = False) -> MaterialModel:
-    """Add ``model`` to :data:`REGISTRY` under ``model.name``.
-
-    Raises ``ValueError`` if the name is taken and ``replace`` is false.
-    """
-    if model.name in REGISTRY and not replace:
-        raise ValueError(f"material model {model.name!r} is already registered")
-    REGISTRY[model.name] = model
-    return model
-
-
-def available_models() -> tuple[str, ...]:
-    """Sorted names of the registered models."""
-    return tuple(sorted(REGISTRY))
-
-
-def get_model(name: str) -> MaterialModel:
-    """Registered model by name; ``KeyError`` listing the known names otherwise."""
-    try:
-        return REGISTRY[name]
-    except KeyError:
-        raise KeyError(
-            f"unknown material model {name!r}; registered models: "
-            f"{', '.join(available_models()) or '(none)'}"
-        ) from None
 
 
 # --------------------------------------------------------------------------

@@ -8,30 +8,24 @@ applied to the Jaumann-rotated stress with ``Delta eps = D dt``
 Structures*, 2000, Sec. 5.4.1, hypoelastic Jaumann model).
 
 Parameters (``pack``): ``density`` and either ``E``, ``nu`` or ``K``, ``G``.
-Vector layout ``[density, K, G]``. No history.
+Vector layout ``[density, K, G]``. No history. Deck table:
+:class:`ElasticParams`.
 """
 
 from __future__ import annotations
 
+from typing import Literal, Optional
+
 import numpy as np
 from numba import njit, prange
+from pydantic import Field, model_validator
 
-from .base import (
-    P_G,
-    P_K,
-    MaterialModel,
-    energy_increment,
-    jaumann_rotate,
-    load_sym6,
-    p_wave_speed,
-    pack_common,
-    rate_split,
-    register,
-    scale6,
-    store_sym6,
-    to_mat33,
-    to_sym6,
-)
+from ..deck.messages import problem
+from ..deck.sections.material import MaterialSection
+from ..deck.values import PositivePressure, real
+from .base import (P_G, P_K, MaterialModel, energy_increment, jaumann_rotate,
+                   load_sym6, p_wave_speed, pack_common, rate_split, register, scale6,
+                   store_sym6, to_mat33, to_sym6)
 
 
 @njit(cache=True, error_model="numpy")
@@ -106,6 +100,51 @@ def elastic_update(idx, L, dt, rho, sig, e, c, damage, hist, params, size):
         c[i] = p_wave_speed(K, G, rho[i])
 
 
+class ElasticParams(MaterialSection):
+    """[[material]] model = "elastic": isotropic linear elasticity.
+
+    Give exactly one pair of elastic constants: E and nu, or K and G.
+    """
+
+    model: Literal["elastic"] = Field(description="Constitutive model.")
+    E: Optional[PositivePressure] = Field(
+        None, description="Young's modulus (give with nu).")
+    nu: Optional[real("Poisson ratio", lo=-1, hi=0.5, lo_open=True,
+                      hi_open=True)] = Field(
+        None, description="Poisson ratio (give with E).")
+    K: Optional[PositivePressure] = Field(
+        None, description="Bulk modulus (give with G).")
+    G: Optional[PositivePressure] = Field(
+        None, description="Shear modulus (give with K).")
+
+    @model_validator(mode="after")
+    def _one_pair(self):
+        given = [k for k in ("E", "nu", "K", "G") if getattr(self, k) is not None]
+        if set(given) in ({"E", "nu"}, {"K", "G"}):
+            return self
+        fix = "give either E and nu, or K and G"
+        if not given:
+            raise problem("no elastic constants are given", fix)
+        if {"E", "nu"} & set(given) and {"K", "G"} & set(given):
+            raise problem(f"{', '.join(given)} mix the two ways of giving "
+                          "elastic constants", fix + ", not both")
+        other = {"E": "nu", "nu": "E", "K": "G", "G": "K"}[given[0]]
+        raise problem(f"{given[0]} is given without {other}",
+                      f"add {other} ({fix})")
+
+    def bulk_modulus(self) -> float:
+        """Return the bulk modulus K [Pa]."""
+        if self.K is not None:
+            return self.K
+        return self.E / (3.0 * (1.0 - 2.0 * self.nu))
+
+    def shear_modulus(self) -> float:
+        """Return the shear modulus G [Pa]."""
+        if self.G is not None:
+            return self.G
+        return self.E / (2.0 * (1.0 + self.nu))
+
+
 def pack_elastic(values: dict) -> np.ndarray:
     """``[density, K, G]`` from ``density`` and ``(E, nu)`` or ``(K, G)`` [SI]."""
     return np.array(pack_common(values), dtype=np.float64)
@@ -116,4 +155,5 @@ ELASTIC = register(MaterialModel(
     history_names=(),
     pack=pack_elastic,
     update=elastic_update,
+    schema=ElasticParams,
 ))

@@ -20,39 +20,30 @@ The mean stress is untouched by the return (plastic flow is deviatoric), and
 after a return ``q = sigma_y + H eps_p`` exactly.
 
 Parameters (``pack``): ``density``, ``E``/``nu`` or ``K``/``G``,
-``yield_stress`` (> 0), ``hardening_modulus`` (>= 0, default 0: perfect
-plasticity). Vector ``[density, K, G, yield_stress, hardening_modulus]``.
-History: ``("plastic_strain",)``, the equivalent plastic strain.
+``yield_stress`` (> 0), ``hardening_modulus`` (>= 0, absent: the deck
+default, perfect plasticity). Vector
+``[density, K, G, yield_stress, hardening_modulus]``.
+History: ``("plastic_strain",)``, the equivalent plastic strain. Deck
+table: :class:`J2Params`.
 """
 
 from __future__ import annotations
 
 import math
+from typing import Literal
 
 import numpy as np
 from numba import njit, prange
+from pydantic import Field
 
-from .base import (
-    N_COMMON,
-    P_G,
-    P_K,
-    MaterialModel,
-    ddot6,
-    deviatoric_split,
-    energy_increment,
-    get_float,
-    jaumann_rotate,
-    load_sym6,
-    p_wave_speed,
-    pack_common,
-    rate_split,
-    register,
-    scale6,
-    store_sym6,
-    to_mat33,
-    to_sym6,
-)
-from .elastic import elastic_increment
+from ..deck.units import PRESSURE
+from ..deck.values import PositivePressure, quantity
+from .base import (N_COMMON, P_G, P_K, MaterialModel, ddot6, deviatoric_split,
+                   energy_increment, get_float, jaumann_rotate, load_sym6,
+                   p_wave_speed, pack_common, rate_split, register, scale6, store_sym6,
+                   to_mat33, to_sym6)
+from .elastic import ElasticParams, elastic_increment
+from .registry import schema_defaults
 
 P_YIELD = N_COMMON
 P_HARDENING = N_COMMON + 1
@@ -106,12 +97,8 @@ def j2_point(sig, deps, K, G, sigma_y, H, eps_p):
 
     Parameters
     ----------
-    sig : (3, 3) float64
-        Cauchy stress [Pa], tension positive (symmetric part is used).
-    deps : (3, 3) float64
-        Strain increment ``D dt`` [-] (symmetric part is used).
-    K, G : float
-        Bulk and shear modulus [Pa].
+    sig, deps, K, G
+        As for :func:`~sphdyn.materials.elastic.elastic_point`.
     sigma_y, H : float
         Initial yield stress and hardening modulus [Pa].
     eps_p : float
@@ -153,11 +140,29 @@ def j2_update(idx, L, dt, rho, sig, e, c, damage, hist, params, size):
         c[i] = p_wave_speed(K, G, rho[i])
 
 
+class J2Params(ElasticParams):
+    """[[material]] model = "j2": von Mises plasticity, linear hardening.
+
+    Elastic constants as for "elastic" (E and nu, or K and G).
+    """
+
+    model: Literal["j2"] = Field(description="Constitutive model.")
+    yield_stress: PositivePressure = Field(
+        description="Initial yield stress in uniaxial tension.")
+    hardening_modulus: quantity(PRESSURE, "hardening modulus", lo=0) = Field(
+        0.0, description="Plastic modulus H of linear isotropic hardening "
+                         "(0 = perfect plasticity).")
+
+
 def pack_j2(values: dict) -> np.ndarray:
-    """``[density, K, G, yield_stress, hardening_modulus]`` from SI values."""
+    """``[density, K, G, yield_stress, hardening_modulus]`` from SI values.
+
+    An absent ``hardening_modulus`` takes the deck default (:class:`J2Params`).
+    """
     out = pack_common(values)
     out.append(get_float(values, "yield_stress", min_value=0.0, min_inclusive=False))
-    out.append(get_float(values, "hardening_modulus", default=0.0, min_value=0.0))
+    out.append(get_float(values, "hardening_modulus", min_value=0.0,
+                         default=schema_defaults(J2Params)["hardening_modulus"]))
     return np.array(out, dtype=np.float64)
 
 
@@ -166,4 +171,5 @@ J2 = register(MaterialModel(
     history_names=("plastic_strain",),
     pack=pack_j2,
     update=j2_update,
+    schema=J2Params,
 ))

@@ -7,7 +7,9 @@ generation from the fits collected in ``cscm-notes.md`` sec. 2.2 (Murray,
 *Users Manual for LS-DYNA Concrete Material Model 159*, FHWA-HRT-05-062,
 2007, as transcribed; tags [V]/[S]/[R]/[D] as in the notes) and returns SI
 values. Any subset of the full parameter set may be given explicitly and
-overrides the generated value.
+overrides the generated value. The defaults of f'c and the aggregate size
+themselves are those of the deck table
+(:class:`~sphdyn.materials.cscm.schema.CscmParams`).
 
 The fits are written in the units they were published in (MPa, mm, psi for
 the fluidity fits); the conversion to SI happens here, once, and nothing
@@ -37,7 +39,7 @@ GFC, GFT,  J/m^2       fracture energies (uniaxial compression, uniaxial
 GFS                    tension, pure shear)
 pwrc,pwrt  -           shear-to-compression / -tension transition powers
 pmod       -           moderate-pressure softening modifier (stored, unused:
-                       dmax is a constant, see cscm.py)
+                       dmax is a constant, see point.py)
 eta0c, nc  s^(1-nc),-  compression fluidity eta_c = eta0c / rate^nc
 eta0t, nt  s^(1-nt),-  tension fluidity
 overc,     Pa          maximum overstress in compression / tension
@@ -54,7 +56,15 @@ import math
 MPA = 1.0e6          # Pa per MPa
 PSI_PER_MPA = 145.0377377  # psi per MPa (1 psi = 6894.757 Pa)
 
-#: Order of the CSCM parameters after the common block (see cscm.py).
+#: Poisson ratio of the default moduli.
+NU = 0.15
+#: Default GFC / GFT (GFS = GFT).
+GFC_PER_GFT = 100.0
+#: Defaults independent of f'c that the deck reference quotes.
+CONSTANT_DEFAULTS = {"B": 100.0, "D": 0.1, "pwrc": 5.0, "pwrt": 1.0,
+                     "srate": 1.0, "repow": 1.0}
+
+#: Order of the CSCM parameters after the common block (see layout.py).
 PARAM_NAMES = (
     "alpha", "theta", "lamda", "beta",
     "alpha1", "theta1", "lamda1", "beta1",
@@ -90,8 +100,7 @@ def elastic_moduli(fc: float) -> tuple[float, float]:
     (K, G) : tuple of float, [Pa].
     """
     E = 18.275e9 * (fc / (10.0 * MPA)) ** (1.0 / 3.0)
-    nu = 0.15
-    return E / (3.0 * (1.0 - 2.0 * nu)), E / (2.0 * (1.0 + nu))
+    return E / (3.0 * (1.0 - 2.0 * NU)), E / (2.0 * (1.0 + NU))
 
 
 def fracture_energy_tension(fc: float, dagg: float) -> float:
@@ -118,8 +127,7 @@ def fracture_energy_tension(fc: float, dagg: float) -> float:
     return gf0 * (fc / (10.0 * MPA)) ** 0.7
 
 
-def default_parameters(fc: float = 30.0 * MPA, dagg: float = 0.019,
-                       **overrides: float) -> dict[str, float]:
+def default_parameters(fc: float, dagg: float, **overrides: float) -> dict[str, float]:
     """Full CSCM parameter set (SI) from f'c and aggregate size.
 
     Fits of notes sec. 2.2 (Murray 2007 defaults as transcribed; each fit
@@ -129,9 +137,9 @@ def default_parameters(fc: float = 30.0 * MPA, dagg: float = 0.019,
     Parameters
     ----------
     fc : float
-        Unconfined compression strength f'c [Pa] (LS-DYNA default 30 MPa).
+        Unconfined compression strength f'c [Pa].
     dagg : float
-        Maximum aggregate size [m] (LS-DYNA default 19 mm).
+        Maximum aggregate size [m].
     **overrides
         Any of :data:`PARAM_NAMES` or ``K``, ``G`` in SI units; replaces the
         generated value. Unknown names raise ``ValueError``.
@@ -172,13 +180,13 @@ def default_parameters(fc: float = 30.0 * MPA, dagg: float = 0.019,
         "D1": 2.5e-4 / MPA,
         "D2": 3.49e-7 / MPA ** 2,
         # damage [S]; GFS = GFT, GFC = 100 GFT [V 05-063 ch.10]
-        "B": 100.0,
-        "D": 0.1,
+        "B": CONSTANT_DEFAULTS["B"],
+        "D": CONSTANT_DEFAULTS["D"],
         "GFT": gft,
         "GFS": gft,
-        "GFC": 100.0 * gft,
-        "pwrc": 5.0,
-        "pwrt": 1.0,
+        "GFC": GFC_PER_GFT * gft,
+        "pwrc": CONSTANT_DEFAULTS["pwrc"],
+        "pwrt": CONSTANT_DEFAULTS["pwrt"],
         "pmod": 0.0,
         # rate effects [S + numeric check]; eta0 fits in psi, time in s
         "eta0c": _poly(fpsi, 1.2772337e-11, -1.0613722e-7, 3.203497e-4),
@@ -187,8 +195,8 @@ def default_parameters(fc: float = 30.0 * MPA, dagg: float = 0.019,
         "nt": 0.48,
         "overc": _poly(f, 1.309663e-2, -0.3927659, 21.45) * MPA,
         "overt": _poly(f, 1.309663e-2, -0.3927659, 21.45) * MPA,
-        "srate": 1.0,
-        "repow": 1.0,
+        "srate": CONSTANT_DEFAULTS["srate"],
+        "repow": CONSTANT_DEFAULTS["repow"],
     }
     for key, value in overrides.items():
         if value is None:

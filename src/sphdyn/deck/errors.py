@@ -1,0 +1,170 @@
+"""From pydantic validation errors to deck problem lines.
+
+:func:`explain` turns a ``ValidationError`` into one line per problem,
+``<path>: <what is wrong>. Fix: <what to write>``, prefixed with the dotted
+path of the offending key (union tags dropped, list entries ``[i]``) and
+labelled with the name of the enclosing table.
+"""
+
+from dataclasses import dataclass
+from typing import Any, Literal, Optional, get_args, get_origin
+
+from pydantic import BaseModel, ValidationError
+
+from .introspect import field_annotation, is_model, metadata, strip_optional, variants
+from .messages import choices, show, suggest
+from .scope import get_key
+from .values import Quantity, Vector
+
+
+@dataclass
+class Where:
+    """An error location resolved against the schema and the raw deck."""
+
+    path: str = ""
+    label: str = ""
+    owner: Optional[type[BaseModel]] = None
+    key: Optional[str] = None
+    annotation: Any = None
+
+
+def locate(loc: tuple, raw: Any, root: type[BaseModel]) -> Where:
+    """Resolve a pydantic error location.
+
+    Union tags are dropped from the path, list indexes are written
+    ``[i]``, and the name of the enclosing top-level table (if any) becomes
+    the label.
+    """
+    where = Where(annotation=root)
+    data = raw
+    for item in loc:
+        ann = strip_optional(where.annotation)
+        if isinstance(item, int):
+            where.path += f"[{item}]"
+            args = get_args(ann)
+            where.annotation = args[0] if args else None
+            ok = isinstance(data, (list, tuple)) and 0 <= item < len(data)
+            data = data[item] if ok else None
+            name = get_key(data, "name") if isinstance(data, dict) else None
+            if not where.label and isinstance(name, str):
+                where.label = f"{where.path.split('[')[0]} '{name}'"
+            continue
+        members = variants(ann)
+        if item in members:
+            where.annotation = members[item]
+            continue
+        where.path = f"{where.path}.{item}" if where.path else str(item)
+        where.owner = ann if is_model(ann) else None
+        where.key = item
+        info = where.owner.model_fields.get(item) if where.owner else None
+        where.annotation = field_annotation(info)
+        data = data.get(item) if isinstance(data, dict) else None
+    return where
+
+
+def _example(where: Where) -> str:
+    """A TOML snippet a user could write for the key at ``where``."""
+    key, ann = where.key, where.annotation
+    core = strip_optional(ann)
+    if is_model(core):
+        return f"a [{where.path}] table"
+    if get_origin(core) is tuple and get_args(core):
+        element = get_args(core)[0]
+        if is_model(strip_optional(element)) or variants(element):
+            return f"at least one [[{key}]] table"
+    if get_origin(core) is Literal:
+        return f"{key} = {choices(get_args(core))}"
+    for meta in metadata(ann):
+        func = getattr(meta, "func", None)
+        if isinstance(func, Quantity):
+            return f"{key} = \"{func.dim.example}\""
+        if isinstance(func, Vector):
+            return f"{key} = [x, y, z]"
+    if core is str:
+        return f"{key} = \"...\""
+    return f"{key} = <value>"
+
+
+_TYPE_NAMES = {
+    "int_type": ("an integer", "give a whole number such as 2"),
+    "int_from_float": ("an integer", "give a whole number such as 2"),
+    "float_type": ("a number", "give a number such as 0.5"),
+    "bool_type": ("true or false", "write true or false (no quotes)"),
+    "string_type": ("text", "give text in quotes, e.g. \"steel\""),
+    "tuple_type": ("a list", "give a list in brackets, e.g. [1, 2, 3]"),
+    "list_type": ("a list", "give a list in brackets, e.g. [1, 2, 3]"),
+    "model_type": ("a table", "write it as a table: [section] or { k = v }"),
+    "model_attributes_type": ("a table",
+                              "write it as a table: [section] or { k = v }"),
+    "dict_type": ("a table", "write it as a table: [section] or { k = v }"),
+}
+
+
+def _explain_one(err: dict, where: Where) -> tuple[str, str]:
+    """Return ``(what, fix)`` for one pydantic error."""
+    kind, ctx, value = err["type"], err.get("ctx") or {}, err.get("input")
+    if kind == "deck":
+        return ctx["what"], ctx["fix"]
+    if kind == "missing":
+        return "a required key is missing", f"add {_example(where)}"
+    if kind == "extra_forbidden":
+        valid = list(where.owner.model_fields) if where.owner else []
+        return "unknown key", suggest(
+            str(where.key), valid,
+            f"remove or rename it; valid keys here: {', '.join(valid)}")
+    if kind == "literal_error":
+        options = get_args(strip_optional(where.annotation))
+        return (f"{show(value)} is not allowed",
+                suggest(str(value), [str(a) for a in options],
+                        f"use one of {choices(options)}"))
+    if kind in ("union_tag_not_found", "union_tag_invalid"):
+        key = ctx.get("discriminator", "").strip("'")
+        tags = list(variants(where.annotation))
+        allowed = choices(tags)
+        if kind == "union_tag_not_found":
+            return f"the key '{key}' is missing", f"add {key} = {allowed}"
+        tag = str(ctx.get("tag"))
+        return (f"{key} = '{tag}' is not known",
+                suggest(tag, tags, f"use {key} = {allowed}"))
+    if kind == "finite_number":
+        return f"{show(value)} is not finite", "give a finite number"
+    base_kind = kind.replace("_parsing", "_type")
+    if base_kind in _TYPE_NAMES:
+        name, fix = _TYPE_NAMES[base_kind]
+        return f"{show(value)} is not {name}", fix
+    return err["msg"], "see docs/deck-reference.md"
+
+
+def format_problem(path: str, what: str, fix: str) -> str:
+    """Join the parts of one problem line."""
+    fix = fix if fix.endswith((".", "?", "!")) else fix + "."
+    return f"{path or 'deck'}: {what}. Fix: {fix}"
+
+
+def explain(exc: ValidationError, raw: Any, root: type[BaseModel]) -> list[str]:
+    """Turn a ``ValidationError`` from validating ``raw`` into problem lines.
+
+    Parameters
+    ----------
+    exc : ValidationError
+        Raised by ``root.model_validate(raw)``.
+    raw : Any
+        The data that was validated (used to find names for the labels).
+    root : type of BaseModel
+        The model that was validated.
+
+    Returns
+    -------
+    list of str
+        ``<path>: <what is wrong>. Fix: <what to write>`` per problem.
+    """
+    lines = []
+    for err in exc.errors(include_url=False):
+        where = locate(err["loc"], raw, root)
+        what, fix = _explain_one(err, where)
+        if where.label and where.key != "name":
+            what += f" in {where.label}"
+        line = format_problem(where.path, what, fix)
+        if line not in lines:
+            lines.append(line)
+    return lines

@@ -1,0 +1,48 @@
+"""Deck sections [run], [time] and [domain]: what is simulated, how it steps."""
+
+from typing import Literal, Optional
+
+from pydantic import Field, StrictStr
+
+from ..units import TIME
+from ..values import Position, Section, UpperPosition, integer, quantity, real
+
+
+class Run(Section):
+    """[run]: what is simulated and for how long."""
+
+    title: StrictStr = Field("", description="Free text naming the run; "
+                             "copied into the outputs.")
+    dimension: Literal[2, 3] = Field(
+        description="2 = plane strain, quantities per unit depth (masses in "
+                    "kg/m); 3 = three-dimensional.")
+    t_end: quantity(TIME, "end time", lo=0, lo_open=True) = Field(
+        description="Simulated end time.")
+    seed: integer("seed", lo=0) = Field(
+        0, description="Seed of the random number generator (lattice "
+                       "jitter, random material properties).")
+
+
+class Time(Section):
+    """[time]: explicit time stepping."""
+
+    cfl: real("CFL number", lo=0, hi=1, lo_open=True) = Field(
+        0.3, description="Courant number: dt = cfl * min(h / (c + |v|)).")
+    dt_max: Optional[quantity(TIME, "time step", lo=0, lo_open=True)] = Field(
+        None, description="Upper bound on the time step (absent: no bound).")
+    collapse_ratio: real("ratio", lo=0, hi=1, lo_open=True, hi_open=True) = \
+        Field(1e-4, description="The run stops when dt < collapse_ratio * "
+                                "initial dt.")
+
+
+class Domain(Section):
+    """[domain]: guard box; a particle leaving it stops the run."""
+
+    lo: Optional[Position] = Field(
+        None, description="Lower corner (absent: from the bodies and margin).")
+    hi: Optional[UpperPosition] = Field(
+        None, description="Upper corner (absent: from the bodies and margin).")
+    margin: real("margin", lo=0) = Field(
+        1.0, description="For an absent corner: the initial bounding box of "
+                         "the bodies expanded on each side by margin times its "
+                         "largest side (the same distance in every direction).")

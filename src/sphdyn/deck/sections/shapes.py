@@ -1,0 +1,133 @@
+"""Shapes of the deck: body geometries and selection regions ([set.region])."""
+
+from typing import Annotated, Literal, Optional, Union
+
+from pydantic import AfterValidator, Field, ValidationInfo, field_validator
+
+from ..messages import problem, show_number
+from ..scope import dimension
+from ..units import LENGTH
+from ..values import (Axis, Corner, Direction, Position, PositiveLength, Section,
+                      UpperCorner, UpperPosition, quantity)
+
+
+class Box(Section):
+    """Axis-aligned box."""
+
+    shape: Literal["box"] = Field(description="Kind of shape.")
+    lo: Position = Field(description="Lower corner.")
+    hi: UpperPosition = Field(description="Upper corner, above lo in the first "
+                                     "`dimension` components.")
+
+
+class Sphere(Section):
+    """Sphere (a disc in 2D)."""
+
+    shape: Literal["sphere"] = Field(description="Kind of shape.")
+    centre: Position = Field(description="Centre.")
+    radius: PositiveLength = Field(description="Radius.")
+
+
+def _axis_in_plane(axis: str) -> str:
+    if dimension() == 2 and axis != "z":
+        raise problem(f"axis '{axis}' is not allowed in 2D",
+                      "use axis = \"z\" (the shape is a disc in the x-y plane)")
+    return axis
+
+
+def _length_in_3d(length: Optional[float]) -> Optional[float]:
+    if length is None and dimension() == 3:
+        raise problem("a cylinder or ring in a 3D deck needs a length",
+                      "add length = \"100 mm\" (or a number in metres)")
+    return length
+
+
+PlanarAxis = Annotated[Axis, AfterValidator(_axis_in_plane)]
+AxialLength = Annotated[Optional[PositiveLength], AfterValidator(_length_in_3d)]
+
+
+class Cylinder(Section):
+    """Solid circular cylinder (a disc in 2D)."""
+
+    shape: Literal["cylinder"] = Field(description="Kind of shape.")
+    centre: Position = Field(description="Centre (mid-length on the axis).")
+    radius: PositiveLength = Field(description="Radius.")
+    length: AxialLength = Field(
+        None, validate_default=True,
+        description="Length along the axis; required in 3D, ignored in 2D.")
+    axis: PlanarAxis = Field("z", description="Axis direction; must be z "
+                                              "in 2D.")
+
+
+class Ring(Section):
+    """Hollow circular cylinder (an annulus in 2D)."""
+
+    shape: Literal["ring"] = Field(description="Kind of shape.")
+    centre: Position = Field(description="Centre (mid-length on the axis).")
+    inner_radius: quantity(LENGTH, "radius", lo=0) = Field(
+        description="Inner radius.")
+    outer_radius: PositiveLength = Field(
+        description="Outer radius, greater than inner_radius.")
+    length: AxialLength = Field(
+        None, validate_default=True,
+        description="Length along the axis; required in 3D, ignored in 2D.")
+    axis: PlanarAxis = Field("z", description="Axis direction; must be z "
+                                              "in 2D.")
+
+    @field_validator("outer_radius")
+    @classmethod
+    def _above_inner(cls, outer, info: ValidationInfo):
+        inner = info.data.get("inner_radius")
+        if inner is not None and outer <= inner:
+            raise problem(f"outer_radius {show_number(outer)} is not greater than "
+                          f"inner_radius {show_number(inner)}",
+                          "give an outer_radius greater than inner_radius")
+        return outer
+
+
+Geometry = Annotated[Union[Box, Cylinder, Ring, Sphere],
+                     Field(discriminator="shape")]
+
+
+class RegionBox(Section):
+    """Axis-aligned selection box; in 2D its z-range may be any range
+    containing z = 0, so the same box works in 2D and 3D decks."""
+
+    shape: Literal["box"] = Field(description="Kind of shape.")
+    lo: Corner = Field(description="Lower corner.")
+    hi: UpperCorner = Field(description="Upper corner, above lo in the first "
+                                   "`dimension` components.")
+
+    @field_validator("hi")
+    @classmethod
+    def _z_range_holds_the_plane(cls, hi, info: ValidationInfo):
+        lo = info.data.get("lo")
+        if lo is not None and dimension() == 2 and not lo[2] <= 0 <= hi[2]:
+            raise problem(f"the z-range [{show_number(lo[2])}, {show_number(hi[2])}] does "
+                          "not contain the plane z = 0 of this 2D deck",
+                          "give z-components with lo <= 0 <= hi, e.g. 0 and 0")
+        return hi
+
+
+class CylinderRegion(Section):
+    """Circular cylinder region, infinite unless a length is given."""
+
+    shape: Literal["cylinder"] = Field(description="Kind of shape.")
+    centre: Position = Field(description="Centre (mid-length on the axis).")
+    radius: PositiveLength = Field(description="Radius.")
+    axis: Axis = Field("z", description="Axis direction.")
+    length: Optional[PositiveLength] = Field(
+        None, description="Length along the axis (absent: infinite).")
+
+
+class HalfSpace(Section):
+    """Half-space: points with (x - point) . normal >= 0."""
+
+    shape: Literal["halfspace"] = Field(description="Kind of shape.")
+    point: Position = Field(description="A point on the bounding plane.")
+    normal: Direction = Field(description="Normal pointing into the "
+                                          "selected side (normalised).")
+
+
+Region = Annotated[Union[RegionBox, Sphere, HalfSpace, CylinderRegion],
+                   Field(discriminator="shape")]

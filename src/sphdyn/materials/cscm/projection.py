@@ -1,0 +1,219 @@
+"""CSCM return to the yield surface: closest point in the energy norm.
+
+:func:`project` (fast path with a bracketing search, falling back to
+:func:`project_global`: scan, golden section and regula falsi) and the
+yield-onset fraction of a stress increment (:func:`yield_fraction`).
+"""
+
+import math
+
+from numba import njit
+
+from .layout import P_ALPHA, P_J1APEX
+from .surface import meridian_radius, meridian, yield_function
+
+NSCAN = 32  # coarse scan of the projection (see project)
+NGOLDEN = 30  # golden-section iterations of the projection (bracket 5e-7 of a scan cell)
+
+
+@njit(cache=True, error_model="numpy")
+def project(J1t, rt, bhat, kappa, K, G, p):
+    """Closest point of the yield surface to a trial point, energy norm.
+
+    Minimises ``phi(J1) = (J1 - J1t)^2/(9K) + (F(J1) - rt)^2/G`` over
+    ``J1 in [J1_apex, X]``, ``F = Rub Ff sqrt(Fc)`` at the trial Lode angle
+    (associated closest-point return in the meridian plane for isotropic
+    elasticity: notes sec. 1.3 [V text], choice [D]).
+
+    Fast path (the usual plastic sub-step): the trial lies above the
+    meridian, ``J1_apex < J1t < X`` and ``rt > F(J1t)``. For a concave
+    meridian ``F`` (shear surface, Rubin ratios and elliptical cap are
+    concave in J1), ``dphi/dJ1`` is increasing wherever ``F < rt``, and
+    points beyond the first ``J1`` with ``F >= rt`` are farther than that
+    point, so the minimiser is the unique root of ``dphi/dJ1`` found by
+    stepping away from ``J1t`` (doubling steps) until the sign changes,
+    then Illinois regula falsi (:func:`_refine`). If no sign change is found
+    before an end of the interval, or the trial is not above the meridian,
+    :func:`project_global` (scan + golden section + refinement) decides.
+    The two agree to the refinement tolerance (tests/test_cscm.py).
+
+    Returns
+    -------
+    (J1, sqrt(J2')) of the returned point [Pa].
+    """
+    return project_on_meridian(J1t, rt, meridian(bhat, kappa, p), K, G, p)
+
+
+@njit(cache=True, error_model="numpy")
+def project_on_meridian(J1t, rt, m, K, G, p):
+    """:func:`project` with the meridian constants ``m`` of :func:`meridian`."""
+    X = m[3]
+    apex = p[P_J1APEX]
+    if apex < J1t < X:
+        Ft = meridian_radius(J1t, m, p)
+        if rt > Ft > 0.0:
+            g0, dF = _dphi_slope(J1t, J1t, rt, m, K, G, p)
+            if g0 == 0.0:
+                return J1t, Ft
+            sgn = 1.0 if g0 < 0.0 else -1.0
+            # first step: the Newton step with dphi''/2 ~ 1/(9K) + F'^2/G,
+            # which underestimates the curvature where F < rt and F'' < 0,
+            # so it usually overshoots the root and brackets it at once
+            step = abs(g0) / (1.0 / (9.0 * K) + dF * dF / G)
+            step = max(step, 1e-9 * (X - apex))
+            x0, gx0 = J1t, g0
+            for _ in range(40):
+                x1 = J1t + sgn * step
+                if x1 <= apex or x1 >= X:
+                    break
+                g1 = _dphi(x1, J1t, rt, m, K, G, p)
+                if (g1 > 0.0) != (gx0 > 0.0):
+                    if sgn > 0.0:
+                        J1 = _refine(x0, x1, gx0, g1, J1t, rt, m, K, G, p)
+                    else:
+                        J1 = _refine(x1, x0, g1, gx0, J1t, rt, m, K, G, p)
+                    return J1, meridian_radius(J1, m, p)
+                x0, gx0 = x1, g1
+                step *= 2.0
+    return _project_global(J1t, rt, m, K, G, p)
+
+
+@njit(cache=True, error_model="numpy")
+def _refine(lo, hi, gl, gh, J1t, rt, m, K, G, p):
+    """Root of ``dphi/dJ1`` in ``[lo, hi]`` with ``gl < 0 < gh`` (Illinois regula falsi).
+
+    Superlinear bracketing iteration (Dowell & Jarratt 1971); stops at a
+    bracket of ``1e-11 (|J1t| + alpha)`` (about 1e-4 Pa) or after 60
+    iterations.
+    """
+    tol = 1e-11 * (abs(J1t) + abs(p[P_ALPHA]))
+    side = 0
+    mid = 0.5 * (lo + hi)
+    for _ in range(60):
+        mid = (lo * gh - hi * gl) / (gh - gl)
+        gm = _dphi(mid, J1t, rt, m, K, G, p)
+        if gm < 0.0:
+            lo, gl = mid, gm
+            if side == -1:
+                gh *= 0.5
+            side = -1
+        elif gm > 0.0:
+            hi, gh = mid, gm
+            if side == 1:
+                gl *= 0.5
+            side = 1
+        else:
+            return mid
+        if hi - lo <= tol:
+            return 0.5 * (lo + hi)
+    return mid
+
+
+@njit(cache=True, error_model="numpy")
+def project_global(J1t, rt, bhat, kappa, K, G, p):
+    """:func:`project` (same arguments and result) by a global search.
+
+    A coarse scan of ``NSCAN + 1`` points of ``phi`` over ``[J1_apex, X]``
+    brackets the global minimum, ``NGOLDEN`` golden-section steps narrow the
+    bracket, and Illinois regula falsi on ``dphi/dJ1 = 0``
+    (:func:`_refine`) converges.
+    """
+    return _project_global(J1t, rt, meridian(bhat, kappa, p), K, G, p)
+
+
+@njit(cache=True, error_model="numpy")
+def _project_global(J1t, rt, m, K, G, p):
+    """:func:`project_global` with the meridian constants ``m``."""
+    X = m[3]
+    # phi need not be unimodal on the whole interval (e.g. a trial beyond
+    # the cap: local minima on the shear part and at X), so a coarse scan
+    # of NSCAN + 1 points picks the bracket of the global minimum first.
+    lo0 = p[P_J1APEX]
+    width = (X - lo0) / NSCAN
+    best = 0
+    phib = 1e300
+    for k in range(NSCAN + 1):
+        x = lo0 + k * width
+        fx = meridian_radius(x, m, p)
+        ph = (x - J1t) ** 2 / (9.0 * K) + (fx - rt) ** 2 / G
+        if ph < phib:
+            phib = ph
+            best = k
+    a = lo0 + max(best - 1, 0) * width
+    b = lo0 + min(best + 1, NSCAN) * width
+    gr = 0.5 * (math.sqrt(5.0) - 1.0)
+    c = b - gr * (b - a)
+    d = a + gr * (b - a)
+    fcv = meridian_radius(c, m, p)
+    fdv = meridian_radius(d, m, p)
+    phic = (c - J1t) ** 2 / (9.0 * K) + (fcv - rt) ** 2 / G
+    phid = (d - J1t) ** 2 / (9.0 * K) + (fdv - rt) ** 2 / G
+    for _ in range(NGOLDEN):
+        if phic < phid:
+            b = d
+            d = c
+            phid = phic
+            c = b - gr * (b - a)
+            fcv = meridian_radius(c, m, p)
+            phic = (c - J1t) ** 2 / (9.0 * K) + (fcv - rt) ** 2 / G
+        else:
+            a = c
+            c = d
+            phic = phid
+            d = a + gr * (b - a)
+            fdv = meridian_radius(d, m, p)
+            phid = (d - J1t) ** 2 / (9.0 * K) + (fdv - rt) ** 2 / G
+    J1 = 0.5 * (a + b)
+    # The golden section locates the minimiser only to ~sqrt(eps) relative
+    # (phi is flat there); refine on dphi/dJ1 = 0 (central difference for F')
+    # inside the golden bracket by the Illinois variant of regula falsi
+    # (superlinear, the bracket is kept), if the bracket holds a sign change.
+    lo = max(a, p[P_J1APEX])
+    hi = min(b, X)
+    gl = _dphi(lo, J1t, rt, m, K, G, p)
+    gh = _dphi(hi, J1t, rt, m, K, G, p)
+    if gl < 0.0 < gh:
+        J1 = _refine(lo, hi, gl, gh, J1t, rt, m, K, G, p)
+    return J1, meridian_radius(J1, m, p)
+
+
+@njit(cache=True, error_model="numpy")
+def _dphi_slope(J1, J1t, rt, m, K, G, p):
+    """Half the derivative of the projection distance ``phi`` (see
+    :func:`project`), ``(J1 - J1t)/(9K) + (F - rt) F'/G``, and the meridian
+    slope ``F' = dF/dJ1`` (one-sided difference, step ``h = 1e-7 (|J1| +
+    alpha)``, backward within ``h`` of the cap end X; the O(h F'') error
+    moves the returned point by ~1e-7 of the return distance)."""
+    h = 1e-7 * (abs(J1) + abs(p[P_ALPHA]))
+    F = meridian_radius(J1, m, p)
+    if J1 + h < m[3]:
+        dF = (meridian_radius(J1 + h, m, p) - F) / h
+    else:
+        dF = (F - meridian_radius(J1 - h, m, p)) / h
+    return (J1 - J1t) / (9.0 * K) + (F - rt) * dF / G, dF
+
+
+@njit(cache=True, error_model="numpy")
+def _dphi(J1, J1t, rt, m, K, G, p):
+    """Half the derivative of the projection distance ``phi`` (see :func:`project`)."""
+    return _dphi_slope(J1, J1t, rt, m, K, G, p)[0]
+
+
+@njit(cache=True, error_model="numpy")
+def yield_fraction(s0, s1, kappa, p):
+    """Fraction ``a`` in [0, 1] where ``s0 + a (s1 - s0)`` reaches the yield
+    surface (bisection, 50 halvings; 0 if ``s0`` is already outside)."""
+    if yield_function(s0, kappa, p) > 0.0:
+        return 0.0
+    lo = 0.0
+    hi = 1.0
+    for _ in range(50):
+        mid = 0.5 * (lo + hi)
+        sm = (s0[0] + mid * (s1[0] - s0[0]), s0[1] + mid * (s1[1] - s0[1]),
+              s0[2] + mid * (s1[2] - s0[2]), s0[3] + mid * (s1[3] - s0[3]),
+              s0[4] + mid * (s1[4] - s0[4]), s0[5] + mid * (s1[5] - s0[5]))
+        if yield_function(sm, kappa, p) > 0.0:
+            hi = mid
+        else:
+            lo = mid
+    return 0.5 * (lo + hi)

@@ -1,0 +1,259 @@
+"""CSCM yield surface: shear surface, Rubin three-invariant factor, cap, invariants.
+
+All functions take ``J1`` compression positive (``J1 = -tr(sigma)``, see
+:func:`invariants`) in pascals and the packed parameters ``p``
+(:mod:`sphdyn.materials.cscm.layout`). Notes sec. 1.4-1.7.
+"""
+
+import math
+
+from numba import njit
+
+from ..base import ddot6
+from .layout import (P_A1, P_A2, P_ALPHA, P_B1, P_B2, P_BETA, P_D1, P_D2, P_J1APEX,
+                     P_KAPPA0, P_L1, P_L2, P_LAMDA, P_R, P_T1, P_T2, P_THETA, P_W,
+                     P_X0)
+
+
+@njit(cache=True, error_model="numpy")
+def shear_surface(J1, p):
+    """TXC shear failure surface ``Ff(J1) = alpha - lamda exp(-beta J1) + theta J1``.
+
+    Notes sec. 1.5 [R/S]; Murray 2007 ch. 2. Compared with ``sqrt(J2')``.
+
+    Parameters
+    ----------
+    J1 : float
+        First stress invariant, compression positive [Pa].
+    p : float64 array
+        Packed CSCM parameters (SI).
+
+    Returns
+    -------
+    float, [Pa].
+    """
+    return p[P_ALPHA] - p[P_LAMDA] * math.exp(-p[P_BETA] * J1) + p[P_THETA] * J1
+
+
+@njit(cache=True, error_model="numpy")
+def rubin_q(J1, p):
+    """Strength ratios ``Q1 = TOR/TXC`` and ``Q2 = TXE/TXC``.
+
+    ``Q_i = alpha_i - lamda_i exp(-beta_i J1) + theta_i J1`` for ``J1 >= 0``;
+    held at their ``J1 = 0`` values for tensile pressure (``J1 < 0``): the
+    clamp of notes sec. 1.6 [S] (1/sqrt(3), 1/2 with the defaults; holding the
+    J1 = 0 value keeps it continuous for user-given ratios: choice [D]).
+
+    Returns
+    -------
+    (Q1, Q2) : floats [-].
+    """
+    x = J1 if J1 > 0.0 else 0.0
+    q1 = p[P_A1] - p[P_L1] * math.exp(-p[P_B1] * x) + p[P_T1] * x
+    q2 = p[P_A2] - p[P_L2] * math.exp(-p[P_B2] * x) + p[P_T2] * x
+    return q1, q2
+
+
+@njit(cache=True, error_model="numpy")
+def rubin_factor(q1, q2, bhat):
+    """Rubin three-invariant reduction factor ``Rub(beta_hat)``.
+
+    .. math::
+        a_0 = 2Q_1^2(Q_2-1),\\ a_1 = \\sqrt3 Q_2 + 2Q_1(Q_2-1),\\ a_2 = Q_2,\\
+        a = \\frac{-a_1 + \\sqrt{a_1^2 - 4a_2a_0}}{2a_2}
+
+        b = (2Q_1 + a)^2 - 3,\\ b_0 = -(3 + b - a^2)/4,\\
+        b_1 = a(\\cos\\hat\\beta - a\\sin\\hat\\beta),\\
+        b_2 = (\\cos\\hat\\beta - a\\sin\\hat\\beta)^2 + b\\sin^2\\hat\\beta
+
+        \\Re = \\frac{-b_1 + \\sqrt{b_1^2 - 4b_2b_0}}{2b_2}
+
+    Notes sec. 1.6 [S]; Rubin (1991). ``Rub(pi/6) = 1`` (TXC),
+    ``Rub(0) = Q1`` (TOR), ``Rub(-pi/6) = Q2`` (TXE).
+
+    Parameters
+    ----------
+    q1, q2 : float
+        Strength ratios [-].
+    bhat : float
+        Lode angle in [-pi/6, pi/6] [rad] (see :func:`invariants`).
+    """
+    return _rubin_cs(q1, q2, math.cos(bhat), math.sin(bhat))
+
+
+@njit(cache=True, error_model="numpy")
+def _rubin_cs(q1, q2, cb, sb):
+    """:func:`rubin_factor` with ``cos(beta_hat)``, ``sin(beta_hat)`` given."""
+    a0 = 2.0 * q1 * q1 * (q2 - 1.0)
+    a1 = math.sqrt(3.0) * q2 + 2.0 * q1 * (q2 - 1.0)
+    a2 = q2
+    a = (-a1 + math.sqrt(max(a1 * a1 - 4.0 * a2 * a0, 0.0))) / (2.0 * a2)
+    b = (2.0 * q1 + a) ** 2 - 3.0
+    b0 = -(3.0 + b - a * a) / 4.0
+    cs = cb - a * sb
+    b1 = a * cs
+    b2 = cs * cs + b * sb * sb
+    return (-b1 + math.sqrt(max(b1 * b1 - 4.0 * b2 * b0, 0.0))) / (2.0 * b2)
+
+
+@njit(cache=True, error_model="numpy")
+def _j2_j3(dev):
+    """``J2' = dev:dev/2`` and ``J3' = det(dev)`` of a deviator 6-tuple."""
+    J3 = (dev[0] * (dev[1] * dev[2] - dev[4] * dev[4])
+          - dev[3] * (dev[3] * dev[2] - dev[4] * dev[5])
+          + dev[5] * (dev[3] * dev[4] - dev[1] * dev[5]))
+    return 0.5 * ddot6(dev, dev), J3
+
+
+@njit(cache=True, error_model="numpy")
+def invariants(s):
+    """Invariants of a tension-positive stress 6-tuple in CSCM convention.
+
+    ``J1 = -tr(sigma)`` (compression positive, = 3P, notes sec. 1.1 [S]),
+    ``J2' = s:s/2``, ``J3' = det(s)``, Lode angle
+    ``beta_hat = -(1/3) asin(3 sqrt(3)/2 J3'/J2'^(3/2))`` (= +pi/6 in TXC,
+    0 in TOR, -pi/6 in TXE, notes sec. 1.1 [D]).
+
+    Returns
+    -------
+    J1 [Pa], sqrt(J2') [Pa], beta_hat [rad], deviator (6-tuple) [Pa].
+    """
+    m = (s[0] + s[1] + s[2]) / 3.0
+    dev = (s[0] - m, s[1] - m, s[2] - m, s[3], s[4], s[5])
+    J2, J3 = _j2_j3(dev)
+    r = math.sqrt(J2)
+    if J2 <= 1e-200:
+        # J2'^(3/2) would underflow (a 1e-110 Pa deviator at first contact)
+        # and sqrt(J2') may be 0 for a non-zero deviator: the ratio is
+        # scale-free, so evaluate it on the deviator over its largest component
+        big = max(abs(dev[0]), abs(dev[1]), abs(dev[2]), abs(dev[3]), abs(dev[4]),
+                  abs(dev[5]))
+        if big == 0.0:
+            return -3.0 * m, 0.0, 0.0, dev
+        J2, J3 = _j2_j3((dev[0] / big, dev[1] / big, dev[2] / big, dev[3] / big,
+                         dev[4] / big, dev[5] / big))
+        r = big * math.sqrt(J2)
+    x = 1.5 * math.sqrt(3.0) * J3 / J2 ** 1.5
+    x = min(1.0, max(-1.0, x))
+    bhat = -math.asin(x) / 3.0
+    return -3.0 * m, r, bhat, dev
+
+
+@njit(cache=True, error_model="numpy")
+def cap_function(J1, kappa, p):
+    """Elliptical cap ``Fc(J1, kappa)`` and cap location ``X(kappa)``.
+
+    .. math::
+        F_c = 1 - \\frac{(J_1 - L)^2}{(X - L)^2}\\ (J_1 > L),\\quad
+        F_c = 1\\ (J_1 \\le L),\\quad L = \\max(\\kappa, \\kappa_0),\\quad
+        X = L + R\\,F_f(L)
+
+    Notes sec. 1.7 [R/S]. Returns ``(Fc, X)``; ``Fc`` clipped at 0.
+    """
+    L = kappa if kappa > p[P_KAPPA0] else p[P_KAPPA0]
+    X = L + p[P_R] * shear_surface(L, p)
+    if J1 <= L:
+        return 1.0, X
+    t = (J1 - L) / (X - L)
+    fc = 1.0 - t * t
+    return (fc if fc > 0.0 else 0.0), X
+
+
+@njit(cache=True, error_model="numpy")
+def cap_from_compaction(ev, p):
+    """Cap location ``X`` from the plastic volume compaction ``ev``.
+
+    Inverse of ``ev = W {1 - exp[-D1 (X - X0) - D2 (X - X0)^2]}``
+    (notes sec. 1.7 [R/S]):
+    ``X - X0 = [-D1 + sqrt(D1^2 - 4 D2 ln(1 - ev/W))]/(2 D2)``.
+    ``ev`` is clipped to ``[0, W (1 - 1e-12)]`` (lock-up at W).
+    """
+    if ev <= 0.0:
+        return p[P_X0]
+    W = p[P_W]
+    x = min(ev / W, 1.0 - 1e-12)
+    lg = -math.log(1.0 - x)
+    D1 = p[P_D1]
+    D2 = p[P_D2]
+    if D2 > 0.0:
+        y = (-D1 + math.sqrt(D1 * D1 + 4.0 * D2 * lg)) / (2.0 * D2)
+    else:
+        y = lg / D1
+    return p[P_X0] + y
+
+
+@njit(cache=True, error_model="numpy")
+def kappa_from_cap(X, kguess, p):
+    """Solve ``X = kappa + R Ff(kappa)`` for ``kappa`` (Newton, monotone).
+
+    Notes sec. 1.7. ``d/dkappa = 1 + R (lamda beta exp(-beta kappa) + theta) > 0``.
+    """
+    k = kguess
+    for _ in range(50):
+        g = k + p[P_R] * shear_surface(k, p) - X
+        dg = 1.0 + p[P_R] * (p[P_LAMDA] * p[P_BETA] * math.exp(-p[P_BETA] * k)
+                             + p[P_THETA])
+        dk = g / dg
+        k -= dk
+        if abs(dk) <= 1e-12 * (abs(X) + 1.0):
+            break
+    return k
+
+
+@njit(cache=True, error_model="numpy")
+def surface_radius(J1, bhat, kappa, p):
+    """``sqrt(J2')`` on the yield surface: ``Rub Ff sqrt(Fc)`` (0 outside
+    ``[J1_apex, X]``). Yield function ``f = J2' - Rub^2 Ff^2 Fc`` (notes
+    sec. 1.4 [S]; thesis eq. 5.1.1)."""
+    return meridian_radius(J1, meridian(bhat, kappa, p), p)
+
+
+@njit(cache=True, error_model="numpy")
+def meridian(bhat, kappa, p):
+    """Constants of the meridian ``F(J1)`` at fixed Lode angle and cap:
+    ``(cos beta_hat, sin beta_hat, L(kappa), X(kappa))`` (see
+    :func:`cap_function`), computed once per return instead of per point."""
+    L = kappa if kappa > p[P_KAPPA0] else p[P_KAPPA0]
+    return math.cos(bhat), math.sin(bhat), L, L + p[P_R] * shear_surface(L, p)
+
+
+@njit(cache=True, error_model="numpy")
+def meridian_radius(J1, m, p):
+    """:func:`surface_radius` with the meridian constants ``m`` of :func:`meridian`."""
+    cb, sb, L, X = m
+    if J1 <= p[P_J1APEX] or J1 >= X:
+        return 0.0
+    ff = shear_surface(J1, p)
+    if ff <= 0.0:
+        return 0.0
+    q1, q2 = rubin_q(J1, p)
+    r = _rubin_cs(q1, q2, cb, sb) * ff
+    if J1 <= L:
+        return r
+    t = (J1 - L) / (X - L)
+    return r * math.sqrt(max(1.0 - t * t, 0.0))
+
+
+@njit(cache=True, error_model="numpy")
+def yield_function(s, kappa, p):
+    """``f = J2' - Rub^2 Ff^2 Fc`` of a tension-positive stress 6-tuple [Pa^2].
+
+    Returns ``+inf``-like positive values outside ``[J1_apex, X]`` (no
+    admissible state there). Notes sec. 1.4.
+    """
+    J1, r, bhat, dev = invariants(s)
+    fc, X = cap_function(J1, kappa, p)
+    if J1 < p[P_J1APEX] or J1 > X:
+        return r * r + (J1 - min(max(J1, p[P_J1APEX]), X)) ** 2 + 1.0
+    F = surface_radius(J1, bhat, kappa, p)
+    return r * r - F * F
+
+
+@njit(cache=True, error_model="numpy")
+def j1_radius(s):
+    """``(J1, sqrt(J2'))`` of a stress 6-tuple (CSCM convention, see
+    :func:`invariants`), without the Lode angle."""
+    m = (s[0] + s[1] + s[2]) / 3.0
+    d0, d1, d2 = s[0] - m, s[1] - m, s[2] - m
+    J2 = 0.5 * (d0 * d0 + d1 * d1 + d2 * d2) + s[3] * s[3] + s[4] * s[4] + s[5] * s[5]
+    return -3.0 * m, math.sqrt(J2)

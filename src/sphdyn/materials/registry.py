@@ -1,0 +1,184 @@
+"""Registry of material models, built in or from other packages.
+
+A :class:`MaterialModel` bundles a model's group kernel, its parameter
+packing and its deck table (``schema``: a subclass of
+:class:`sphdyn.deck.sections.material.MaterialSection` whose ``model`` key is
+``Literal["<name>"]``, owning the model's keys, defaults and checks). The
+built-in models register when :mod:`sphdyn.materials` is imported; the deck
+offers the tables of every registered model (:func:`material_schemas`).
+
+Another package adds a model through an entry point in the group
+:data:`ENTRY_POINT_GROUP` (``sphdyn.materials``), e.g. in its
+``pyproject.toml``::
+
+    [project.entry-points."sphdyn.materials"]
+    toy = "toy_material:MODEL"
+
+The entry point names a :class:`MaterialModel`, or a callable returning one
+(or registering it and returning None). Entry points are loaded once, the
+first time the registry is asked for a model (:func:`get_model`,
+:func:`available_models`, :func:`material_schemas`); a failing one is
+skipped with a ``RuntimeWarning``.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+from importlib.metadata import entry_points
+from typing import Any, Callable, get_args
+
+import numpy as np
+
+# Common leading block of every parameter vector.
+P_DENSITY = 0
+P_K = 1
+P_G = 2
+N_COMMON = 3
+
+ENTRY_POINT_GROUP = "sphdyn.materials"
+
+
+@dataclass(frozen=True)
+class MaterialModel:
+    """A registered constitutive model.
+
+    Attributes
+    ----------
+    name : str
+        Registry key (e.g. ``"elastic"``, ``"j2"``).
+    history_names : tuple of str
+        Names of the model's history columns ``hist[:, 0:nh]``.
+    pack : callable
+        ``pack(values: dict) -> float64 array``; values in SI units. Raises
+        ``ValueError`` naming a missing or invalid key.
+    update : numba dispatcher
+        Group kernel with the common signature
+        (:data:`sphdyn.materials.base.KERNEL_SIGNATURE_DOC`).
+    history_init : callable or None
+        ``history_init(params) -> (nh,) array`` of initial history values;
+        ``None`` means all zeros.
+    schema : pydantic model class or None
+        The model's ``[[material]]`` table (keys, defaults, checks); None
+        for a model the deck does not offer (e.g. one used only by the
+        material driver).
+    """
+
+    name: str
+    history_names: tuple[str, ...]
+    pack: Callable[[dict], np.ndarray]
+    update: Callable
+    history_init: Callable[[np.ndarray], np.ndarray] | None = None
+    schema: Any = None
+
+    @property
+    def n_history(self) -> int:
+        """Number of history columns the model uses."""
+        return len(self.history_names)
+
+    def initial_history(self, params: np.ndarray) -> np.ndarray:
+        """Initial history values, shape ``(nh,)``."""
+        if self.history_init is None:
+            return np.zeros(self.n_history)
+        return np.asarray(self.history_init(params), dtype=np.float64)
+
+    @staticmethod
+    def density(params: np.ndarray) -> float:
+        """Reference density [kg/m^3] stored in the parameter vector."""
+        return float(params[P_DENSITY])
+
+    @staticmethod
+    def bulk_modulus(params: np.ndarray) -> float:
+        """Elastic bulk modulus K [Pa]."""
+        return float(params[P_K])
+
+    @staticmethod
+    def shear_modulus(params: np.ndarray) -> float:
+        """Elastic shear modulus G [Pa]."""
+        return float(params[P_G])
+
+    @staticmethod
+    def wave_speed(params: np.ndarray, rho: float) -> float:
+        """Longitudinal (P-wave) speed ``c = sqrt((K + 4G/3) / rho)`` [m/s].
+
+        Parameters
+        ----------
+        params : float64 array
+            Packed parameters.
+        rho : float
+            Density [kg/m^3], > 0.
+        """
+        return math.sqrt((params[P_K] + 4.0 * params[P_G] / 3.0) / rho)
+
+
+REGISTRY: dict[str, MaterialModel] = {}
+
+#: True once the entry points of :data:`ENTRY_POINT_GROUP` have been loaded;
+#: set it back to False to load them again (tests).
+entry_points_loaded = False
+
+
+def register(model: MaterialModel, *, replace: bool = False) -> MaterialModel:
+    """Add ``model`` to :data:`REGISTRY` under ``model.name``.
+
+    Raises ``ValueError`` if the name is taken and ``replace`` is false, or
+    if the model's schema does not have ``model: Literal[<name>]``.
+    """
+    if model.name in REGISTRY and not replace:
+        raise ValueError(f"material model {model.name!r} is already registered")
+    if model.schema is not None:
+        info = model.schema.model_fields.get("model")
+        if info is None or get_args(info.annotation) != (model.name,):
+            raise ValueError(f"the schema {model.schema.__name__} of material model "
+                             f"{model.name!r} needs model: Literal[{model.name!r}]")
+    REGISTRY[model.name] = model
+    return model
+
+
+def load_entry_points() -> None:
+    """Register the models of the ``sphdyn.materials`` entry points (once)."""
+    global entry_points_loaded
+    if entry_points_loaded:
+        return
+    entry_points_loaded = True
+    for ep in entry_points(group=ENTRY_POINT_GROUP):
+        try:
+            found = ep.load()
+            model = found if isinstance(found, MaterialModel) else found()
+            if isinstance(model, MaterialModel) and REGISTRY.get(model.name) is not model:
+                register(model)
+        except Exception as exc:  # a broken plugin must not stop every deck
+            warnings.warn(f"material entry point {ep.name!r} ({ep.value}) was "
+                          f"skipped: {exc}", RuntimeWarning, stacklevel=2)
+
+
+def available_models() -> tuple[str, ...]:
+    """Sorted names of the registered models."""
+    load_entry_points()
+    return tuple(sorted(REGISTRY))
+
+
+def get_model(name: str) -> MaterialModel:
+    """Registered model by name; ``KeyError`` listing the known names otherwise."""
+    load_entry_points()
+    try:
+        return REGISTRY[name]
+    except KeyError:
+        raise KeyError(
+            f"unknown material model {name!r}; registered models: "
+            f"{', '.join(available_models()) or '(none)'}"
+        ) from None
+
+
+def material_schemas() -> tuple[type, ...]:
+    """The deck tables of the registered models, in registration order."""
+    load_entry_points()
+    return tuple(m.schema for m in REGISTRY.values() if m.schema is not None)
+
+
+def schema_defaults(schema) -> dict[str, Any]:
+    """``{key: default}`` of the keys of ``schema`` with a default other than None."""
+    return {k: f.default for k, f in schema.model_fields.items()
+            if not f.is_required() and f.default_factory is None
+            and f.default is not None}
