@@ -51,7 +51,7 @@ def main():
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--threads", type=int, default=2)
     a = ap.parse_args()
-    print(f"| case | old particle-steps/s | new particle-steps/s | new / old |")
+    print("| case | old particle-steps/s | new particle-steps/s | new / old |")
     print("|---|---|---|---|")
     for name, args in CASES:
         for src in (a.old, a.new):  # compile / fill the Numba caches first

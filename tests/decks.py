@@ -38,3 +38,37 @@ progress = false
 vtk = false
 fields = [{field_list}]
 """
+
+
+#: A rubber-like J2 disc (2D, dx = 1 mm, 316 particles) dropped on a floor at
+#: 5 m/s; format keys ``t_end`` and ``ck`` (checkpoint_every).
+SMALL_DISC = """
+[run]
+title = "small disc on a wall"
+dimension = 2
+t_end = "{t_end}"
+[[material]]
+name = "rubber"
+model = "j2"
+density = 1000.0
+E = 1e7
+nu = 0.3
+yield_stress = 2e5
+hardening_modulus = 1e6
+[[body]]
+name = "disc"
+material = "rubber"
+dx = 1e-3
+velocity = [0, -5.0, 0]
+geometry = {{ shape = "cylinder", centre = [0, 0.0062, 0], radius = 0.006 }}
+[[wall]]
+name = "floor"
+point = [0, 0, 0]
+normal = [0, 1, 0]
+[output]
+every = "0.5 ms"
+history_every = 2
+checkpoint_every = {ck}
+progress = false
+fields = ["velocity", "stress", "von_mises", "plastic_strain", "damage"]
+"""

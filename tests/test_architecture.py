@@ -12,38 +12,9 @@ from sphdyn.io import read_checkpoint, read_frame, read_history_csv
 from sphdyn.simulation import Simulation
 from sphdyn.state import STATE, WORK, ArrayStore, Kinematics
 from sphdyn.stepper import Stepper
+from decks import SMALL_DISC
 from stepping import build_stepper
 
-DECK = """
-[run]
-title = "small disc on a wall"
-dimension = 2
-t_end = "{t_end}"
-[[material]]
-name = "rubber"
-model = "j2"
-density = 1000.0
-E = 1e7
-nu = 0.3
-yield_stress = 2e5
-hardening_modulus = 1e6
-[[body]]
-name = "disc"
-material = "rubber"
-dx = 1e-3
-velocity = [0, -5.0, 0]
-geometry = {{ shape = "cylinder", centre = [0, 0.0062, 0], radius = 0.006 }}
-[[wall]]
-name = "floor"
-point = [0, 0, 0]
-normal = [0, 1, 0]
-[output]
-every = "0.5 ms"
-history_every = 2
-checkpoint_every = {ck}
-progress = false
-fields = ["velocity", "stress", "von_mises", "plastic_strain", "damage"]
-"""
 
 T_INJECT = 1.0e-3
 
@@ -56,14 +27,14 @@ def _inject():
 
 
 def _deck(t_end="2 ms", ck=0):
-    return loads_deck(DECK.format(t_end=t_end, ck=ck))
+    return loads_deck(SMALL_DISC.format(t_end=t_end, ck=ck))
 
 
 # ------------------------------------------------------------------ the store
 def test_store_grows_every_array_and_keeps_the_data():
     s = ArrayStore(3)
     a = s.add("a", (3,), kind=STATE)
-    b = s.add("b", (), np.int8, fill=7)
+    s.add("b", (), np.int8, fill=7)
     a[:] = np.arange(9.0).reshape(3, 3)
     seen = []
     s.on_grow(lambda n0, n1: seen.append((n0, n1)))
@@ -124,6 +95,24 @@ def test_injected_particles_join_every_array_group_list_and_frame(tmp_path):
     assert f_first["position"].shape[0] == n0 and f_last["position"].shape[0] == n0 + 5
     h = read_history_csv(tmp_path / "run/history.csv")
     assert h["time"][-1] == pytest.approx(2e-3) and np.isfinite(h["E_total"]).all()
+
+
+def test_injected_particles_in_a_total_lagrangian_body_get_their_reference(tmp_path):
+    # The new particles join the reference lists at their birth positions;
+    # the old particles keep the reference they had (here the initial one).
+    text = SMALL_DISC.format(t_end="1.5 ms", ck=0).replace(
+        "[output]", '[sph]\nformulation = "total_lagrangian"\n[output]')
+    sim = Simulation.from_deck(loads_deck(text), tmp_path / "tl", events=[_inject()])
+    p = sim.particles
+    n0, x_ref0 = p.n, p.x0.copy()
+    sim.run()
+    tl = sim.stepper.part("sph").tl
+    new = np.arange(n0, n0 + 5)
+    assert np.array_equal(tl.rows, np.arange(n0 + 5))
+    assert np.array_equal(tl.X[new], _inject().positions)
+    assert np.array_equal(tl.X[:n0], x_ref0)
+    assert np.diff(tl.offsets)[new].min() > 0  # they have reference neighbours
+    assert np.isfinite(p.x).all() and np.abs(p.sig[new]).max() > 0.0
 
 
 @pytest.mark.parametrize("stop_after", [100, 400], ids=["before_event", "after_event"])
@@ -252,3 +241,24 @@ def test_another_part_leaves_the_sph_part_bitwise_unchanged():
         both.step()
     for name, arr in alone.particles.arrays().items():
         assert np.array_equal(arr, getattr(both.particles, name)), name
+
+
+def test_the_step_is_the_smallest_of_parts_interactions_and_dt_max():
+    # A bulk-modulus wall (paper eq. 9) limits the step to half its spring's
+    # 2 sqrt(m/k): in 2D k = alpha K (A/L = 1 per unit depth) and the nominal
+    # inertia is rho0 dx^2, so stable_dt = sqrt(rho0 dx^2 / (alpha K)) with
+    # K = E / (3 (1 - 2 nu)) of the rubber. A mass-based wall (eq. 8) has none.
+    text = SMALL_DISC.format(t_end="1 ms", ck=0).replace(
+        'normal = [0, 1, 0]', 'normal = [0, 1, 0]\nstiffness = "bulk"')
+    deck = loads_deck(text)
+    s = build_stepper(deck)
+    w = s.interactions[0]
+    K = 1e7 / (3.0 * (1.0 - 2 * 0.3))
+    expected = np.sqrt(1000.0 * 1e-6 / (deck.wall[0].alpha * K))
+    assert w.stable_dt() == pytest.approx(expected, rel=1e-12)
+    part_dt = s.part("sph").stable_dt()[0]
+    assert s.stable_dt()[0] == pytest.approx(min(part_dt, expected), rel=1e-12)
+    s.dt_max = 0.5 * min(part_dt, w.stable_dt())
+    assert s.stable_dt()[0] == s.dt_max
+    mass = build_stepper(_deck())
+    assert mass.interactions[0].stable_dt() == np.inf

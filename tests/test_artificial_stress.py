@@ -7,7 +7,7 @@ from sphdyn import kernels
 from sphdyn.deck import DeckError, loads_deck
 from sphdyn.geometry import box_lattice
 from sphdyn.neighbours import build_neighbours
-from stepping import build_stepper, step
+from stepping import build_stepper
 from sphdyn.parts.sph.artificial_stress import artificial_stress_forces, artificial_stress_tensor
 from sphdyn.parts.sph.passes import particle_volumes, velocity_gradient
 

@@ -294,4 +294,4 @@ def test_kernel_context_holds_the_kernel_as_one_thing():
     assert k.sigma == K.normalisation(k.kid, 3)  # its value is tested above
     assert k.radius_factor == 3.0 and k.support_scale == 1.5
     with pytest.raises(ValueError, match="unknown kernel"):
-        K.KernelContext.named("bogus", 3)
+        K.KernelContext.named("bogus", 3, 1.0)

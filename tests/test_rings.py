@@ -23,7 +23,7 @@ import pytest
 from sphdyn.analysis import count_fragments, fragment_labels, fragment_sizes
 from sphdyn.deck import loads_deck
 from sphdyn.geometry import box_lattice
-from stepping import build_stepper, step
+from stepping import build_stepper
 
 DX = 1.5e-3
 V0 = 7.52  # impact speed of each ring [m/s] (Gray et al.'s 0.059 c0)

@@ -13,41 +13,12 @@ from sphdyn.deck import loads_deck
 from sphdyn.guards import SimulationFailed
 from sphdyn.io import read_checkpoint, read_frame, read_history_csv, read_pvd
 from sphdyn.simulation import Simulation
+from decks import SMALL_DISC
 
-SMALL = """
-[run]
-title = "small disc on a wall"
-dimension = 2
-t_end = "{t_end}"
-[[material]]
-name = "rubber"
-model = "j2"
-density = 1000.0
-E = 1e7
-nu = 0.3
-yield_stress = 2e5
-hardening_modulus = 1e6
-[[body]]
-name = "disc"
-material = "rubber"
-dx = 1e-3
-velocity = [0, -5.0, 0]
-geometry = {{ shape = "cylinder", centre = [0, 0.0062, 0], radius = 0.006 }}
-[[wall]]
-name = "floor"
-point = [0, 0, 0]
-normal = [0, 1, 0]
-[output]
-every = "0.5 ms"
-history_every = 2
-checkpoint_every = {ck}
-progress = false
-fields = ["velocity", "stress", "von_mises", "plastic_strain", "damage"]
-"""
 
 
 def _sim(tmp_path, name, t_end="3 ms", ck=0, **extra):
-    text = SMALL.format(t_end=t_end, ck=ck)
+    text = SMALL_DISC.format(t_end=t_end, ck=ck)
     for key, val in extra.items():
         text = text.replace(key, val)
     return Simulation.from_deck(loads_deck(text), tmp_path / name)
@@ -157,7 +128,7 @@ def test_time_step_collapse_is_caught(tmp_path):
 
 def test_cli_check_run_export_plot_info(tmp_path, capsys):
     deck = tmp_path / "small.toml"
-    deck.write_text(SMALL.format(t_end="1 ms", ck=0))
+    deck.write_text(SMALL_DISC.format(t_end="1 ms", ck=0))
     assert main(["check", str(deck)]) == 0
     assert "OK" in capsys.readouterr().out
     out = tmp_path / "cli"
@@ -174,7 +145,7 @@ def test_cli_check_run_export_plot_info(tmp_path, capsys):
 
 def test_cli_rejects_a_bad_deck_before_running(tmp_path, capsys):
     deck = tmp_path / "bad.toml"
-    deck.write_text(SMALL.format(t_end="1 ms", ck=0).replace("dx = 1e-3", "dx = '3 MPa'")
+    deck.write_text(SMALL_DISC.format(t_end="1 ms", ck=0).replace("dx = 1e-3", "dx = '3 MPa'")
                     .replace("nu = 0.3", "nu = 0.7\ncolour = 'red'"))
     assert main(["run", str(deck), "--out", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err
@@ -206,7 +177,7 @@ def test_probes_record_set_histories(tmp_path):
     # A probe on the whole disc records the mean velocity, which before the
     # impact equals the initial -5 m/s exactly, and the max plastic strain,
     # which grows once the contact zone yields.
-    text = SMALL.format(t_end="3 ms", ck=0) + """
+    text = SMALL_DISC.format(t_end="3 ms", ck=0) + """
 [[set]]
 name = "all"
 [[probe]]
@@ -224,7 +195,7 @@ reduce = "max"
 
 
 def test_probe_of_a_missing_history_variable_is_rejected_before_running(tmp_path):
-    text = SMALL.format(t_end="1 ms", ck=0).replace('model = "j2"', 'model = "elastic"')
+    text = SMALL_DISC.format(t_end="1 ms", ck=0).replace('model = "j2"', 'model = "elastic"')
     text = text.replace("yield_stress = 2e5\nhardening_modulus = 1e6\n", "")
     text += '[[set]]\nname = "all"\n[[probe]]\nset = "all"\nquantities = ["plastic_strain"]\n'
     deck = tmp_path / "d.toml"

@@ -8,7 +8,7 @@ from sphdyn.deck import loads_deck
 from sphdyn.geometry import box_lattice
 from sphdyn.io import particle_fields
 from sphdyn.neighbours import build_neighbours
-from stepping import build_stepper, step
+from stepping import build_stepper
 from sphdyn.parts.sph.swegle import (FLAG_FRACTION, REL_STRESS_TOL, count_unstable, stress_scale,
                                swegle_indicator)
 

@@ -28,7 +28,7 @@ def _solver(text):
 def _run_until(solver, t_end, probe=None):
     out = []
     while solver.t < t_end:
-        rec = step(solver)
+        solver.step()
         if probe is not None:
             out.append((solver.t, probe(solver)))
     return out

@@ -33,14 +33,12 @@ def sph_settings(deck) -> SPHSettings:
         hourglass=sph.hourglass, reference_update_every=sph.reference_update_every)
 
 
-def contact_on(deck) -> bool:
+def contact_on(deck, settings: SPHSettings) -> bool:
     """``[contact] enabled``, by default on with two or more bodies of which one
     is total-Lagrangian (their kernels never see the other bodies)."""
-    c = deck.contact
-    if c.enabled is not None:
-        return bool(c.enabled)
-    tl = sph_settings(deck).total_lagrangian
-    return len(deck.body) >= 2 and any(tl)
+    if deck.contact.enabled is not None:
+        return bool(deck.contact.enabled)
+    return len(deck.body) >= 2 and any(settings.total_lagrangian)
 
 
 def build_stepper(deck, model: Model | None = None, events=(), monitors=()) -> Stepper:
@@ -48,14 +46,13 @@ def build_stepper(deck, model: Model | None = None, events=(), monitors=()) -> S
     model = build_model(deck) if model is None else model
     p = model.particles
     kernel = KernelContext.named(deck.sph.kernel, p.dim, deck.sph.support_scale)
-    part = SPHPart(p, model.groups, kernel, sph_settings(deck), phase=model.phase,
+    settings = sph_settings(deck)
+    part = SPHPart(p, model.groups, kernel, settings, phase=model.phase,
                    variation=model.variation)
     interactions = []
-    if contact_on(deck) and p.n:
+    if contact_on(deck, settings) and p.n:
         interactions.append(ParticleContact(part, deck.contact.alpha,
                                             deck.contact.distance_factor))
     interactions += [Wall(spec, part) for spec in model.walls]
     dt_max = deck.time.dt_max if deck.time.dt_max is not None else np.inf
-    stepper = Stepper([part], interactions, events, monitors, dt_max=dt_max)
-    stepper.model = model
-    return stepper
+    return Stepper([part], interactions, events, monitors, dt_max=dt_max)

@@ -5,8 +5,8 @@ Each :class:`OutputField` has a name, a shape per particle (``scalar``,
 ``history``, a column of the material history), a unit, a one-line
 description and a getter ``getter(p, computed) -> ndarray``: ``p`` is the
 :class:`~sphdyn.state.Particles` state and ``computed`` maps names to
-zero-argument callables for fields the solver evaluates itself (e.g.
-``"swegle"``, ``"phase"``, ``"variation"``; ``Solver.output_fields()``).
+zero-argument callables for fields a part evaluates itself (e.g.
+``"swegle"``, ``"phase"``, ``"variation"``; ``SPHPart.fields()``).
 Getters return fresh arrays for all particles, so the state can keep
 evolving.
 
@@ -152,8 +152,8 @@ def _array(attr: str) -> Getter:
     return lambda p, computed: getattr(p, attr).copy()
 
 
-def _solver_or(name: str, fallback: Callable[[Any], np.ndarray]) -> Getter:
-    """Getter of a field the solver computes (``computed[name]``), else ``fallback(p)``."""
+def _computed_or(name: str, fallback: Callable[[Any], np.ndarray]) -> Getter:
+    """Getter of a field a part computes (``computed[name]``), else ``fallback(p)``."""
     def get(p, computed):
         if name in computed:
             return np.array(computed[name](), copy=True)
@@ -195,15 +195,15 @@ _BUILT_IN = (
     OutputField("material", "scalar", "-", "Material index (int32).", _array("mat")),
     OutputField("swegle", "scalar", "-", "Swegle tensile-instability indicator: "
                 "fraction of neighbour pairs with W''(r) sigma_n > 0 (tension "
-                "positive), in [0, 1]; NaN without a solver; see "
+                "positive), in [0, 1]; NaN without a part to compute it; see "
                 "docs/tensile-instability.md.",
-                _solver_or("swegle", lambda p: np.full(p.n, np.nan))),
+                _computed_or("swegle", lambda p: np.full(p.n, np.nan))),
     OutputField("phase", "scalar", "-", "Mesostructure phase (int8): 0 mortar, 1 "
                 "aggregate, 2 ITZ, -1 for bodies without [body.mesostructure].",
-                _solver_or("phase", lambda p: np.full(p.n, -1, np.int8))),
+                _computed_or("phase", lambda p: np.full(p.n, -1, np.int8))),
     OutputField("variation", "scalar", "-", "Factor of the [material.variation] "
                 "parameter (1 for materials without variation).",
-                _solver_or("variation", lambda p: np.ones(p.n))),
+                _computed_or("variation", lambda p: np.ones(p.n))),
 )
 
 for _field in _BUILT_IN:

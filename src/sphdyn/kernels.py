@@ -541,7 +541,7 @@ class KernelContext:
 
     kid: int
     dim: int
-    support_scale: float = 1.0
+    support_scale: float
     sigma: float = field(init=False)
     radius_factor: float = field(init=False)
 
@@ -550,6 +550,6 @@ class KernelContext:
         object.__setattr__(self, "radius_factor", support(self.kid) * self.support_scale)
 
     @classmethod
-    def named(cls, name: str, dim: int, support_scale: float = 1.0) -> "KernelContext":
+    def named(cls, name: str, dim: int, support_scale: float) -> "KernelContext":
         """The context of the kernel called ``name`` (see :data:`KERNEL_IDS`)."""
         return cls(kernel_id(name), dim, float(support_scale))

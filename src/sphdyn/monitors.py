@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from .guards import check_particles, check_time_step
 from .probes import record as probe_record
 
@@ -20,8 +22,10 @@ class Guards:
     """Stop the run with a diagnosis: time-step collapse, NaN, particles leaving
     the domain box ``[lo, hi]`` (see :mod:`sphdyn.guards`)."""
 
-    def __init__(self, lo, hi, collapse_ratio: float):
+    def __init__(self, lo, hi, collapse_ratio: float, parts):
         self.lo, self.hi, self.collapse_ratio = lo, hi, collapse_ratio
+        for part in parts:  # (N,) int8 scratch of the particle check, grows with them
+            part.kin.add("guard_work", (), np.int8)
 
     def before_step(self, s, dt, k, part) -> None:
         check_time_step(dt, s.dt0, self.collapse_ratio, s.t, s.step_count, k, part.kin)
@@ -29,8 +33,7 @@ class Guards:
     def after_step(self, s) -> None:
         for part in s.parts:
             q = part.kin
-            check_particles(q, self.lo, self.hi, s.t, s.step_count,
-                            q.add("guard_work", (), "int8"))
+            check_particles(q, self.lo, self.hi, s.t, s.step_count, q.guard_work)
 
 
 class HistoryRecorder:

@@ -30,6 +30,7 @@ from .io import (FrameWriter, History, atomic_write_text, particle_fields,
 from .analysis import window_mean_force
 from .io.plots import energy_columns, relative_drift
 from .assembly import build_stepper
+from .model import Model, build_model
 from .monitors import Checkpoints, FrameOutput, Guards, HistoryRecorder, Progress
 from .neighbours import max_neighbours, mean_neighbours
 from .stepper import Stepper
@@ -47,12 +48,12 @@ class Simulation:
     checkpoints.
     """
 
-    def __init__(self, deck, outdir: Path, stepper: Stepper, history: History,
-                 frames: FrameWriter, next_frame: float):
+    def __init__(self, deck, outdir: Path, model: Model, stepper: Stepper,
+                 history: History, frames: FrameWriter, next_frame: float):
         self.deck = deck
         self.outdir = Path(outdir)
+        self.model = model
         self.stepper = stepper
-        self.model = stepper.model
         self.history = history
         self.frames = frames
         out = deck.output
@@ -62,7 +63,7 @@ class Simulation:
                                   deck.run.t_end)
         self.recorder = HistoryRecorder(history, out.history_every, self.model.probes)
         for monitor in (Guards(self.model.domain_lo, self.model.domain_hi,
-                               deck.time.collapse_ratio),
+                               deck.time.collapse_ratio, stepper.parts),
                         self.recorder, self.output,
                         Checkpoints(self._checkpoint, out.checkpoint_every)):
             stepper.add_monitor(monitor)
@@ -79,9 +80,10 @@ class Simulation:
         outdir = Path(outdir)
         outdir.mkdir(parents=True, exist_ok=True)
         dump_resolved(deck, outdir / RESOLVED)
-        stepper = build_stepper(deck, events=events)
-        return cls(deck, outdir, stepper, History(), FrameWriter(outdir, vtk=deck.output.vtk),
-                   next_frame=0.0)
+        model = build_model(deck)
+        stepper = build_stepper(deck, model, events=events)
+        return cls(deck, outdir, model, stepper, History(),
+                   FrameWriter(outdir, vtk=deck.output.vtk), next_frame=0.0)
 
     @classmethod
     def from_directory(cls, outdir, events=()) -> "Simulation":
@@ -95,14 +97,15 @@ class Simulation:
                                     "interrupted run")
         deck = load_deck(outdir / RESOLVED)
         _, scalars, groups = read_checkpoint(ck)
-        stepper = build_stepper(deck, events=events)
+        model = build_model(deck)
+        stepper = build_stepper(deck, model, events=events)
         stepper.restore(scalars, groups)
         t = stepper.t
         hist_path = outdir / "history.csv"
         history = History.from_csv(hist_path) if hist_path.exists() else History()
         history.truncate_after(np.nextafter(t, -np.inf))  # the next step records t
         frames = FrameWriter(outdir, vtk=deck.output.vtk, start_after=t)
-        return cls(deck, outdir, stepper, history, frames,
+        return cls(deck, outdir, model, stepper, history, frames,
                    next_frame=float(scalars["next_frame"]))
 
     # ------------------------------------------------------------------- run

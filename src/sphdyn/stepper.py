@@ -210,6 +210,10 @@ class Stepper:
         size first (the listeners run after the arrays are restored).
         """
         for part in self.parts:
+            if f"kin.{part.name}" not in groups:
+                raise ValueError(f"the checkpoint has no part {part.name!r}: it was written "
+                                 "by another deck or an sphdyn before parts existed "
+                                 "(2026-11-23); run the deck again")
             arrays = groups[f"kin.{part.name}"]
             q = part.kin
             n_old, n_new = q.n, arrays["x"].shape[0]
@@ -219,9 +223,7 @@ class Stepper:
             if n_new > n_old:
                 q.grow(n_new - n_old, notify=False)
             for name, arr in arrays.items():
-                if name == "hist" and arr.shape[1] != q.hist.shape[1]:
-                    raise ValueError("checkpoint history width differs from the model's")
-                setattr(q, name, arr)
+                setattr(q, name, arr)  # a shape that does not fit raises
             if n_new > n_old:
                 q.notify_grown(n_old, n_new)
         self.t = float(scalars["t"])
@@ -229,7 +231,7 @@ class Stepper:
         self.dt_prev = float(scalars["dt_prev"])
         self.dt0 = float(scalars["dt0"])
         self.dt_contact_step = float(scalars["dt_contact_step"])
-        self.dt_step = float(scalars.get("dt_step", self.dt_prev))
+        self.dt_step = float(scalars["dt_step"])
         self.work_contact = float(scalars["work_contact"])
         self.work_external = float(scalars["work_external"])
         for kind, items in (("part", self.parts), ("interaction", self.interactions)):

@@ -12,12 +12,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..fields import FIELDS, history_column, pressure, von_mises
+from ..fields import FIELDS, history_column
 
 if TYPE_CHECKING:
     from sphdyn.state import Particles
 
-__all__ = ["particle_fields", "pressure", "von_mises"]
+__all__ = ["particle_fields"]
 
 
 def particle_fields(p: "Particles", names: list[str],
@@ -34,8 +34,8 @@ def particle_fields(p: "Particles", names: list[str],
         over history names; a registered history field (``plastic_strain``)
         needs its column in ``p.hist_names``. Duplicates are ignored.
     computed : mapping of str to callable, optional
-        Fields the solver evaluates on demand (``Solver.output_fields()``,
-        e.g. ``"swegle"``); each callable returns an (N,) array.
+        Fields a part evaluates on demand (``SPHPart.fields()``, e.g.
+        ``"swegle"``); each callable returns an (N,) array.
 
     Returns
     -------

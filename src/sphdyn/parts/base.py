@@ -29,6 +29,7 @@ from ..state import Kinematics
 
 class Part(Protocol):
     name: str
+    kind: str  # set by register_part
     kin: Kinematics
 
     def stable_dt(self) -> tuple[float, int]: ...

@@ -110,7 +110,8 @@ class ArrayStore:
     def grow(self, k: int, notify: bool = True) -> slice:
         """Add ``k`` rows to every array; returns the slice of the new rows.
 
-        New rows hold each array's fill value. The views are replaced (old
+        New rows hold each array's fill value (rows beyond ``n`` are never
+        written: they keep the value they were allocated with). The views are replaced (old
         views still point at the old rows); listeners are then called, unless
         ``notify`` is False: the caller fills the new rows first and then
         calls :meth:`notify_grown`.
@@ -120,8 +121,6 @@ class ArrayStore:
         n_old, n_new = self._n, self._n + int(k)
         if n_new > self.capacity:
             self._reallocate(max(n_new, int(1.5 * self.capacity) + 1))
-        for name, full in self._full.items():  # rows freed by an earlier shrink
-            full[n_old:n_new] = self._fill[name]
         object.__setattr__(self, "_n", n_new)
         self._refresh_views()
         if notify:

@@ -47,25 +47,26 @@ from .tl_scheme import TotalLagrangian
 
 @dataclass(frozen=True)
 class SPHSettings:
-    """The SPH scheme's settings, resolved from the deck by :mod:`sphdyn.assembly`.
+    """The SPH scheme's settings, resolved from the deck by :mod:`sphdyn.assembly`
+    (the defaults are the deck's, written there once).
 
     Per-body tuples are indexed by ``particles.body``.
     """
 
-    correction: bool = False  # Randles-Libersky gradient correction
-    alpha: float = 1.0  # artificial viscosity (Monaghan 1992)
-    beta: float = 2.0
-    xsph: float = 0.0  # XSPH epsilon (0: off)
-    benz: bool = True  # smoothing length from the density (else constant)
-    h_min_factor: float = 0.0  # h bounds in units of h0
-    h_max_factor: float = np.inf
-    skin_factor: float = 0.1  # Verlet skin in units of the support radius
-    cfl: float = 0.3
-    stress_exponent: float = 4.0  # artificial stress n (Monaghan 2000)
-    epsilon: tuple = (0.0,)  # artificial stress epsilon per body
-    total_lagrangian: tuple = (False,)  # per body
-    hourglass: float = 0.0  # total-Lagrangian hourglass coefficient
-    reference_update_every: int = 0  # total-Lagrangian reference update (0: never)
+    correction: bool  # Randles-Libersky gradient correction
+    alpha: float  # artificial viscosity (Monaghan 1992)
+    beta: float
+    xsph: float  # XSPH epsilon (0: off)
+    benz: bool  # smoothing length from the density (else constant)
+    h_min_factor: float  # h bounds in units of h0
+    h_max_factor: float
+    skin_factor: float  # Verlet skin in units of the support radius
+    cfl: float
+    stress_exponent: float  # artificial stress n (Monaghan 2000)
+    epsilon: tuple  # artificial stress epsilon per body
+    total_lagrangian: tuple  # per body
+    hourglass: float  # total-Lagrangian hourglass coefficient
+    reference_update_every: int  # total-Lagrangian reference update (0: never)
 
 
 @register_part("sph")
@@ -79,7 +80,8 @@ class SPHPart:
     kernel : the kernel context.
     settings : the scheme's settings.
     phase, variation : (N,) mesostructure phase (int8, -1 outside one) and
-        material variation factor, or None; kept as output fields.
+        material variation factor (1 without variation), or None for those
+        values; kept as output fields.
     """
 
     name = "sph"
@@ -91,7 +93,6 @@ class SPHPart:
         self.kernel = kernel
         self.s = settings
         self.dim = p.dim
-        self.has_phase, self.has_variation = phase is not None, variation is not None
         p.add("phase", (), np.int8, fill=-1)
         p.add("variation", (), np.float64, fill=1.0)
         if phase is not None:
@@ -147,7 +148,8 @@ class SPHPart:
         """Particles ``n_old:n_new`` were added: groups, derived data, neighbours.
 
         New particles join the first group of their material (``mat``) and,
-        in total-Lagrangian bodies, take their current position as reference.
+        in total-Lagrangian bodies, take their birth configuration (``x0``,
+        ``rho0``) as reference; the others keep theirs.
         Their accelerations are zero until the next step computes them.
         """
         p = self.p
@@ -161,16 +163,14 @@ class SPHPart:
         self._derive(n_old, n_new)
         self.nl = build_neighbours(p.x, p.h, self.kernel.radius_factor, self.skin,
                                    self.dim, active=self.ul_active)
-        if self.tl is not None or p.tl.any():
-            X = p.x.copy() if self.tl is None else np.concatenate([self.tl.X, p.x[n_old:]])
-            rho_ref = p.rho.copy() if self.tl is None else np.concatenate(
-                [self.tl.rho_ref, p.rho[n_old:]])
-            if self.tl is None:
-                self.tl = TotalLagrangian(p, np.flatnonzero(p.tl), self.kernel, p.young,
-                                          self.s.hourglass, self.s.alpha, self.s.beta)
+        if self.tl is None and p.tl.any():  # the first total-Lagrangian particles
+            self.tl = TotalLagrangian(p, np.flatnonzero(p.tl), self.kernel, p.young,
+                                      self.s.hourglass, self.s.alpha, self.s.beta)
+        elif self.tl is not None:
             self.tl.rows = np.flatnonzero(p.tl).astype(np.int64)
             self.tl.young = p.young
-            self.tl.rebuild(p, X, rho_ref)
+            self.tl.rebuild(p, np.concatenate([self.tl.X, p.x0[n_old:]]),
+                            np.concatenate([self.tl.rho_ref, p.rho0[n_old:]]))
         self._swegle_at = None
 
     # ----------------------------------------------------------- protocol
@@ -226,12 +226,9 @@ class SPHPart:
 
     def fields(self) -> dict:
         """Output fields the part evaluates on demand (for ``particle_fields``)."""
-        out = {"swegle": self.swegle_field}
-        if self.has_phase:
-            out["phase"] = lambda: self.p.phase
-        if self.has_variation:
-            out["variation"] = lambda: self.p.variation
-        return out
+        p = self.p
+        return {"swegle": self.swegle_field, "phase": lambda: p.phase,
+                "variation": lambda: p.variation}
 
     def state(self) -> tuple[dict, dict[str, np.ndarray]]:
         p = self.p
