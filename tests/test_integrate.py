@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from sphdyn.integrate import cfl_time_step, drift, kick
+from sphdyn.integrate import cfl_time_step, drift, kick, kick_scratch
 from sphdyn.state import BC_FIXED, BC_VELOCITY
 
 
@@ -17,10 +17,10 @@ def _oscillator(dt, t_end, omega=2.0):
     vm = np.zeros((1, 3))
     nsteps = int(round(t_end / dt))
     for k in range(nsteps):
-        kick(v, a, zeros, m, bc, zeros, 0.5 * dt if k == 0 else dt, vm)
+        kick(v, a, zeros, m, bc, zeros, 0.5 * dt if k == 0 else dt, vm, kick_scratch(len(m)))
         drift(x, v, dt)
         a = -omega**2 * x
-    kick(v, a, zeros, m, bc, zeros, 0.5 * dt, vm)  # synchronise v to t_end
+    kick(v, a, zeros, m, bc, zeros, 0.5 * dt, vm, kick_scratch(len(m)))  # synchronise v to t_end
     return x[0, 0], v[0, 0]
 
 
@@ -44,7 +44,7 @@ def test_kick_energy_and_boundary_conditions():
     bcv = np.zeros((3, 3))
     bcv[2] = [0, 5.0, 0]
     vm = np.zeros((3, 3))
-    ke, wc, we = kick(v, a, ac, m, bc, bcv, 0.1, vm)
+    ke, wc, we = kick(v, a, ac, m, bc, bcv, 0.1, vm, kick_scratch(len(m)))
     assert np.allclose(v, [[1, 0, 0], [0, 0, 0], [0, 5, 0]])
     # kinetic energy at the kick time uses the mean velocity
     assert np.isclose(ke, 0.5 * (1 * 1**2 + 2 * 1.0**2 + 3 * 4.0**2))

@@ -28,14 +28,27 @@ from numba import njit, prange
 from .state import BC_FIXED, BC_VELOCITY
 
 
+#: particles per block of the kick's energy sums: the sums are taken block by
+#: block in a fixed order, so they do not depend on the number of threads
+KICK_BLOCK = 1024
+
+
+def kick_scratch(n: int) -> np.ndarray:
+    """Scratch (blocks, 3) for :func:`kick`'s per-block energy sums of ``n`` particles."""
+    return np.zeros((n // KICK_BLOCK + 1, 3))
+
+
 @njit(cache=True, error_model="numpy", parallel=True)
-def kick(v, a, a_contact, m, bc, bc_v, dt_kick, v_out_mean):
+def kick(v, a, a_contact, m, bc, bc_v, dt_kick, v_out_mean, sums):
     r"""Velocity kick with boundary conditions and energy bookkeeping.
 
     ``v`` (N, 3) is advanced in place from :math:`n-1/2` to :math:`n+1/2`;
     ``a`` (N, 3) is the total acceleration (including ``a_contact``, the part
     from contact, (N, 3)). ``bc``/``bc_v`` impose fixed or prescribed
-    velocities. ``v_out_mean`` (N, 3) receives :math:`\mathbf v^n`.
+    velocities. ``v_out_mean`` (N, 3) receives :math:`\mathbf v^n`. ``sums`` is
+    the (blocks, 3) scratch of :func:`kick_scratch`: each block of
+    :data:`KICK_BLOCK` particles is summed in order, then the blocks in order,
+    so the energies are the same bits on any number of threads.
 
     Returns
     -------
@@ -45,44 +58,56 @@ def kick(v, a, a_contact, m, bc, bc_v, dt_kick, v_out_mean):
     external_work : float, work done by the boundary-condition reactions [J]
     """
     n = v.shape[0]
-    ke = 0.0
-    wc = 0.0
-    we = 0.0
-    for i in prange(n):
-        mi = m[i]
-        n0 = v[i, 0] + dt_kick * a[i, 0]
-        n1 = v[i, 1] + dt_kick * a[i, 1]
-        n2 = v[i, 2] + dt_kick * a[i, 2]
-        if bc[i] != 0:
-            if bc[i] == BC_FIXED:
-                t0 = 0.0
-                t1 = 0.0
-                t2 = 0.0
-            else:
-                t0 = bc_v[i, 0]
-                t1 = bc_v[i, 1]
-                t2 = bc_v[i, 2]
-            # reaction impulse m (v_target - v_free) does work on the particle
-            mm0 = 0.5 * (v[i, 0] + t0)
-            mm1 = 0.5 * (v[i, 1] + t1)
-            mm2 = 0.5 * (v[i, 2] + t2)
-            we += mi * ((t0 - n0) * mm0 + (t1 - n1) * mm1 + (t2 - n2) * mm2)
-            n0 = t0
-            n1 = t1
-            n2 = t2
-        m0 = 0.5 * (v[i, 0] + n0)
-        m1 = 0.5 * (v[i, 1] + n1)
-        m2 = 0.5 * (v[i, 2] + n2)
-        ke += 0.5 * mi * (m0 * m0 + m1 * m1 + m2 * m2)
-        wc += mi * dt_kick * (a_contact[i, 0] * m0 + a_contact[i, 1] * m1
-                              + a_contact[i, 2] * m2)
-        v_out_mean[i, 0] = m0
-        v_out_mean[i, 1] = m1
-        v_out_mean[i, 2] = m2
-        v[i, 0] = n0
-        v[i, 1] = n1
-        v[i, 2] = n2
-    return ke, wc, we
+    nb = (n + KICK_BLOCK - 1) // KICK_BLOCK
+    for b in prange(nb):
+        ke = 0.0
+        wc = 0.0
+        we = 0.0
+        for i in range(b * KICK_BLOCK, min(n, (b + 1) * KICK_BLOCK)):
+            mi = m[i]
+            n0 = v[i, 0] + dt_kick * a[i, 0]
+            n1 = v[i, 1] + dt_kick * a[i, 1]
+            n2 = v[i, 2] + dt_kick * a[i, 2]
+            if bc[i] != 0:
+                if bc[i] == BC_FIXED:
+                    t0 = 0.0
+                    t1 = 0.0
+                    t2 = 0.0
+                else:
+                    t0 = bc_v[i, 0]
+                    t1 = bc_v[i, 1]
+                    t2 = bc_v[i, 2]
+                # reaction impulse m (v_target - v_free) does work on the particle
+                mm0 = 0.5 * (v[i, 0] + t0)
+                mm1 = 0.5 * (v[i, 1] + t1)
+                mm2 = 0.5 * (v[i, 2] + t2)
+                we += mi * ((t0 - n0) * mm0 + (t1 - n1) * mm1 + (t2 - n2) * mm2)
+                n0 = t0
+                n1 = t1
+                n2 = t2
+            m0 = 0.5 * (v[i, 0] + n0)
+            m1 = 0.5 * (v[i, 1] + n1)
+            m2 = 0.5 * (v[i, 2] + n2)
+            ke += 0.5 * mi * (m0 * m0 + m1 * m1 + m2 * m2)
+            wc += mi * dt_kick * (a_contact[i, 0] * m0 + a_contact[i, 1] * m1
+                                  + a_contact[i, 2] * m2)
+            v_out_mean[i, 0] = m0
+            v_out_mean[i, 1] = m1
+            v_out_mean[i, 2] = m2
+            v[i, 0] = n0
+            v[i, 1] = n1
+            v[i, 2] = n2
+        sums[b, 0] = ke
+        sums[b, 1] = wc
+        sums[b, 2] = we
+    kinetic = 0.0
+    contact_work = 0.0
+    external_work = 0.0
+    for b in range(nb):
+        kinetic += sums[b, 0]
+        contact_work += sums[b, 1]
+        external_work += sums[b, 2]
+    return kinetic, contact_work, external_work
 
 
 @njit(cache=True, error_model="numpy", parallel=True)

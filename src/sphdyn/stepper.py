@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .integrate import kick
+from .integrate import KICK_BLOCK, kick, kick_scratch
 
 
 def _add(total, value):
@@ -61,6 +61,7 @@ class Stepper:
         self.kinetic = 0.0  # kinetic energy at the last kick's time [J]
         self.work_contact = 0.0  # work of the interaction forces [J]
         self.work_external = 0.0  # work of the boundary-condition reactions [J]
+        self._kick_sums: dict[str, np.ndarray] = {}  # per part, grown with it
         for part in self.parts:
             part.kin.add("v_mid", (3,))
         self.dt0, _, _ = self.stable_dt()
@@ -103,6 +104,12 @@ class Stepper:
             dt = min(dt, inter.stable_dt())
         return min(dt, self.dt_max), k, which
 
+    def _sums(self, part) -> np.ndarray:
+        sums = self._kick_sums.get(part.name)
+        if sums is None or sums.shape[0] <= part.kin.n // KICK_BLOCK:
+            sums = self._kick_sums[part.name] = kick_scratch(part.kin.n)
+        return sums
+
     def _interaction_forces(self, dt: float) -> None:
         for part in self.parts:
             part.kin.a_ext[:] = 0.0
@@ -124,7 +131,8 @@ class Stepper:
         ke = wc = we = None
         for part in self.parts:
             q = part.kin
-            k_, c_, e_ = kick(q.v, q.a, q.a_ext, q.m, q.bc, q.bc_v, dt_kick, q.v_mid)
+            k_, c_, e_ = kick(q.v, q.a, q.a_ext, q.m, q.bc, q.bc_v, dt_kick, q.v_mid,
+                              self._sums(part))
             ke, wc, we = _add(ke, k_), _add(wc, c_), _add(we, e_)
         self.work_contact += wc
         self.work_external += we
