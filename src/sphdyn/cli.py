@@ -26,28 +26,39 @@ def cmd_run(args) -> int:
 
     deck = load_deck(args.deck, args.set)
     out = Path(args.out) if args.out else Path("out") / Path(args.deck).stem
-    _threads(args.threads)
     sim = Simulation.from_deck(deck, out)
     print(f"sphdyn: {sim.particles.n} particles, {deck.run.dimension}D, "
           f"t_end = {deck.run.t_end:g} s, initial dt = {sim.stepper.dt0:.3e} s -> {out}")
-    return _finish(sim.run(max_steps=args.max_steps, progress=not args.quiet and None))
+    return _finish(sim.run(max_steps=args.max_steps, progress=not args.quiet and None,
+                           threads=args.threads or None), out)
 
 
 def cmd_restart(args) -> int:
     from .simulation import Simulation
 
-    _threads(args.threads)
     sim = Simulation.from_directory(args.dir)
     print(f"sphdyn: restarting {args.dir} at t = {sim.stepper.t:.6e} s "
           f"(step {sim.stepper.step_count})")
     return _finish(sim.run(t_end=args.t_end, max_steps=args.max_steps,
-                           progress=not args.quiet and None))
+                           progress=not args.quiet and None,
+                           threads=args.threads or None), args.dir)
 
 
-def _finish(summary: dict) -> int:
+def _finish(summary: dict, out) -> int:
+    """Print the run's one-line summary; the exit code (128 + signal if interrupted)."""
     keys = ("status", "particles", "steps", "time", "wall_seconds",
             "particle_steps_per_s", "energy_error_max_rel")
     print(json.dumps({k: summary.get(k) for k in keys}))
+    if summary.get("status") == "interrupted":
+        import signal
+
+        from .interrupt import SIGNALS
+
+        sig = signal.Signals[summary["signal"]]
+        print(f"sphdyn: interrupted by {sig.name} at t = {summary['time']:.6e} s "
+              f"(step {summary['steps']}); checkpoint, history and summary written. "
+              f"Resume with: sphdyn restart {out}", file=sys.stderr)
+        return SIGNALS[sig]
     return 0
 
 

@@ -31,7 +31,10 @@ from .analysis import window_mean_force
 from .io.plots import energy_columns, relative_drift
 from .assembly import build_stepper
 from .model import Model, build_model
-from .monitors import Checkpoints, FrameOutput, Guards, HistoryRecorder, Progress
+from .interrupt import StopRequests
+from .monitors import (Checkpoints, FrameOutput, Guards, HistoryFlush, HistoryRecorder,
+                       Progress)
+from .threads import ThreadTuner
 from .neighbours import max_neighbours, mean_neighbours
 from .stepper import Stepper
 
@@ -110,58 +113,105 @@ class Simulation:
 
     # ------------------------------------------------------------------- run
     def run(self, t_end: float | None = None, max_steps: int | None = None,
-            progress: bool | None = None) -> dict:
+            progress: bool | None = None, threads: int | None = None) -> dict:
         """Run to ``t_end`` (default the deck's) or for ``max_steps`` steps.
 
-        Returns the run summary. Raises :class:`SimulationFailed` after writing
-        all output when a guard stops the run.
+        ``threads``: a fixed Numba thread count, or None to let a
+        :class:`~sphdyn.threads.ThreadTuner` keep the faster of all threads
+        and one (results are the same bits either way).
+
+        SIGINT or SIGTERM (in the main thread) end the run after the current
+        step with all output and a checkpoint written; the summary's status
+        is then ``"interrupted"`` and ``signal`` names the signal. Returns the
+        run summary. Raises :class:`SimulationFailed` after writing all output
+        when a guard stops the run or the output cannot be written (a full
+        disk): what was written before is kept.
         """
         deck, s = self.deck, self.stepper
         t_end = deck.run.t_end if t_end is None else t_end
         self.output.t_end = t_end
         show = deck.output.progress if progress is None else progress
-        bar = Progress(s.t, t_end) if show else None
-        if bar is not None:
-            s.add_monitor(bar)
+        added = []
+        tuner = self._thread_tuner(threads)
+        if tuner is not None:
+            added.append(tuner)
+            s.monitors.insert(0, tuner)  # times the step alone, before any output
+        if show:
+            added.append(Progress(s.t, t_end))
+        flush = HistoryFlush(self._flush_history)
+        added.append(flush)
+        s.monitors.extend(m for m in added if m is not tuner)
         start_step = s.step_count
         failure = None
         t0 = time.perf_counter()
-        try:
-            if s.step_count == 0 and not self.frames.frames_on_disk():
-                self._write_frame()
-            while s.t < t_end * (1 - 1e-12):
-                if max_steps is not None and s.step_count - start_step >= max_steps:
-                    break
-                s.step(t_stop=t_end)
-        except SimulationFailed as exc:
-            failure = exc
-        finally:
-            self.wall_seconds += time.perf_counter() - t0
-            if bar is not None:
-                bar.close()
-                s.monitors.remove(bar)
-        if failure is None and s.t >= t_end * (1 - 1e-12) and (
-                not self.frames.frames_on_disk()
-                or abs(self.frames.last_time - s.t) > 1e-12 * t_end):
-            self._write_frame()
+        with StopRequests() as stop:
+            try:
+                if s.step_count == 0 and not self.frames.frames_on_disk():
+                    self._write_frame()
+                while s.t < t_end * (1 - 1e-12) and not stop.requested:
+                    if max_steps is not None and s.step_count - start_step >= max_steps:
+                        break
+                    s.step(t_stop=t_end)
+            except SimulationFailed as exc:
+                failure = exc
+            except OSError as exc:  # a full disk, a lost mount: keep what is written
+                failure = SimulationFailed(_output_failure(exc, s))
+            finally:
+                self.wall_seconds += time.perf_counter() - t0
+                for m in added:
+                    if hasattr(m, "close"):
+                        m.close()
+                    s.monitors.remove(m)
+            self._wind_up(t_end, failure)
+            summary = self._summary(start_step, failure, stop.name)
+            if tuner is not None:
+                summary["threads"] = tuner.summary()
+            try:
+                atomic_write_text(self.outdir / "summary.json",
+                                  json.dumps(summary, indent=2))
+            except OSError as exc:
+                print(f"warning: summary.json not written: {exc}")
         if failure is not None:
-            self._write_frame()
-        if failure is None and s.t >= t_end * (1 - 1e-12):
+            raise failure
+        return summary
+
+    def _thread_tuner(self, threads: int | None):
+        import numba
+
+        if threads is not None:
+            numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
+            return None
+        n = numba.get_num_threads()
+        return ThreadTuner(n) if n > 1 else None
+
+    def _wind_up(self, t_end: float, failure) -> None:
+        """The end of a run: the last frame, history row, checkpoint and plots.
+
+        Each write is tried on its own, so a full disk loses only what did
+        not fit (and a failed run still gets its history and summary).
+        """
+        s = self.stepper
+        done = failure is None and s.t >= t_end * (1 - 1e-12)
+        writes = []
+        if failure is not None or (done and (not self.frames.frames_on_disk() or abs(
+                self.frames.last_time - s.t) > 1e-12 * t_end)):
+            writes.append(self._write_frame)
+        if done:
             self.history.append(self.recorder.row(s, kinetic=s.kinetic_now(),
                                                   dt=s.dt_prev))
-        self.history.write_csv(self.outdir / "history.csv")
+        writes.append(self._flush_history)
         if failure is None:
-            self._checkpoint()
+            writes.append(self._checkpoint)
+        for write in writes:
+            try:
+                write()
+            except OSError as exc:
+                print(f"warning: {exc}")
         try:
             plot_history(self.outdir / "history.csv", self.outdir / "plots",
                          self.deck.output.force_window)
         except Exception as exc:  # plots must never lose a run
             print(f"warning: plotting failed: {exc}")
-        summary = self._summary(start_step, failure)
-        atomic_write_text(self.outdir / "summary.json", json.dumps(summary, indent=2))
-        if failure is not None:
-            raise failure
-        return summary
 
     # --------------------------------------------------------------- helpers
     def _write_frame(self):
@@ -177,18 +227,26 @@ class Simulation:
         scalars, groups = self.stepper.state()
         scalars.update(next_frame=self.output.next_frame, version=__version__)
         write_checkpoint(self.outdir / CHECKPOINT, {}, scalars, groups)
+        self._flush_history()
+
+    def _flush_history(self):
         self.history.write_csv(self.outdir / "history.csv")
 
-    def _summary(self, start_step: int, failure) -> dict:
+    def _summary(self, start_step: int, failure, interrupted: str | None = None) -> dict:
         s, deck = self.stepper, self.deck
         steps = s.step_count - start_step
         n = sum(part.kin.n for part in s.parts)
         sph = s.part("sph")
         h = self.history.as_arrays() if len(self.history.columns) else {}
+        if failure is not None:
+            status = "failed"
+        elif s.t >= deck.run.t_end * (1 - 1e-12):
+            status = "completed"
+        else:
+            status = "interrupted" if interrupted else "stopped"
         summary = {
-            "sphdyn": __version__, "title": deck.run.title, "status":
-            "completed" if failure is None and s.t >= deck.run.t_end * (1 - 1e-12)
-            else ("failed" if failure is not None else "stopped"),
+            "sphdyn": __version__, "title": deck.run.title, "status": status,
+            "signal": interrupted if status == "interrupted" else None,
             "diagnosis": None if failure is None else failure.diagnosis,
             "particles": n, "dimension": s.particles.dim, "time": s.t,
             "steps": s.step_count, "steps_this_run": steps,
@@ -214,6 +272,15 @@ class Simulation:
         if self.model.walls:
             summary["force_window"] = window
         return summary
+
+
+def _output_failure(exc: OSError, s) -> str:
+    """The diagnosis of a run stopped because its output could not be written."""
+    where = f" ({exc.filename})" if getattr(exc, "filename", None) else ""
+    return (f"output could not be written at t = {s.t:.6e} s, step {s.step_count}: "
+            f"{exc.strerror or exc}{where}. The run stopped; the files written "
+            "before are complete. Free space (or fix the directory), then restart "
+            "from the last checkpoint or run again.")
 
 
 def run_deck(path, outdir=None, overrides=None, **kw) -> dict:

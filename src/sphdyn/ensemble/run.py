@@ -67,7 +67,7 @@ def run_sample(spec: SampleSpec) -> dict:
         sim = Simulation.from_deck(deck, out)
         status, error = "completed", ""
         try:
-            sim.run(progress=False)
+            sim.run(progress=False, threads=spec.threads)
         except SimulationFailed as exc:
             status, error = "failed", exc.diagnosis
         values = sample_metrics(sim)
