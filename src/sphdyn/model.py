@@ -17,6 +17,7 @@ from .heterogeneity.mass import body_rng, mass_field
 from .heterogeneity.mesostructure import AGGREGATE, ITZ, MORTAR, generate_phases
 from .heterogeneity.photo import photo_targets
 from .heterogeneity.variation import factor_of, quantise, standard_normal_field, variation_rng
+from .initial import initial_fields
 from .interactions.wall import STIFFNESS, WallSpec
 from .materials import get_model
 from .probes import Probe, quantity
@@ -170,6 +171,30 @@ def _material_groups(deck, particles: Particles, models: dict,
     return groups, factor
 
 
+def _apply_initial(deck, body, p: Particles, models: dict, mat_ids, dim: int) -> None:
+    """Set the ``[body.initial]`` velocity and stress of one body's particles."""
+    where = f"body {body.name!r} [body.initial]"
+    vel, sig = initial_fields(body.initial, p.x, dim, body.dx, where)
+    if vel is not None:
+        if any(v != 0.0 for v in body.velocity):
+            raise ValueError(f"{where}: velocity is given twice (the body's velocity "
+                             "and [body.initial]); keep one")
+        p.v[:] = vel
+    if sig is not None:
+        if (body.formulation or deck.sph.formulation) == "total_lagrangian":
+            raise ValueError(f"{where}: a total-Lagrangian body computes its stress "
+                             "from the deformation since t = 0, so it cannot start "
+                             "stressed; use formulation = \"updated_lagrangian\"")
+        names = {deck.material[k].name for k in np.unique(mat_ids)}
+        refused = sorted(n for n in names if not models[n].initial_stress)
+        if refused:
+            raise ValueError(f"{where}: material {', '.join(refused)} (model "
+                             f"{models[refused[0]].name}) cannot start from a given "
+                             "stress (its state is tied to the loading history); "
+                             "initial stress works with elastic and j2 materials")
+        p.sig[:] = sig
+
+
 def build_model(deck) -> Model:
     """Create the particle model described by a validated deck."""
     dim = deck.run.dimension
@@ -201,6 +226,8 @@ def build_model(deck) -> Model:
         p.x[:] = x
         p.x0[:] = x
         p.v[:] = np.asarray(body.velocity, dtype=float)
+        if body.initial is not None:
+            _apply_initial(deck, body, p, models, mat_ids, dim)
         vol = body.dx ** dim
         p.vol0[:] = vol
         p.mat[:] = mat_ids

@@ -156,4 +156,5 @@ ELASTIC = register(MaterialModel(
     pack=pack_elastic,
     update=elastic_update,
     schema=ElasticParams,
+    initial_stress=True,
 ))

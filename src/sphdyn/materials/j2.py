@@ -172,4 +172,5 @@ J2 = register(MaterialModel(
     pack=pack_j2,
     update=j2_update,
     schema=J2Params,
+    initial_stress=True,
 ))

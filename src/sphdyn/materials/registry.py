@@ -63,6 +63,10 @@ class MaterialModel:
         The model's ``[[material]]`` table (keys, defaults, checks); None
         for a model the deck does not offer (e.g. one used only by the
         material driver).
+    initial_stress : bool
+        The model accepts a Cauchy stress given at t = 0 (``[body.initial]
+        stress``) as its state: an incremental model with no other state tied
+        to the stress. False (the default) refuses one in the deck.
     """
 
     name: str
@@ -71,6 +75,7 @@ class MaterialModel:
     update: Callable
     history_init: Callable[[np.ndarray], np.ndarray] | None = None
     schema: Any = None
+    initial_stress: bool = False
 
     @property
     def n_history(self) -> int:

@@ -7,13 +7,14 @@ structure of bodies and materials: [body.mesostructure], [body.mass] and
 
 from typing import Annotated, Literal, Optional, Union
 
-from pydantic import Field, field_validator, model_validator
+from pydantic import BeforeValidator, Field, field_validator, model_validator
 
-from ..messages import problem, show_number
+from ..expressions import ExpressionError, check_expression
+from ..messages import problem, show, show_number
 from ..units import LENGTH
 from ..values import (Corner, Direction, ExistingFile, Position, PositiveLength, Section,
-                      UpperCorner, VelocityVector, integer, name_of, quantity, real,
-                      reference_to)
+                      UpperCorner, Vector, VelocityVector, integer, name_of, quantity,
+                      real, reference_to)
 from .shapes import Geometry, PlanarAxis
 
 
@@ -272,6 +273,72 @@ Crack = Annotated[Union[CrackPlane, CrackPolyline, CrackBox],
 
 # Bodies, walls, sets, boundaries ----------------------------------------
 
+def expression(value):
+    """Before-validator: a number or an expression of x, y, z (SI result)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, str)):
+        raise problem(f"{show(value)} is not an expression",
+                      "give a number or a string such as \"2.0 * sin(pi * x / 0.4)\"")
+    text = repr(float(value)) if not isinstance(value, str) else value
+    try:
+        check_expression(text)
+    except ExpressionError as exc:
+        raise problem(str(exc), "see [body.initial] in docs/deck-reference.md") from None
+    return text
+
+
+Expression = Annotated[str, BeforeValidator(expression)]
+#: the stress components of [body.initial] stress
+STRESS_COMPONENTS = ("xx", "yy", "zz", "xy", "xz", "yz")
+#: the columns a [body.initial] file may hold, besides x, y, z
+FILE_COLUMNS = ("vx", "vy", "vz") + tuple(f"s{c}" for c in STRESS_COMPONENTS)
+
+
+class InitialFields(Section):
+    """[body.initial]: initial velocity and stress that vary with position.
+
+    Expressions of x, y, z [m] with SI results (velocity in m/s, stress in
+    Pa, tension positive), or a CSV file of points with a header row naming
+    x, y[, z] and any of vx, vy, vz, sxx, syy, szz, sxy, sxz, syz, taken at
+    each particle from the nearest point or by linear interpolation. Applied
+    before boundary conditions (a fixed set stays at rest). An expression may
+    use x, y, z, numbers, pi, e, + - * / ** %, comparisons inside where(c, a,
+    b), and sin, cos, tan, arcsin, arccos, arctan, arctan2, sinh, cosh, tanh,
+    exp, log, log10, sqrt, abs, sign, floor, ceil, minimum, maximum, clip,
+    hypot (NumPy's); nothing else, so a deck cannot run code.
+    """
+
+    velocity: Optional[Annotated[tuple[Expression, Expression, Expression],
+                                 BeforeValidator(Vector())]] = Field(
+        None, description="Initial velocity [m/s] as 3 expressions of x, y, z "
+                          "(2 in a 2D deck), e.g. [\"0\", \"0.5 * sin(pi * x / "
+                          "0.2)\", \"0\"]; replaces the body's velocity.")
+    stress: Optional[dict[Literal["xx", "yy", "zz", "xy", "xz", "yz"], Expression]] = \
+        Field(None, description="Initial Cauchy stress [Pa] by component "
+                                "(xx, yy, zz, xy, xz, yz; absent components 0), "
+                                "e.g. { yy = \"-2400 * 9.81 * (0.3 - y)\" }. "
+                                "Updated-Lagrangian bodies of elastic or j2 "
+                                "material.")
+    file: Optional[ExistingFile] = Field(
+        None, description="CSV file of points: header x, y[, z] and any of vx, vy, "
+                          "vz, sxx, syy, szz, sxy, sxz, syz (SI). Its columns "
+                          "must not repeat a velocity or stress given above.")
+    interpolation: Literal["nearest", "linear"] = Field(
+        "nearest", description="From the file's points to the particles: the "
+                               "nearest point (within max_distance), or linear "
+                               "interpolation on their Delaunay triangulation "
+                               "(particles outside it are refused).")
+    max_distance: Optional[PositiveLength] = Field(
+        None, description="Nearest interpolation: the farthest a particle may be "
+                          "from its point (default: the body's dx).")
+
+    @model_validator(mode="after")
+    def _something_given(self):
+        if self.velocity is None and self.stress is None and self.file is None:
+            raise problem("[body.initial] gives neither velocity, stress nor file",
+                          "give at least one of them, or remove the table")
+        return self
+
+
 class Body(Section):
     """[[body]]: a solid filled with particles on a lattice."""
 
@@ -299,3 +366,6 @@ class Body(Section):
     crack: tuple[Crack, ...] = Field(
         (), description="Initial cracks: their particles get zero mass; "
                         "use a wall with stiffness = \"bulk\".")
+    initial: Optional[InitialFields] = Field(
+        None, description="Initial velocity and stress varying with position "
+                          "(expressions or a file).")
