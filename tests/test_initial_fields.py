@@ -215,3 +215,10 @@ def test_a_file_with_a_wrong_header_is_named(tmp_path):
     (tmp_path / "g.csv").write_text("x,vx\n0,1\n")
     with pytest.raises(ValueError, match="no column y"):
         build_model(_deck('[body.initial]\nfile = "g.csv"\n', base_dir=tmp_path))
+
+
+def test_the_deck_reference_lists_every_expression_function():
+    from sphdyn.deck.expressions import FUNCTIONS
+    from sphdyn.deck.sections.bodies import InitialFields
+
+    assert all(f in InitialFields.__doc__ for f in FUNCTIONS)
