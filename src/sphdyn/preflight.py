@@ -38,17 +38,34 @@ DEFAULT_MEMORY_SHARE = 0.5
 _TOLERANCE = 1e-6
 
 
+def _power(x: float, n: int) -> float:
+    """``x**n`` that overflows to inf instead of raising (float ``**`` raises)."""
+    return math.prod([float(x)] * n)
+
+
+def ball_volume(radius: float, dim: int) -> float:
+    """Area of a disc (2D) or volume of a ball (3D) of ``radius``."""
+    return math.pi * _power(radius, 2) if dim == 2 else 4.0 / 3.0 * math.pi * _power(radius, 3)
+
+
 def shape_volume(geometry, dim: int) -> float:
     """Closed-form volume of a body geometry [m^3], or area [m^2] in 2D."""
     g = geometry
     if g.shape == "box":
-        return float(np.prod(np.subtract(g.hi, g.lo)[:dim]))
+        return math.prod(h - l for l, h in zip(g.lo[:dim], g.hi[:dim]))
     if g.shape == "sphere":
-        return math.pi * g.radius ** 2 if dim == 2 else 4.0 / 3.0 * math.pi * g.radius ** 3
+        return ball_volume(g.radius, dim)
     outer = g.radius if g.shape == "cylinder" else g.outer_radius
     inner = 0.0 if g.shape == "cylinder" else g.inner_radius
-    area = math.pi * (outer ** 2 - inner ** 2)
+    area = ball_volume(outer, 2) - ball_volume(inner, 2)
     return area if dim == 2 else area * g.length
+
+
+def lattice_count(volume: float, dx: float, dim: int) -> float:
+    """Particles of spacing ``dx`` in ``volume``; inf when it overflows."""
+    cell = _power(dx, dim)
+    n = volume / cell if cell > 0 else math.inf
+    return n if math.isfinite(n) else math.inf
 
 
 def depth_inside(geometry, x: np.ndarray, dim: int) -> np.ndarray:
@@ -158,20 +175,22 @@ def estimate_size(deck) -> SizeEstimate:
 
     dim = deck.run.dimension
     sph = deck.sph
-    bodies = {b.name: shape_volume(b.geometry, dim) / b.dx ** dim for b in deck.body}
+    bodies = {b.name: lattice_count(shape_volume(b.geometry, dim), b.dx, dim)
+              for b in deck.body}
     n = float(sum(bodies.values()))
     radius = (support(kernel_id(sph.kernel)) * sph.support_scale * sph.h_factor
               * (1.0 + sph.neighbours.skin_factor))
-    pairs = math.pi * radius ** 2 if dim == 2 else 4.0 / 3.0 * math.pi * radius ** 3
+    pairs = ball_volume(radius, dim)
     per_particle = PARTICLE_BYTES + 8 * _history_width(deck)
-    return SizeEstimate(bodies, n, pairs, n * per_particle, n * pairs * PAIR_BYTES)
+    return SizeEstimate(bodies, n, pairs, n * per_particle,
+                        n * pairs * PAIR_BYTES if n and pairs else 0.0)
 
 
 def check_size(deck) -> SizeEstimate:
     """Refuse a deck whose model would exceed its memory limit; return the estimate."""
     est = estimate_size(deck)
     limit, source = memory_limit(deck)
-    if est.bytes > limit:
+    if not est.bytes <= limit:  # nan (inf * 0) counts as too large
         b = max(range(len(deck.body)), key=lambda k: est.bodies[deck.body[k].name])
         big = deck.body[b]
         raise DeckError([format_problem(
