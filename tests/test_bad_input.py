@@ -17,7 +17,7 @@ import numba
 import pytest
 
 from decks import SMALL_DISC
-from sphdyn.cli import _threads, main
+from sphdyn.cli import _threads, build_parser, main
 from sphdyn.deck import DeckError, loads_deck
 from sphdyn.model import build_model
 
@@ -108,7 +108,10 @@ def test_out_of_range_numbers_are_refused(argv, flag, capsys):
     assert rc == 2 and f"argument {flag}" in err and ">= " in err
 
 
-def test_threads_default_is_automatic():
+@pytest.mark.parametrize("argv", [["run", "D"], ["restart", "D"], ["ensemble", "D"],
+                                  ["bench", "block3d"], ["material-test", "j2"]])
+def test_threads_default_is_automatic(argv):
+    assert build_parser().parse_args(argv).threads is None
     before = numba.get_num_threads()
     _threads(None)
     assert numba.get_num_threads() == before

@@ -100,7 +100,8 @@ def cmd_restart(args) -> int:
     from .simulation import Simulation
 
     _threads(args.threads)
-    _writable_dir(args.dir, "DIR")
+    if Path(args.dir).is_dir():  # a missing one is reported by from_directory
+        _writable_dir(args.dir, "DIR")
     sim = Simulation.from_directory(args.dir)
     t = sim.stepper.t
     if args.t_end is not None and args.t_end <= t * (1 + 1e-12):
