@@ -8,8 +8,9 @@ import pytest
 
 from sphdyn.cli import main
 from sphdyn.deck import load_deck, loads_deck
-from sphdyn.ensemble import (count_main_cracks, default_layout, parse_vary,
-                             plan_samples, plot_mass_histograms, sample_seed)
+from sphdyn.ensemble import (RESULT, SampleSpec, count_main_cracks, default_layout,
+                             parse_vary, plan_samples, plot_mass_histograms, run_sample,
+                             sample_seed)
 from sphdyn.io import read_frame
 from sphdyn.io.frames import list_frames
 from sphdyn.simulation import Simulation
@@ -180,19 +181,33 @@ def ensemble(tmp_path_factory):
     """One ensemble shared by the tests below (each Dask worker process pays
     the CSCM compilation, ~7 s, so clusters are started sparingly).
 
-    2 replicates x 3 values of domain.margin: 1.0 (the default) runs to the
-    end, 0.001 makes the guard stop the run (particles leave the box), -1 is
-    an invalid deck. Run on 2 worker processes.
+    2 replicates x 2 values of domain.margin: 1.0 (the default) runs to the
+    end, 0.001 makes the guard stop the run (particles leave the box). (An
+    invalid value is refused before anything starts:
+    test_bad_input.py; an invalid sample is recorded: test below.) Run on
+    2 worker processes.
     """
     base = tmp_path_factory.mktemp("ensemble")
     deck = base / "tiny.toml"
     deck.write_text(TINY)
     out = base / "ens"
     args = ["ensemble", str(deck), "--samples", "2", "--vary",
-            "domain.margin=1.0,0.001,-1", "--out", str(out), "-q", "--threads", "1",
+            "domain.margin=1.0,0.001", "--out", str(out), "-q", "--threads", "1",
             "--workers", "2"]
     assert main(args) == 0
     return deck, out, args
+
+
+def test_an_invalid_sample_is_recorded_not_raised(deck, tmp_path):
+    # e.g. the deck file edited between the plan and the run: the sample's
+    # record says "invalid" with the deck's message
+    spec = SampleSpec(0, 0, 1, {}, ("domain.margin=-1",), str(deck),
+                      str(tmp_path / "sample_0000"))
+    rec = run_sample(spec)
+    assert rec["status"] == "invalid"
+    assert "domain.margin" in rec["error"] and "Fix:" in rec["error"]
+    assert json.loads((tmp_path / "sample_0000" / RESULT).read_text())["status"] == \
+        "invalid"
 
 
 @pytest.mark.slow
@@ -200,10 +215,8 @@ def test_ensemble_records_failures_resumes_and_reports(ensemble, capsys):
     # The failures are recorded and the others complete.
     deck, out, args = ensemble
     rows = _table(out)
-    assert [r["status"] for r in rows] == ["completed"] * 2 + ["failed"] * 2 + \
-        ["invalid"] * 2
+    assert [r["status"] for r in rows] == ["completed"] * 2 + ["failed"] * 2
     assert "left the domain box" in rows[2]["error"]
-    assert "domain.margin" in rows[4]["error"] and "Fix:" in rows[4]["error"]
     assert rows[0]["domain.margin"] == "1.0"
     for r in rows[:2]:
         assert float(r["peak_contact_force"]) > 0
@@ -227,7 +240,7 @@ def test_ensemble_records_failures_resumes_and_reports(ensemble, capsys):
     (out / "sample_0001" / "result.json").unlink()
     capsys.readouterr()
     assert main(args[:-1] + ["1"]) == 0
-    assert "1 already done, 5 to run" in capsys.readouterr().out
+    assert "1 already done, 3 to run" in capsys.readouterr().out
     assert marker0.stat().st_mtime_ns == before
     assert [f.stat().st_mtime_ns for f in list_frames(out / "sample_0000")] == frames0
     again = _final(out / "sample_0001")
@@ -238,7 +251,7 @@ def test_ensemble_records_failures_resumes_and_reports(ensemble, capsys):
     # the report alone is rewritten without running anything
     (out / "ensemble.csv").unlink()
     assert main(["ensemble", str(deck), "--report", "--out", str(out)]) == 0
-    assert len(_table(out)) == 6
+    assert len(_table(out)) == 4
 
 
 @pytest.mark.slow

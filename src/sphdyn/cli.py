@@ -14,18 +14,81 @@ from pathlib import Path
 
 
 def _threads(n):
-    if n:
+    """Set the Numba thread count; ``None`` leaves the automatic choice."""
+    if n is not None:
         import numba
 
         numba.set_num_threads(n)
 
 
+def _whole(lo: int):
+    """An argparse type: a whole number of at least ``lo``."""
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = None
+        if value is None or value < lo:
+            raise argparse.ArgumentTypeError(
+                f"{text!r} is not a whole number >= {lo}; give e.g. {max(lo, 1) * 2}")
+        return value
+    parse.__name__ = f"whole number >= {lo}"
+    return parse
+
+
+def _duration(text: str) -> float:
+    """An argparse type: a time, plain numbers in seconds or with units ("250 us")."""
+    from .deck.units import TIME, QuantityError, to_si
+
+    try:
+        value = float(text)
+    except ValueError:
+        try:
+            value = to_si(text, TIME)
+        except QuantityError as exc:
+            raise argparse.ArgumentTypeError(f"{exc.what}; {exc.fix}") from None
+    if not value > 0 or value == float("inf"):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a positive finite time; "
+                                         "give e.g. 2e-4 (seconds) or '250 us'")
+    return value
+
+
+def _writable_dir(path, flag: str) -> Path:
+    """Create directory ``path`` if needed and make sure a file can be written in it.
+
+    Raises a ValueError naming ``flag`` (the option that gave the path) when
+    the path is a file, lies under a file or cannot be written.
+    """
+    import tempfile
+
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise ValueError(f"{flag} {path}: this is a file, not a directory. "
+                         f"Fix: give {flag} a directory (new or existing)")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=path):
+            pass
+    except OSError as exc:
+        raise ValueError(f"{flag} {path}: cannot write there ({exc.strerror or exc}). "
+                         f"Fix: give {flag} a directory you may write to") from None
+    return path
+
+
+def _print_warnings(lines) -> None:
+    for line in lines:
+        print(f"sphdyn: warning: {line}", file=sys.stderr)
+
+
 def cmd_run(args) -> int:
     from .deck import load_deck
+    from .preflight import check_deck
     from .simulation import Simulation
 
     deck = load_deck(args.deck, args.set)
+    check_deck(deck)  # refused before the output directory is made
     out = Path(args.out) if args.out else Path("out") / Path(args.deck).stem
+    _writable_dir(out, "--out")
     sim = Simulation.from_deck(deck, out)
     print(f"sphdyn: {sim.particles.n} particles, {deck.run.dimension}D, "
           f"t_end = {deck.run.t_end:g} s, initial dt = {sim.stepper.dt0:.3e} s -> {out}")
@@ -36,8 +99,15 @@ def cmd_run(args) -> int:
 def cmd_restart(args) -> int:
     from .simulation import Simulation
 
+    if Path(args.dir).is_dir():  # a missing one is reported by from_directory
+        _writable_dir(args.dir, "DIR")
     sim = Simulation.from_directory(args.dir)
-    print(f"sphdyn: restarting {args.dir} at t = {sim.stepper.t:.6e} s "
+    t = sim.stepper.t
+    if args.t_end is not None and args.t_end <= t * (1 + 1e-12):
+        raise ValueError(f"--t-end {args.t_end:g} s is not after the checkpoint's time "
+                         f"t = {t:.6g} s in {args.dir}. Fix: give a --t-end later than "
+                         f"{t:.6g} s")
+    print(f"sphdyn: restarting {args.dir} at t = {t:.6e} s "
           f"(step {sim.stepper.step_count})")
     return _finish(sim.run(t_end=args.t_end, max_steps=args.max_steps,
                            progress=not args.quiet and None,
@@ -64,11 +134,14 @@ def _finish(summary: dict, out) -> int:
 
 def cmd_ensemble(args) -> int:
     from .ensemble import run_ensemble, write_report
+    from .ensemble.plan import parse_vary, validate_grid
 
     out = Path(args.out) if args.out else Path("out") / f"{Path(args.deck).stem}-ensemble"
     if args.report:
         print(write_report(out))
         return 0
+    validate_grid(args.deck, parse_vary(args.vary), args.set or ())  # before anything
+    _writable_dir(out, "--out")
     path = run_ensemble(args.deck, args.samples, vary=args.vary or (), out=out,
                         scheduler=args.scheduler, workers=args.workers,
                         threads=args.threads, overrides=args.set or (),
@@ -80,14 +153,19 @@ def cmd_ensemble(args) -> int:
 def cmd_check(args) -> int:
     from .deck import load_deck
     from .model import build_model
+    from .preflight import check_deck, memory_limit, show_bytes
 
     deck = load_deck(args.deck, args.set)
+    estimate = check_deck(deck)
     model = build_model(deck)
     p = model.particles
+    limit, source = memory_limit(deck)
     print(f"{args.deck}: OK")
     print(f"  {deck.run.dimension}D, t_end = {deck.run.t_end:g} s, {p.n} particles in "
           f"{len(model.body_names)} bodies, {len(deck.material)} materials, "
           f"{len(model.walls)} walls, sets {sorted(model.sets) or '-'}")
+    print(f"  estimate: {estimate.summary()}; memory limit {show_bytes(limit)} "
+          f"({source})")
     if args.resolved:
         from .deck import dump_resolved
 
@@ -180,10 +258,14 @@ def cmd_ucs(args) -> int:
 def cmd_export(args) -> int:
     from .io import export_csv, export_vtk
 
+    if args.format == "vtk" and args.frame is not None:
+        raise ValueError("--frame selects the frame of --format csv; the VTK export "
+                         "writes every frame. Fix: add --format csv or drop --frame")
+
     if args.format == "vtk":
         print(export_vtk(args.dir))
     else:
-        print(export_csv(args.dir, frame=args.frame))
+        print(export_csv(args.dir, frame=-1 if args.frame is None else args.frame))
     return 0
 
 
@@ -214,24 +296,67 @@ def cmd_info(args) -> int:
 def cmd_bench(args) -> int:
     from .bench import main_json
 
+    if args.particles is not None and args.case != "block3d":
+        raise ValueError(f"--particles: the case {args.case} has a fixed particle count "
+                         "(the rings of Gray et al. 2001). Fix: drop --particles, or "
+                         "use it with block3d")
     print(main_json(case=args.case, steps=args.steps, threads=args.threads,
                     particles=args.particles))
     return 0
 
 
-def _param_value(text: str):
+def _param_value(key: str, text: str):
     """``true``/``false`` -> bool, else a float (SI units)."""
     low = text.strip().lower()
     if low in ("true", "false"):
         return low == "true"
-    return float(text)
+    try:
+        return float(text)
+    except ValueError:
+        raise ValueError(f"--param {key}={text}: {text!r} is not a number. Fix: give "
+                         "the value as a number in SI units (or true/false)") from None
+
+
+def _material_params(name: str, params: dict) -> dict:
+    """Check ``--param`` values against the material's deck table.
+
+    Returns the values with the table's defaults filled in (SI, None
+    dropped); raises ValueError with one ``--param`` line per problem.
+    """
+    from pydantic import ValidationError
+
+    from .deck.errors import explain
+    from .materials import available_models, get_model
+
+    if name not in available_models():
+        raise ValueError(f"MODEL {name!r} is not a registered material model. Fix: use "
+                         f"one of {', '.join(available_models())}, or --deck DECK "
+                         f"--material {name}")
+    schema = get_model(name).schema
+    if schema is None:
+        return params
+    raw = {"name": "material-test", "model": name, **params}
+    try:
+        table = schema.model_validate(raw)
+    except ValidationError as exc:
+        raise ValueError("\n".join(f"--param {line}" for line in explain(exc, raw, schema))
+                         ) from None
+    return {k: v for k, v in table.model_dump().items()
+            if k not in ("name", "model", "variation") and v is not None}
 
 
 def cmd_material_test(args) -> int:
     from .materials import get_model  # noqa: F401  (registers the models)
-    from .materials.driver import drive
+    from .materials.driver import COMPONENTS, drive
 
-    _threads(args.threads or 1)
+    _threads(1 if args.threads is None else args.threads)
+    if (args.confinement is None) == (args.path == "triaxial"):
+        raise ValueError("--confinement is required by --path triaxial and used by no "
+                         "other path. Fix: give --confinement PRESSURE [Pa] with "
+                         "--path triaxial only")
+    if args.confinement is not None and not 0 <= args.confinement < float("inf"):
+        raise ValueError(f"--confinement {args.confinement:g}: the confining pressure "
+                         "must be >= 0. Fix: give a compressive pressure in Pa, e.g. 1e7")
     params = {}
     name = args.model
     if args.deck:
@@ -255,46 +380,55 @@ def cmd_material_test(args) -> int:
         key, sep, value = item.partition("=")
         if not sep:
             raise ValueError(f"--param {item!r}: write KEY=VALUE (SI units)")
-        params[key.strip()] = _param_value(value)
+        params[key.strip()] = _param_value(key.strip(), value)
+    params = _material_params(name, params)
+    _writable_dir(args.out, "--out")
     res = drive(name, params, args.path, strain=args.strain, rate=args.rate,
-                n_steps=args.steps, confinement=args.confinement, size=args.size,
+                n_steps=args.steps, confinement=args.confinement or 0.0, size=args.size,
                 out=args.out)
-    y = res["y"]
+    # the CSV's own columns and signs (tension positive), not the plot's axes
+    strain_col, stress_col = res["columns"]
+    y = res["stress"][:, COMPONENTS.index(stress_col)]
     k = int(abs(y).argmax())
     print(json.dumps({"model": name, "path": args.path, "peak_stress_Pa": float(y[k]),
-                      "at_strain": float(res["x"][k]),
+                      "at_strain": float(res["strain"][k, COMPONENTS.index(strain_col)]),
+                      "stress_column": f"stress_{stress_col}_Pa",
+                      "strain_column": f"strain_{strain_col}",
                       "final_damage": float(res["damage"][-1]),
                       "files": [str(f) for f in res["files"]]}))
     return 0
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from . import __version__
+
     ap = argparse.ArgumentParser(prog="sphdyn", description=__doc__.splitlines()[0])
+    ap.add_argument("--version", action="version", version=f"sphdyn {__version__}")
     sub = ap.add_subparsers(dest="command", required=True)
 
     r = sub.add_parser("run", help="validate and run a deck")
     r.add_argument("deck")
     r.add_argument("--out", help="output directory (default out/<deck name>)")
-    r.add_argument("--threads", type=int, default=0, help="Numba threads (default all)")
+    r.add_argument("--threads", type=_whole(1), default=None, help="Numba threads (default: automatic)")
     r.add_argument("--set", action="append", metavar="KEY=VALUE",
                    help="override a deck value, e.g. --set run.t_end=1e-4")
-    r.add_argument("--max-steps", type=int, help="stop after this many steps")
+    r.add_argument("--max-steps", type=_whole(0), help="stop after this many steps")
     r.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     r.set_defaults(func=cmd_run)
 
     en = sub.add_parser("ensemble", help="run N random samples of a deck (and a grid "
                         "of --vary values) on Dask; resumable; CSV table + damage figure")
     en.add_argument("deck")
-    en.add_argument("--samples", type=int, default=1, help="replicates per grid point, "
+    en.add_argument("--samples", type=_whole(1), default=1, help="replicates per grid point, "
                     "seeds derived from run.seed and the replicate index (default 1)")
     en.add_argument("--vary", action="append", metavar="KEY=V1,V2,...",
                     help="a deck key and its values, e.g. sph.support_scale=0.7,1.0,1.5; "
                     "repeatable (the grid is the product)")
     en.add_argument("--scheduler", metavar="ADDRESS", help="a running Dask scheduler, "
                     "e.g. tcp://host:8786 (default: a local cluster of processes)")
-    en.add_argument("--workers", type=int, help="local worker processes (default: one "
+    en.add_argument("--workers", type=_whole(1), help="local worker processes (default: one "
                     "per core, at most one per sample)")
-    en.add_argument("--threads", type=int, help="Numba threads per sample (default: "
+    en.add_argument("--threads", type=_whole(1), default=None, help="Numba threads per sample (default: "
                     "cores / workers locally, 1 on a scheduler)")
     en.add_argument("--out", help="output directory (default out/<deck>-ensemble)")
     en.add_argument("--set", action="append", metavar="KEY=VALUE",
@@ -312,9 +446,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     s = sub.add_parser("restart", help="continue a run from DIR/checkpoint.h5")
     s.add_argument("dir")
-    s.add_argument("--t-end", type=float, help="new end time [s] (default the deck's)")
-    s.add_argument("--threads", type=int, default=0)
-    s.add_argument("--max-steps", type=int)
+    s.add_argument("--t-end", type=_duration, help="new end time, later than the "
+                   "checkpoint's: seconds or with units, e.g. 2.5e-4 or '250 us' "
+                   "(default the deck's)")
+    s.add_argument("--threads", type=_whole(1), default=None, help="Numba threads (default: automatic)")
+    s.add_argument("--max-steps", type=_whole(0), help="stop after this many steps")
     s.add_argument("-q", "--quiet", action="store_true")
     s.set_defaults(func=cmd_restart)
 
@@ -362,7 +498,8 @@ def build_parser() -> argparse.ArgumentParser:
     e = sub.add_parser("export", help="convert native frames (VTK series or CSV)")
     e.add_argument("dir")
     e.add_argument("--format", choices=("vtk", "csv"), default="vtk")
-    e.add_argument("--frame", type=int, default=-1, help="frame for CSV (default last)")
+    e.add_argument("--frame", type=int, help="frame for CSV, Python style: 0 the "
+                   "first, -1 the last (default)")
     e.set_defaults(func=cmd_export)
 
     i = sub.add_parser("info", help="versions, threads, Numba cache")
@@ -370,9 +507,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     b = sub.add_parser("bench", help="run a built-in benchmark, print one JSON line")
     b.add_argument("case", choices=("rings2d", "rings2d_tl", "block3d"))
-    b.add_argument("--steps", type=int, default=1000)
-    b.add_argument("--threads", type=int, default=0)
-    b.add_argument("--particles", type=int, help="block3d: approximate particle count")
+    b.add_argument("--steps", type=_whole(1), default=1000)
+    b.add_argument("--threads", type=_whole(1), default=None, help="Numba threads (default: automatic)")
+    b.add_argument("--particles", type=_whole(8), help="block3d: approximate particle "
+                   "count (the rings cases have a fixed count)")
     b.set_defaults(func=cmd_bench)
     mt = sub.add_parser("material-test", help="drive one material point along a load "
                         "path; CSV + plot into --out")
@@ -389,13 +527,14 @@ def build_parser() -> argparse.ArgumentParser:
                     help="controlling strain rate [1/s] (default 1e-5)")
     mt.add_argument("--strain", type=float, help="controlling strain magnitude "
                     "(default per path)")
-    mt.add_argument("--steps", type=int, default=400, help="load steps (default 400)")
-    mt.add_argument("--confinement", type=float, default=0.0,
-                    help="triaxial confining pressure [Pa]")
+    mt.add_argument("--steps", type=_whole(1), default=400, help="load steps (default 400)")
+    mt.add_argument("--confinement", type=float,
+                    help="confining pressure [Pa] of --path triaxial (required there)")
     mt.add_argument("--size", type=float, default=0.01,
                     help="particle size for fracture-energy regularisation [m]")
     mt.add_argument("--out", default="out/material-test", help="output directory")
-    mt.add_argument("--threads", type=int, default=1)
+    mt.add_argument("--threads", type=_whole(1), default=None,
+                    help="Numba threads (default 1: one material point)")
     mt.set_defaults(func=cmd_material_test)
     return ap
 
@@ -404,7 +543,10 @@ def main(argv=None) -> int:
     from .deck import DeckError
     from .guards import SimulationFailed
 
-    args = build_parser().parse_args(argv)
+    try:
+        args = build_parser().parse_args(argv)
+    except SystemExit as exc:  # --help, --version, or a bad argument (usage printed)
+        return exc.code if isinstance(exc.code, int) else 2
     try:
         return args.func(args)
     except DeckError as exc:
@@ -412,6 +554,11 @@ def main(argv=None) -> int:
         return 2
     except (FileNotFoundError, ValueError) as exc:
         print(f"sphdyn: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:  # the environment: permissions, a missing device, ...
+        where = f" {exc.filename}" if exc.filename else ""
+        print(f"sphdyn: cannot access{where}: {exc.strerror or exc}. Fix: check that "
+              "the path exists and may be written", file=sys.stderr)
         return 2
     except SimulationFailed as exc:
         print(f"sphdyn: {exc.diagnosis}\nAll output written so far is kept.",

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .geometry import lattice_from_shape, select
+from .geometry import select
 from .heterogeneity.cracks import crack_mask
 from .heterogeneity.mass import body_rng, mass_field
 from .heterogeneity.mesostructure import AGGREGATE, ITZ, MORTAR, generate_phases
@@ -19,6 +19,7 @@ from .heterogeneity.photo import photo_targets
 from .heterogeneity.variation import factor_of, quantise, standard_normal_field, variation_rng
 from .initial import initial_fields
 from .interactions.wall import STIFFNESS, WallSpec
+from .preflight import checked_lattices
 from .materials import get_model
 from .probes import Probe, quantity
 from .state import BC_FIXED, BC_VELOCITY, Particles
@@ -196,8 +197,15 @@ def _apply_initial(deck, body, p: Particles, models: dict, mat_ids, dim: int) ->
 
 
 def build_model(deck) -> Model:
-    """Create the particle model described by a validated deck."""
+    """Create the particle model described by a validated deck.
+
+    Raises :class:`~sphdyn.deck.DeckError` before making any particle if the
+    model would exceed ``run.memory_limit``, and before anything else if
+    bodies overlap, start through a wall or are smaller than their dx
+    (:mod:`sphdyn.preflight`).
+    """
     dim = deck.run.dimension
+    _, lattices = checked_lattices(deck)
     mats = {m.name: m for m in deck.material}
     mat_index = {m.name: k for k, m in enumerate(deck.material)}
     models = {m.name: get_model(m.model) for m in deck.material}
@@ -214,11 +222,8 @@ def build_model(deck) -> Model:
     parts, phase_parts = [], []
     photos, draws, start = {}, {}, 0
     for b, body in enumerate(deck.body):
-        x = lattice_from_shape(body.geometry.model_dump(), body.dx, dim)
+        x = lattices[b]
         n = x.shape[0]
-        if n == 0:
-            raise ValueError(f"body {body.name!r}: its geometry holds no particle at "
-                             f"dx = {body.dx} m; make dx smaller or the shape larger")
         mat = mats[body.material]
         mat_ids, ph = _phase_materials(deck, b, body, x, dim, mat_index, photos)
         phase_parts.append(np.full(n, -1, np.int8) if ph is None else ph)

@@ -163,7 +163,7 @@ class Simulation:
                         m.close()
                     s.monitors.remove(m)
             self._wind_up(t_end, failure)
-            summary = self._summary(start_step, failure, stop.name)
+            summary = self._summary(start_step, failure, stop.name, t_end)
             if tuner is not None:
                 summary["threads"] = tuner.summary()
             try:
@@ -232,7 +232,8 @@ class Simulation:
     def _flush_history(self):
         self.history.write_csv(self.outdir / "history.csv")
 
-    def _summary(self, start_step: int, failure, interrupted: str | None = None) -> dict:
+    def _summary(self, start_step: int, failure, interrupted: str | None,
+                 t_end: float) -> dict:
         s, deck = self.stepper, self.deck
         steps = s.step_count - start_step
         n = sum(part.kin.n for part in s.parts)
@@ -240,7 +241,7 @@ class Simulation:
         h = self.history.as_arrays() if len(self.history.columns) else {}
         if failure is not None:
             status = "failed"
-        elif s.t >= deck.run.t_end * (1 - 1e-12):
+        elif s.t >= t_end * (1 - 1e-12):  # the deck's end or a restart's --t-end
             status = "completed"
         else:
             status = "interrupted" if interrupted else "stopped"

@@ -25,7 +25,8 @@ from pydantic import BeforeValidator, Field, create_model, model_validator
 from .introspect import field_annotation, metadata, strip_optional, variants
 from .scope import SCOPE, scope_of
 from .sections.bodies import Body, Crack, MassField, Mesostructure, Variation
-from .sections.material import MaterialSection
+from .messages import problem
+from .sections.material import MaterialSection, parameter_clashes
 from .sections.output import Output, Probe
 from .sections.run import Domain, Run, Time
 from .sections.sets import Boundary, ParticleSet
@@ -76,6 +77,19 @@ class DeckSections(Section):
             return handler(data)
         finally:
             SCOPE.reset(token)
+
+    @model_validator(mode="after")
+    def _materials_fit_together(self):
+        """Each material's values are accepted together by its model (checked
+        after every table is valid, so a missing key is reported as such)."""
+        clashes = parameter_clashes(self.material)
+        if clashes:
+            k, message = clashes[0]
+            raise problem(f"material[{k}] '{self.material[k].name}': the parameters do "
+                          f"not fit together ({message})",
+                          "change the values named there; docs/deck-reference.md "
+                          "gives each key's meaning and range")
+        return self
 
     def frame_interval(self) -> float:
         """Return the time between output frames [s]."""

@@ -135,3 +135,38 @@ def to_si(value: object, dim: Dimension) -> float:
     if not math.isfinite(result):
         raise QuantityError(f"{value!r} is not finite", dim.hint())
     return result
+
+
+#: Multipliers of the memory-size units accepted by :func:`to_bytes`.
+BYTE_UNITS = {"": 1, "b": 1, "byte": 1, "bytes": 1,
+              "kb": 10**3, "mb": 10**6, "gb": 10**9, "tb": 10**12,
+              "kib": 2**10, "mib": 2**20, "gib": 2**30, "tib": 2**40}
+
+_MEMORY = re.compile(r"\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*([A-Za-z]*)\s*$")
+MEMORY_HINT = "give a size such as '8 GiB', '500 MB' or a number of bytes"
+
+
+def to_bytes(value: object) -> float:
+    """Convert a memory size (``"8 GiB"``, ``"500 MB"`` or a number of bytes) to bytes.
+
+    pint counts bytes as dimensionless, so sizes are read here: decimal
+    (kB, MB, GB, TB) and binary (KiB, MiB, GiB, TiB) prefixes, any case.
+
+    Raises
+    ------
+    QuantityError
+        If the value is not a finite number or such a string.
+    """
+    if isinstance(value, bool) or not isinstance(value, (int, float, str)):
+        raise QuantityError(f"{value!r} is not a memory size", MEMORY_HINT)
+    if isinstance(value, str):
+        match = _MEMORY.match(value)
+        unit = match.group(2).lower() if match else None
+        if unit not in BYTE_UNITS:
+            raise QuantityError(f"'{value}' is not a memory size", MEMORY_HINT)
+        result = float(match.group(1)) * BYTE_UNITS[unit]
+    else:
+        result = float(value)
+    if not math.isfinite(result):
+        raise QuantityError(f"{value!r} is not finite", MEMORY_HINT)
+    return result

@@ -18,7 +18,8 @@ from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict,
 
 from .messages import problem, show, show_number, show_vector, suggest
 from .scope import SCOPE, dimension
-from .units import LENGTH, PRESSURE, VELOCITY, Dimension, QuantityError, to_si
+from .units import (LENGTH, PRESSURE, VELOCITY, Dimension, QuantityError, to_bytes,
+                    to_si)
 
 
 class Section(BaseModel):
@@ -38,6 +39,35 @@ class Quantity:
             return to_si(value, self.dim)
         except QuantityError as exc:
             raise problem(exc.what, exc.fix) from None
+
+
+def memory_size(value: Any) -> float:
+    """Before-validator: a memory size (``"8 GiB"`` or bytes) in bytes."""
+    try:
+        return to_bytes(value)
+    except QuantityError as exc:
+        raise problem(exc.what, exc.fix) from None
+
+
+@dataclass(frozen=True)
+class OnlyIn:
+    """After-validator: a key that means something only in ``dim`` dimensions.
+
+    In a deck of the other dimension the key must be absent (None); ``why``
+    says what the shape is there ("a 2D cylinder is a disc in the x-y
+    plane"). Read by :mod:`sphdyn.deck.docgen` through the metadata.
+    """
+
+    dim: int
+    why: str
+
+    def __call__(self, value: Any) -> Any:
+        actual = dimension()
+        if value is not None and actual is not None and actual != self.dim:
+            raise problem(f"this key means nothing in a {actual}D deck "
+                          f"(run.dimension = {actual}; {self.why})",
+                          f"remove it, or set run.dimension = {self.dim}")
+        return value
 
 
 @dataclass(frozen=True)

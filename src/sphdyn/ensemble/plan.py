@@ -50,6 +50,40 @@ def parse_vary(items) -> list[tuple[str, list[str]]]:
     return grid
 
 
+def validate_grid(deck: str | Path, grid, overrides=()) -> None:
+    """Check every ``--vary`` value (and the ``--set`` overrides) against the schema.
+
+    Each value of each key is validated with the other keys at their first
+    value, so a misspelt key or a value out of range is refused before
+    anything starts; raises :class:`~sphdyn.deck.DeckError` with one line per
+    problem, each naming the ``--vary KEY=VALUE`` it came from.
+    """
+    from ..deck import DeckError, load_deck
+
+    first = {k: v[0] for k, v in grid}
+    trials = [(k, v) for k, values in grid for v in values] or [(None, None)]
+    found = []  # (trial, problem) in order
+    for key, value in trials:
+        items = [f"{k}={v}" for k, v in first.items() if k != key]
+        items += [f"{key}={value}"] if key is not None else []
+        try:
+            load_deck(deck, [*overrides, *items])
+        except DeckError as exc:
+            found += [((key, value), line) for line in exc.problems]
+    problems = []
+    for trial, line in found:  # a problem of every trial is the deck's own
+        everywhere = all((t, line) in found for t in trials)
+        keys = [k for k in first if line.startswith(f"{k}:")]  # the key itself is wrong
+        if not everywhere and trial[0] is not None:
+            text = f"--vary {trial[0]}={trial[1]}: {line}"
+        else:
+            text = f"--vary {keys[0]}: {line}" if keys else line
+        if text not in problems:
+            problems.append(text)
+    if problems:
+        raise DeckError(problems)
+
+
 def _base_seed(deck: Path, overrides, grid) -> int:
     """``run.seed`` of the deck with ``overrides`` and the first grid point.
 
@@ -104,6 +138,7 @@ def plan_samples(deck: str | Path, samples: int, vary=(), out: str | Path = "out
     deck = Path(deck).resolve()
     grid = parse_vary(vary) if vary and isinstance(vary[0], str) else list(vary)
     if base_seed is None:
+        validate_grid(deck, grid, overrides)
         base_seed = _base_seed(deck, overrides, grid)
     keys = [k for k, _ in grid]
     specs = []

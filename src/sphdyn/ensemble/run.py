@@ -163,6 +163,26 @@ def run_ensemble(deck: str | Path, samples: int, vary=(), out: str | Path | None
     return csv_path
 
 
+#: Seconds to wait for a ``--scheduler`` to answer.
+CONNECT_TIMEOUT = 5.0
+
+
+def _connect(scheduler: str):
+    """A Dask client of a running scheduler; a ValueError within
+    :data:`CONNECT_TIMEOUT` seconds if none answers at that address."""
+    from distributed import Client
+
+    try:
+        return Client(scheduler, timeout=CONNECT_TIMEOUT)
+    except (OSError, TimeoutError, ValueError, TypeError) as exc:
+        detail = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise ValueError(
+            f"--scheduler {scheduler}: no Dask scheduler answered within "
+            f"{CONNECT_TIMEOUT:g} s ({detail}). Fix: start one (`dask scheduler`) and "
+            "give its address, e.g. tcp://host:8786, or leave out --scheduler for a "
+            "local cluster") from None
+
+
 def _run_on_dask(todo, scheduler, n_workers, n_threads, progress, log) -> None:
     from distributed import Client, as_completed
 
@@ -174,7 +194,7 @@ def _run_on_dask(todo, scheduler, n_workers, n_threads, progress, log) -> None:
         log(f"  local Dask cluster: {n_workers} worker process(es) x {n_threads} "
             "Numba thread(s)")
     else:
-        client = Client(scheduler)
+        client = _connect(scheduler)
         log(f"  Dask scheduler {scheduler}: "
             f"{len(client.scheduler_info().get('workers', {}))} worker(s), "
             f"{n_threads} Numba thread(s) per sample")

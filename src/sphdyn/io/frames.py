@@ -247,6 +247,9 @@ def export_csv(outdir: str | os.PathLike, frame: int = -1,
     frames = list_frames(outdir)
     if not frames:
         raise FileNotFoundError(f"no frames in {outdir / FRAMES_DIR}")
+    if not -len(frames) <= frame < len(frames):
+        raise ValueError(f"frame {frame}: {outdir} has {len(frames)} frames. Fix: give "
+                         f"--frame from 0 to {len(frames) - 1}, or -1 for the last")
     src = frames[frame]
     _, _, fields, _ = read_frame(src)
     header: list[str] = []

@@ -218,12 +218,19 @@ def drive(model_name: str, params: dict, path: str, *, strain: float | None = No
         ``t`` (n+1,) [s]; ``strain``, ``stress`` (n+1, 6) [-, Pa] in the
         order ``xx, yy, zz, xy, yz, xz`` (tensor shear); ``damage`` (n+1,);
         ``history`` (n+1, nh) and ``history_names``; ``x``, ``y`` the
-        controlling strain and stress component (for plots); ``files``.
+        plotted strain and stress (for hydrostatic: volumetric strain and
+        pressure, compression positive; for shear: engineering gamma);
+        ``columns`` the components (``"xx"``, ``"xy"``) of the CSV's strain
+        and stress columns that control the path (signed, tension
+        positive); ``files``.
     """
     if path not in PATHS:
         raise ValueError(f"unknown path {path!r}; choose one of {', '.join(PATHS)}")
     if not rate > 0.0:
         raise ValueError(f"rate must be > 0, got {rate}")
+    if not confinement >= 0.0:
+        raise ValueError(f"confinement must be >= 0 (a compressive pressure), got "
+                         f"{confinement}")
     model = get_model(model_name)
     p = model.pack(dict(params))
     pt = _Point(model, p, size)
@@ -267,6 +274,7 @@ def drive(model_name: str, params: dict, path: str, *, strain: float | None = No
         "history_names": list(model.history_names), "model": model_name, "path": path,
     }
     comp = 3 if path == "shear" else 0
+    res["columns"] = (COMPONENTS[comp], COMPONENTS[comp])  # CSV strain, stress columns
     if path == "hydrostatic":
         res["x"] = -res["strain"][:, :3].sum(axis=1)
         res["y"] = -res["stress"][:, :3].mean(axis=1)

@@ -369,3 +369,20 @@ class Body(Section):
     initial: Optional[InitialFields] = Field(
         None, description="Initial velocity and stress varying with position "
                           "(expressions or a file).")
+
+    @model_validator(mode="after")
+    def _mesostructure_resolved(self):
+        """The aggregate and the ITZ must be resolved by the body's dx."""
+        ms = self.mesostructure
+        if ms is None:
+            return self
+        if ms.max_aggregate_size is not None and ms.max_aggregate_size < 2 * self.dx:
+            raise problem(f"mesostructure.max_aggregate_size "
+                          f"{show_number(ms.max_aggregate_size)} m is below 2 dx = "
+                          f"{show_number(2 * self.dx)} m",
+                          "refine dx or give a larger max_aggregate_size")
+        if 0 < ms.itz_thickness < self.dx * (1 - 1e-9):
+            raise problem(f"mesostructure.itz_thickness {show_number(ms.itz_thickness)} "
+                          f"m is below dx = {show_number(self.dx)} m",
+                          "give itz_thickness = 0 (no ITZ) or at least dx, or refine dx")
+        return self

@@ -56,3 +56,21 @@ class MaterialSection(Section):
                           "the material (its default is generated)",
                           f"give {var.parameter} explicitly to vary it")
         return self
+
+
+def parameter_clashes(materials) -> list[tuple[int, str]]:
+    """``(index, message)`` of validated materials whose model refuses the values
+    together (``pack`` raises, e.g. CSCM surfaces that do not meet)."""
+    from ...materials.registry import available_models, get_model
+
+    clashes = []
+    for k, mat in enumerate(materials):
+        if mat.model not in available_models():
+            continue
+        values = {key: v for key, v in mat.model_dump().items()
+                  if key not in ("name", "model", "variation") and v is not None}
+        try:
+            get_model(mat.model).pack(values)
+        except ValueError as exc:
+            clashes.append((k, str(exc)))
+    return clashes

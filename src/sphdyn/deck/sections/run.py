@@ -1,11 +1,12 @@
 """Deck sections [run], [time] and [domain]: what is simulated, how it steps."""
 
-from typing import Literal, Optional
+from typing import Annotated, Literal, Optional
 
-from pydantic import Field, StrictStr
+from pydantic import AfterValidator, BeforeValidator, Field, StrictStr
 
 from ..units import TIME
-from ..values import Position, Section, UpperPosition, integer, quantity, real
+from ..values import (Bounds, Position, Section, UpperPosition, integer, memory_size,
+                      quantity, real)
 
 
 class Run(Section):
@@ -21,6 +22,14 @@ class Run(Section):
     seed: integer("seed", lo=0) = Field(
         0, description="Seed of the random number generator (lattice "
                        "jitter, random material properties).")
+    memory_limit: Optional[Annotated[float, BeforeValidator(memory_size), AfterValidator(
+        Bounds(lo=0, lo_open=True, noun="memory size"))]] = Field(
+        None, description="Largest model the deck may build, e.g. \"8 GiB\" (decimal "
+                          "kB, MB, GB or binary KiB, MiB, GiB; a number is bytes). "
+                          "The particle count and memory are estimated from the "
+                          "geometry before any particle is made (`sphdyn check` "
+                          "prints them); a larger model is refused. Absent: half "
+                          "of this machine's memory.")
 
 
 class Time(Section):

@@ -7,7 +7,7 @@ from pydantic import AfterValidator, Field, ValidationInfo, field_validator
 from ..messages import problem, show_number
 from ..scope import dimension
 from ..units import LENGTH
-from ..values import (Axis, Corner, Direction, Position, PositiveLength, Section,
+from ..values import (Axis, Corner, Direction, OnlyIn, Position, PositiveLength, Section,
                       UpperCorner, UpperPosition, quantity)
 
 
@@ -43,7 +43,9 @@ def _length_in_3d(length: Optional[float]) -> Optional[float]:
 
 
 PlanarAxis = Annotated[Axis, AfterValidator(_axis_in_plane)]
-AxialLength = Annotated[Optional[PositiveLength], AfterValidator(_length_in_3d)]
+AxialLength = Annotated[Optional[PositiveLength], AfterValidator(_length_in_3d),
+                        AfterValidator(OnlyIn(3, "a cylinder or ring is then a disc or "
+                                                 "annulus in the x-y plane, per unit depth"))]
 
 
 class Cylinder(Section):
@@ -54,7 +56,7 @@ class Cylinder(Section):
     radius: PositiveLength = Field(description="Radius.")
     length: AxialLength = Field(
         None, validate_default=True,
-        description="Length along the axis; required in 3D, ignored in 2D.")
+        description="Length along the axis; required in 3D, not allowed in 2D.")
     axis: PlanarAxis = Field("z", description="Axis direction; must be z "
                                               "in 2D.")
 
@@ -70,7 +72,7 @@ class Ring(Section):
         description="Outer radius, greater than inner_radius.")
     length: AxialLength = Field(
         None, validate_default=True,
-        description="Length along the axis; required in 3D, ignored in 2D.")
+        description="Length along the axis; required in 3D, not allowed in 2D.")
     axis: PlanarAxis = Field("z", description="Axis direction; must be z "
                                               "in 2D.")
 
@@ -117,7 +119,18 @@ class CylinderRegion(Section):
     radius: PositiveLength = Field(description="Radius.")
     axis: Axis = Field("z", description="Axis direction.")
     length: Optional[PositiveLength] = Field(
-        None, description="Length along the axis (absent: infinite).")
+        None, description="Length along the axis (absent: infinite); not allowed "
+                          "with axis = \"z\" in 2D.")
+
+    @field_validator("length")
+    @classmethod
+    def _length_along_a_plane_axis(cls, length, info: ValidationInfo):
+        if length is not None and dimension() == 2 and info.data.get("axis") == "z":
+            raise problem("a length along axis z means nothing in a 2D deck (every "
+                          "particle lies in the plane z = 0)",
+                          "remove length, or use axis = \"x\" or \"y\" to cut the "
+                          "region along the plane")
+        return length
 
 
 class HalfSpace(Section):

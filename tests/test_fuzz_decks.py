@@ -1,0 +1,221 @@
+"""Fuzzing the deck: mutated example decks end in status 0 or 2, never a traceback.
+
+Every example deck is mutated deterministically (one mutation per case,
+seeded by the case number): a key deleted or renamed, a value of the wrong
+type or unit, negative, zero, huge or not finite, a table emptied, a body
+duplicated, nonsense text, a file reference to a missing file. Each mutated
+deck goes through ``sphdyn check`` in-process: it must return 0, or 2 with a
+one-paragraph message that names a field and a fix; no exception may escape.
+A few accepted ones also run two steps.
+"""
+
+import math
+import random
+from pathlib import Path
+
+import pytest
+import tomli_w
+import tomllib
+
+from sphdyn.cli import main
+
+EXAMPLES = sorted((Path(__file__).parent.parent / "examples").glob("*.toml"))
+#: Every fuzzed deck may build at most this much (a mutation such as a
+#: halved dx must not make the test build a model of gigabytes).
+MEMORY_LIMIT = "150 MB"
+N_CASES = 224
+
+
+def _paths(node, prefix=()):
+    """Every key path of a parsed TOML document: tables, lists and leaves."""
+    if isinstance(node, dict):
+        for key, value in node.items():
+            yield prefix + (key,)
+            yield from _paths(value, prefix + (key,))
+    elif isinstance(node, list):
+        for i, value in enumerate(node):
+            if isinstance(value, (dict, list)):
+                yield from _paths(value, prefix + (i,))
+
+
+def _parent(doc, path):
+    node = doc
+    for key in path[:-1]:
+        node = node[key]
+    return node
+
+
+def _leaves(doc, kinds):
+    return [p for p in _paths(doc) if isinstance(_parent(doc, p)[p[-1]], kinds)]
+
+
+def _set(doc, path, value):
+    _parent(doc, path)[path[-1]] = value
+
+
+def _delete(doc, rng):
+    path = rng.choice(list(_paths(doc)))
+    del _parent(doc, path)[path[-1]]
+
+
+def _rename(doc, rng):
+    path = rng.choice([p for p in _paths(doc) if isinstance(p[-1], str)])
+    parent = _parent(doc, path)
+    key = path[-1]
+    new = rng.choice([key + "s", key[:-1], key.upper(), key.replace("_", "-") + "_"])
+    parent[new if new != key else key + "x"] = parent.pop(key)
+
+
+def _wrong_type(doc, rng):
+    path = rng.choice(list(_paths(doc)))
+    value = _parent(doc, path)[path[-1]]
+    options = {dict: ["table?", 3, [1, 2]], list: [3, "list?", {"a": 1}],
+               str: [5, True, [1, "a"]], bool: ["yes", 1.5], int: ["two", 2.5, [2]],
+               float: ["0.5 parsecs?", False, {"x": 1}]}
+    _set(doc, path, rng.choice(options.get(type(value), ["?"])))
+
+
+def _wrong_unit(doc, rng):
+    candidates = _leaves(doc, (str,)) or _leaves(doc, (int, float))
+    path = rng.choice(candidates)
+    _set(doc, path, rng.choice(["3 MPa", "12 kg", "5 m/s", "2 ms", "7 furlongs",
+                                "4 mm/K", "1 GiB"]))
+
+
+def _number(value_of):
+    """A mutation that sets a numeric leaf (or a unit string's number) to ``value_of(x)``."""
+    def mutate(doc, rng):
+        candidates = _leaves(doc, (int, float, str))
+        path = rng.choice(candidates)
+        old = _parent(doc, path)[path[-1]]
+        if isinstance(old, str):
+            number, _, unit = old.partition(" ")
+            try:
+                x = float(number)
+            except ValueError:
+                x = 1.0
+            new = value_of(x)
+            _set(doc, path, f"{new:g} {unit}".strip() if isinstance(new, float)
+                 and math.isfinite(new) else new)
+        else:
+            _set(doc, path, value_of(float(old)) if not isinstance(old, bool) else 0)
+    return mutate
+
+
+def _empty_table(doc, rng):
+    path = rng.choice([p for p in _paths(doc)
+                       if isinstance(_parent(doc, p)[p[-1]], (dict, list))])
+    value = _parent(doc, path)[path[-1]]
+    _set(doc, path, {} if isinstance(value, dict) else [])
+
+
+def _duplicate_body(doc, rng):
+    bodies = doc.get("body") or [{}]
+    doc.setdefault("body", []).append(dict(rng.choice(bodies)))
+
+
+def _nonsense(doc, rng):
+    path = rng.choice(list(_paths(doc)))
+    _set(doc, path, rng.choice(["\u2603 snow", "", " ", "NaN", "1e999 mm", "-0",
+                                "mm 5", "${HOME}", "0x1F", "null"]))
+
+
+def _missing_file(doc, rng):
+    bodies = doc.get("body") or []
+    if bodies and isinstance(bodies[0], dict):
+        bodies[0]["mesostructure"] = {"photo": "no/such/section.png",
+                                      "pixel_size": "0.1 mm"}
+    else:
+        doc["body"] = [{"mesostructure": {"photo": "missing.png"}}]
+
+
+MUTATIONS = {
+    "delete": _delete, "rename": _rename, "wrong_type": _wrong_type,
+    "wrong_unit": _wrong_unit, "negative": _number(lambda x: -abs(x) - 1.0),
+    "zero": _number(lambda x: 0.0), "huge": _number(lambda x: 1e300),
+    "tiny": _number(lambda x: 1e-300), "not_finite": _number(lambda x: math.inf),
+    "empty_table": _empty_table, "duplicate_body": _duplicate_body,
+    "nonsense": _nonsense, "missing_file": _missing_file,
+}
+
+
+def mutated_deck(case: int) -> tuple[str, dict]:
+    """``(description, document)`` of fuzz case ``case`` (deterministic)."""
+    rng = random.Random(20261124 + case)
+    example = EXAMPLES[case % len(EXAMPLES)]
+    name = list(MUTATIONS)[(case // len(EXAMPLES)) % len(MUTATIONS)]
+    doc = tomllib.loads(example.read_text(encoding="utf-8"))
+    MUTATIONS[name](doc, rng)
+    if isinstance(doc.get("run"), dict):
+        doc["run"]["memory_limit"] = MEMORY_LIMIT
+    return f"{example.stem}:{name}", doc
+
+
+def _write(doc, path: Path) -> bool:
+    """Write the document; False if TOML cannot hold it (e.g. an empty key)."""
+    try:
+        path.write_text(tomli_w.dumps(doc), encoding="utf-8")
+    except (TypeError, ValueError):
+        return False
+    return True
+
+
+def _assert_one_paragraph(err: str, what: str):
+    text = err.strip()
+    assert text, f"{what}: status 2 without a message"
+    assert "Traceback" not in text and "\n\n" not in text, f"{what}:\n{err}"
+    assert "Fix:" in text or "error:" in text, f"{what}: no fix named:\n{err}"
+
+
+@pytest.fixture(scope="module")
+def checked(tmp_path_factory):
+    """Every case through ``sphdyn check``: case -> (description, path, status)."""
+    base = tmp_path_factory.mktemp("fuzz")
+    results = {}
+    for case in range(N_CASES):
+        what, doc = mutated_deck(case)
+        path = base / f"case_{case:03d}.toml"
+        if not _write(doc, path):
+            continue
+        results[case] = (what, path, None)
+    return base, results
+
+
+def test_at_least_200_mutated_decks_end_in_0_or_2_with_one_paragraph(checked, capsys):
+    _, results = checked
+    assert len(results) >= 200
+    statuses, failures = {}, []
+    for case, (what, path, _) in sorted(results.items()):
+        try:
+            rc = main(["check", str(path)])
+            err = capsys.readouterr().err
+            assert rc in (0, 2), f"case {case} {what}: status {rc}\n{err}"
+            if rc == 2:
+                _assert_one_paragraph(err, f"case {case} {what}")
+        except Exception as exc:  # noqa: BLE001 -- every failure listed at once
+            failures.append(f"case {case} {what}: {type(exc).__name__}: {exc}")
+            continue
+        results[case] = (what, path, rc)
+        statuses[rc] = statuses.get(rc, 0) + 1
+    assert not failures, "\n".join(failures)
+    assert statuses.get(2, 0) > 100  # most mutations are caught
+
+
+def test_a_few_accepted_mutants_run_two_steps(checked, capsys):
+    base, results = checked
+    small = ("elastic_disc_bounce", "ucs_homogeneous", "two_boxes_close",
+             "rings_gray2001")
+    runnable = [(case, what, path) for case, (what, path, rc) in sorted(results.items())
+                if rc in (0, None) and what.split(":")[0] in small]
+    ran = 0
+    for case, what, path in runnable:
+        if main(["check", str(path)]) != 0:
+            continue
+        rc = main(["run", str(path), "--out", str(base / f"run_{case:03d}"),
+                   "--max-steps", "2", "-q"])
+        err = capsys.readouterr().err
+        assert rc in (0, 1), f"case {case} {what}: status {rc}\n{err}"
+        ran += 1
+        if ran == 10:
+            break
+    assert ran >= 5
