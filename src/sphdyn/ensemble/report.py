@@ -87,6 +87,16 @@ def _final_frame(sample_dir: Path):
 def plot_damage_grid(out: str | Path, recs: list[dict] | None = None,
                      keys: list[str] | None = None, path: str | Path | None = None
                      ) -> Path | None:
+    """Write :func:`damage_grid_figure` to ``path`` (default
+    ``OUT/ensemble_damage.png``); None if no sample has a frame."""
+    fig = damage_grid_figure(out, recs, keys)
+    if fig is None:
+        return None
+    return save_figure(fig, Path(path) if path else Path(out) / FIGURE)
+
+
+def damage_grid_figure(out: str | Path, recs: list[dict] | None = None,
+                       keys: list[str] | None = None):
     """Final damage of every sample, one panel each (paper Figs. 8-10, 13).
 
     Rows are the points of the ``--vary`` grid, columns the replicates.
@@ -97,8 +107,8 @@ def plot_damage_grid(out: str | Path, recs: list[dict] | None = None,
     that look like cracks), grey intact to black failed as in the paper, on
     one colour bar; zero-mass particles (initial cracks) are left out, so
     they show as gaps. All panels share their x and y axes [mm].
-    Needs ``damage`` among the output fields. Returns None if no sample has a
-    frame.
+    Needs ``damage`` among the output fields. Returns the (unsaved) figure,
+    or None if no sample has a frame.
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.collections import PolyCollection
@@ -179,8 +189,7 @@ def plot_damage_grid(out: str | Path, recs: list[dict] | None = None,
     if collection is not None:
         fig.colorbar(collection, ax=axes.ravel().tolist(), label="damage [-]",
                      shrink=0.8, aspect=30)
-    path = Path(path) if path else out / FIGURE
-    return save_figure(fig, path)
+    return fig
 
 
 def plot_mass_histograms(sim, outdir: str | Path) -> list[Path]:
