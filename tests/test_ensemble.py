@@ -164,6 +164,7 @@ def test_mass_histogram_plots_the_field_the_model_drew(text, tmp_path, monkeypat
     paths = plot_mass_histograms(sim, tmp_path / "run")
     assert paths == [tmp_path / "run" / "plots" / "mass_histogram.png"]
     assert paths[0].stat().st_size > 5000
+    assert drawn[0][1]["dimension"] == sim.deck.run.dimension
     (masses, kw), = drawn
     (draw,) = sim.model.mass_draws.values()
     p = sim.particles

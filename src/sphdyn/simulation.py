@@ -209,7 +209,7 @@ class Simulation:
                 print(f"warning: {exc}")
         try:
             plot_history(self.outdir / "history.csv", self.outdir / "plots",
-                         self.deck.output.force_window)
+                         self.deck.output.force_window, self.deck.run.dimension, t_end)
         except Exception as exc:  # plots must never lose a run
             print(f"warning: plotting failed: {exc}")
 

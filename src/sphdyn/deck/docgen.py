@@ -31,7 +31,7 @@ EXAMPLE = """\
 [run]
 title = "Rubber disc bouncing on a rigid floor"
 dimension = 2                 # plane strain, per unit depth
-t_end = "2 ms"
+t_end = "1 ms"                # impact and rebound, inside the guard box
 
 [sph]
 kernel = "cubic_spline"

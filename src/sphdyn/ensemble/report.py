@@ -21,6 +21,8 @@ from ..io.plots import save_figure
 from .plan import RESULT
 
 TABLE = "ensemble.csv"
+#: Side of a particle's square in the damage grid, in particle spacings.
+SQUARE = 1.15
 FIGURE = "ensemble_damage.png"
 
 #: Columns of ``ensemble.csv`` after the sample, replicate, seed and vary keys.
@@ -85,20 +87,36 @@ def _final_frame(sample_dir: Path):
 def plot_damage_grid(out: str | Path, recs: list[dict] | None = None,
                      keys: list[str] | None = None, path: str | Path | None = None
                      ) -> Path | None:
+    """Write :func:`damage_grid_figure` to ``path`` (default
+    ``OUT/ensemble_damage.png``); None if no sample has a frame."""
+    fig = damage_grid_figure(out, recs, keys)
+    if fig is None:
+        return None
+    return save_figure(fig, Path(path) if path else Path(out) / FIGURE)
+
+
+def damage_grid_figure(out: str | Path, recs: list[dict] | None = None,
+                       keys: list[str] | None = None):
     """Final damage of every sample, one panel each (paper Figs. 8-10, 13).
 
     Rows are the points of the ``--vary`` grid, columns the replicates.
     Particles at their final positions (x-y plane; in 3D all particles,
-    the most damaged drawn on top, so a crack through the depth shows),
-    grey intact to black failed as in the paper; zero-mass particles (initial
-    cracks) are left out, so they show as gaps. Needs ``damage`` among the
-    output fields. Returns None if no sample has a frame.
+    the most damaged drawn on top, so a crack through the depth shows), each
+    a filled square :data:`SQUARE` particle spacings wide (so the small
+    openings of a jittered or heterogeneous lattice do not draw white lines
+    that look like cracks), grey intact to black failed as in the paper, on
+    one colour bar; zero-mass particles (initial cracks) are left out, so
+    they show as gaps. All panels share their x and y axes [mm].
+    Needs ``damage`` among the output fields. Returns the (unsaved) figure,
+    or None if no sample has a frame.
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.colors import LinearSegmentedColormap
+    from matplotlib.collections import PolyCollection
+    from matplotlib.colors import LinearSegmentedColormap, Normalize
     from matplotlib.figure import Figure
 
-    from ..io.snapshots import particle_spacing
+    from ..io.plots import time_unit
+    from ..io.snapshots import particle_spacing, particle_squares
 
     out = Path(out)
     recs = _records(out) if recs is None else recs
@@ -110,54 +128,68 @@ def plot_damage_grid(out: str | Path, recs: list[dict] | None = None,
     ncol = max(len(v) for v in rows.values()) if rows else 0
     if not ncol:
         return None
-    cmap = LinearSegmentedColormap.from_list("damage", [(0.72, 0.72, 0.72), (0, 0, 0)])
-    size = 2.4
-    fig = Figure(figsize=(size * ncol + 0.8, size * len(rows) + 0.4), dpi=110)
-    FigureCanvasAgg(fig)
-    drawn = 0
-    squares = []  # (axes, scatter, spacing [mm]): squares sized once laid out
-    for i, (point, items) in enumerate(rows.items()):
-        label = ", ".join(f"{k} = {v}" for k, v in zip(keys, point))
+    panels = {}  # (row, col) -> (time, xy [mm], damage, square side [mm])
+    for i, items in enumerate(rows.values()):
         for j, r in enumerate(items):
-            ax = fig.add_subplot(len(rows), ncol, i * ncol + j + 1)
-            ax.set_xticks([])
-            ax.set_yticks([])
-            ax.set_aspect("equal")
-            frame = _final_frame(Path(out) / Path(r.get("dir", "")).name)
-            status = r.get("status", "?")
-            title = f"#{r.get('sample')} seed {r.get('seed', '?')}"
+            frame = _final_frame(out / Path(r.get("dir", "")).name)
             if frame is None or "damage" not in frame[2]:
-                ax.set_title(f"{title}\n{status}", fontsize=7)
                 continue
             t, _, f, _ = frame
             keep = f["mass"] > 0 if "mass" in f else np.ones(len(f["damage"]), bool)
             order = np.argsort(f["damage"][keep], kind="stable")
-            xy = f["position"][keep][order] * 1e3
-            ext = max(np.ptp(xy[:, 0]), np.ptp(xy[:, 1]), 1e-9)
             dim = 2 if np.ptp(f["position"][:, 2]) == 0 else 3
-            dots = ax.scatter(xy[:, 0], xy[:, 1], c=f["damage"][keep][order], cmap=cmap,
-                              vmin=0, vmax=1, marker="s", linewidths=0)
-            squares.append((ax, dots, particle_spacing(f["position"][keep], dim) * 1e3))
-            ax.set_xlim(xy[:, 0].min() - 0.05 * ext, xy[:, 0].max() + 0.05 * ext)
-            ax.set_ylim(xy[:, 1].min() - 0.05 * ext, xy[:, 1].max() + 0.05 * ext)
-            cracks = r.get("main_cracks", "?")
-            ax.set_title(f"{title}, {cracks} main\n"
-                         f"{status} t = {t * 1e6:.0f} us", fontsize=7)
-            if j == 0 and label:
-                ax.set_ylabel(label, fontsize=8)
-            drawn += 1
-    if not drawn:
+            panels[i, j] = (t, f["position"][keep][order, :2] * 1e3,
+                            f["damage"][keep][order],
+                            SQUARE * particle_spacing(f["position"][keep], dim) * 1e3)
+    if not panels:
         return None
-    fig.tight_layout()
-    for ax, dots, spacing in squares:
-        # one particle spacing in points, from the axes' final size, so the
-        # squares tile the lattice without gaps or overlap
-        ax.apply_aspect()
-        width_pt = ax.get_position().width * fig.get_figwidth() * 72
-        side = spacing * width_pt / np.ptp(ax.get_xlim())
-        dots.set_sizes([side ** 2])
-    path = Path(path) if path else out / FIGURE
-    return save_figure(fig, path)
+    allxy = np.concatenate([p[1] for p in panels.values()])
+    pad = 0.5 * max(p[3] for p in panels.values()) + 0.03 * np.ptp(allxy, axis=0).max()
+    lo, hi = allxy.min(axis=0) - pad, allxy.max(axis=0) + pad
+    t_factor, t_unit = time_unit(max(p[0] for p in panels.values()))
+
+    cmap = LinearSegmentedColormap.from_list("damage", [(0.72, 0.72, 0.72), (0, 0, 0)])
+    norm = Normalize(0.0, 1.0)
+    size = 2.4
+    panel_h = size * (hi[1] - lo[1]) / (hi[0] - lo[0])
+    fig = Figure(figsize=(size * ncol + 1.6, (panel_h + 0.55) * len(rows) + 0.4),
+                 dpi=110, layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(len(rows), ncol, sharex=True, sharey=True, squeeze=False)
+    collection = None
+    for i, (point, items) in enumerate(rows.items()):
+        label = "\n".join(f"{k} = {v}" for k, v in zip(keys, point))
+        for j in range(ncol):
+            ax = axes[i, j]
+            if j >= len(items):
+                ax.set_visible(False)
+                continue
+            r = items[j]
+            ax.set_xlim(lo[0], hi[0])
+            ax.set_ylim(lo[1], hi[1])
+            ax.set_aspect("equal")
+            title = f"#{r.get('sample')} seed {r.get('seed', '?')}"
+            status = r.get("status", "?")
+            if (i, j) not in panels:
+                ax.set_title(f"{title}\n{status}", fontsize=7)
+                continue
+            t, xy, damage, side = panels[i, j]
+            collection = PolyCollection(particle_squares(xy, side), cmap=cmap,
+                                        norm=norm, edgecolors="face", linewidths=0.4)
+            collection.set_array(damage)
+            ax.add_collection(collection)
+            ax.set_title(f"{title}, {r.get('main_cracks', '?')} main\n"
+                         f"{status} t = {t * t_factor:.4g} {t_unit}", fontsize=7)
+            ax.tick_params(labelsize=7)
+        axes[i, 0].set_ylabel((label + "\n" if label else "") + "y [mm]", fontsize=8)
+    for j in range(ncol):  # x label under the lowest visible panel of each column
+        visible = [i for i in range(len(rows)) if axes[i, j].get_visible()]
+        axes[visible[-1], j].set_xlabel("x [mm]", fontsize=8)
+        axes[visible[-1], j].xaxis.set_tick_params(labelbottom=True)
+    if collection is not None:
+        fig.colorbar(collection, ax=axes.ravel().tolist(), label="damage [-]",
+                     shrink=0.8, aspect=30)
+    return fig
 
 
 def plot_mass_histograms(sim, outdir: str | Path) -> list[Path]:
@@ -185,5 +217,5 @@ def plot_mass_histograms(sim, outdir: str | Path) -> list[Path]:
         paths.append(plot_mass_histogram(
             draw.m0 * draw.factors * draw.scale, Path(outdir) / "plots" / name,
             law=distribution(draw.spec), m0=draw.m0, scale=draw.scale,
-            title=f"{body.name}: {draw.spec['distribution']} masses, seed {seed}"))
+            dimension=sim.deck.run.dimension, title=f"{body.name}: {draw.spec['distribution']} masses, seed {seed}"))
     return paths

@@ -57,7 +57,8 @@ from sphdyn.heterogeneity.noise import cellular, fbm, grid_points
 __all__ = ["MORTAR", "AGGREGATE", "ITZ", "SHAPES", "fuller_grading",
            "generate_phase_grid", "generate_phases", "particle_grid",
            "equivalent_diameters", "roundness", "PhaseStatistics",
-           "phase_statistics", "save_phase_slices"]
+           "phase_statistics", "save_phase_slices", "phase_slice_figure",
+           "PHASE_NAMES"]
 
 MORTAR = np.int8(0)
 AGGREGATE = np.int8(1)
@@ -450,6 +451,8 @@ def phase_statistics(phases, dx: float, *, x=None, mask=None
 
 
 _COLOURS = ((0.80, 0.78, 0.72), (0.35, 0.35, 0.40), (0.85, 0.35, 0.20))
+#: Legend name of each phase (index = phase value).
+PHASE_NAMES = ("mortar", "aggregate", "ITZ")
 
 
 def _rgb(grid2d, mask2d=None):
@@ -459,18 +462,20 @@ def _rgb(grid2d, mask2d=None):
     return img
 
 
-def save_phase_slices(phases, path, dx: float, *, x=None, index=None,
-                      title: str | None = None) -> Path:
-    """PNG of three orthogonal mid-slices of a 3D phase field (one panel in
-    2D). ``phases``: a phase grid, or particle phases (N,) with ``x``
-    (N, 3) (mapped with :func:`particle_grid`; empty voxels white).
-    ``index``: voxel (i, j, k) the slices pass through (default centre).
-    Colours: mortar light grey, aggregate dark grey, ITZ orange."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+def phase_slice_figure(phases, dx: float, *, x=None, index=None,
+                       title: str | None = None, panel_inches: float = 5.0):
+    """Figure (unsaved) of three orthogonal mid-slices of a 3D phase field
+    (one panel in 2D), with a legend of the phases present.
 
-    from sphdyn.io.plots import save_figure
+    ``phases``: a phase grid, or particle phases (N,) with ``x`` (N, 3)
+    (mapped with :func:`particle_grid`; voxels without a particle white,
+    "no particle" in the legend). ``index``: voxel (i, j, k) the slices pass
+    through (default centre). Colours: mortar light grey, aggregate dark
+    grey, ITZ orange. The longer side of each panel is ``panel_inches``.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    from matplotlib.patches import Patch
 
     phases = np.asarray(phases)
     mask = None
@@ -483,25 +488,48 @@ def save_phase_slices(phases, path, dx: float, *, x=None, index=None,
     if mask is None:
         mask = np.ones(phases.shape, dtype=bool)
     if phases.ndim == 2:
-        panels = [("x-y", phases, mask, phases.shape)]
+        panels = [("xy", "", phases, mask)]
     else:
         c = [s // 2 for s in phases.shape] if index is None else list(index)
-        panels = [("x-y (z = %.4g m)" % (c[2] * dx), phases[:, :, c[2]],
-                   mask[:, :, c[2]], None),
-                  ("x-z (y = %.4g m)" % (c[1] * dx), phases[:, c[1], :],
-                   mask[:, c[1], :], None),
-                  ("y-z (x = %.4g m)" % (c[0] * dx), phases[c[0], :, :],
-                   mask[c[0], :, :], None)]
-    fig, axes = plt.subplots(1, len(panels), figsize=(3.6 * len(panels), 3.6),
-                             squeeze=False)
-    for ax, (name, g, m, _) in zip(axes[0], panels):
+        panels = [("xy", f"z = {c[2] * dx * 1e3:.4g} mm", phases[:, :, c[2]],
+                   mask[:, :, c[2]]),
+                  ("xz", f"y = {c[1] * dx * 1e3:.4g} mm", phases[:, c[1], :],
+                   mask[:, c[1], :]),
+                  ("yz", f"x = {c[0] * dx * 1e3:.4g} mm", phases[c[0], :, :],
+                   mask[c[0], :, :])]
+    sizes = [(g.shape[0], g.shape[1]) for _, _, g, _ in panels]
+    scale = panel_inches / max(max(s) for s in sizes)
+    width = sum(w * scale for w, _ in sizes) + 0.8 * len(panels) + 1.3
+    height = max(h * scale for _, h in sizes) + 1.4
+    fig = Figure(figsize=(width, height), layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(1, len(panels), squeeze=False,
+                        width_ratios=[w for w, _ in sizes])[0]
+    for ax, (plane, where, g, m) in zip(axes, panels):
         ax.imshow(np.transpose(_rgb(g, m), (1, 0, 2)), origin="lower",
                   extent=(0, g.shape[0] * dx * 1e3, 0, g.shape[1] * dx * 1e3),
                   interpolation="nearest")
-        ax.set_title(name, fontsize=9)
-        ax.set_xlabel("mm", fontsize=8)
-        ax.tick_params(labelsize=7)
+        ax.set_title(f"{plane[0]}-{plane[1]}" + (f" ({where})" if where else ""),
+                     fontsize=10)
+        ax.set_xlabel(f"{plane[0]} [mm]", fontsize=9)
+        ax.set_ylabel(f"{plane[1]} [mm]", fontsize=9)
+        ax.tick_params(labelsize=8)
+    present = set(np.unique(phases[mask]).tolist())
+    handles = [Patch(facecolor=_COLOURS[k], edgecolor="0.3", label=name)
+               for k, name in enumerate(PHASE_NAMES) if k in present]
+    if not mask.all():
+        handles.append(Patch(facecolor="white", edgecolor="0.3", label="no particle"))
+    fig.legend(handles=handles, loc="outside right center", title="phase",
+               fontsize=9, title_fontsize=9)
     if title:
-        fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
-    return save_figure(fig, path, 90)
+        fig.suptitle(title, fontsize=11)
+    return fig
+
+
+def save_phase_slices(phases, path, dx: float, *, x=None, index=None,
+                      title: str | None = None) -> Path:
+    """PNG of :func:`phase_slice_figure` (mid-slices with a phase legend)."""
+    from sphdyn.io.plots import save_figure
+
+    fig = phase_slice_figure(phases, dx, x=x, index=index, title=title)
+    return save_figure(fig, path, 110)

@@ -11,13 +11,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.plots import save_figure
+from ..io.plots import per_depth, save_figure
 
 __all__ = ["plot_mass_histogram"]
 
 
 def plot_mass_histogram(masses, path, bins: int = 40, law=None, scale: float = 1.0,
-                        m0: float | None = None, title: str = "") -> Path:
+                        m0: float | None = None, title: str = "",
+                        dimension: int | None = None) -> Path:
     """Histogram of particle masses (paper Fig. 5), in grams.
 
     Parameters
@@ -27,6 +28,8 @@ def plot_mass_histogram(masses, path, bins: int = 40, law=None, scale: float = 1
     law : optional law of the mass factors (``mass.distribution(spec)``); its
         density, mapped to masses by ``m = m0 * scale * f``, is drawn over the
         histogram (needs ``m0``).
+    dimension : 2 or 3, the run's dimension: masses in g/m (2D, per unit
+        depth) or g (3D); unknown: both named.
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
@@ -43,7 +46,7 @@ def plot_mass_histogram(masses, path, bins: int = 40, law=None, scale: float = 1
         f = np.linspace(g.min(), g.max(), 400) / unit
         ax.plot(f * unit, np.gradient(law.cdf(f), f) / unit, "k-", lw=1.2,
                 label="requested law")
-    ax.set_xlabel("particle mass [g] (g/m in 2D)")
+    ax.set_xlabel(f"particle mass [{per_depth('g', dimension)}]")
     ax.set_ylabel("probability density [1/g]")
     if title:
         ax.set_title(title, fontsize=9)

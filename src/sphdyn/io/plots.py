@@ -15,7 +15,8 @@ import numpy as np
 from .atomic import atomic_path
 from .history import read_history_csv
 
-__all__ = ["plot_history", "save_figure", "ENERGY_COLUMNS", "energy_columns", "relative_drift"]
+__all__ = ["plot_history", "history_figures", "save_figure", "time_unit", "per_depth",
+           "run_dimension_and_end", "ENERGY_COLUMNS", "energy_columns", "relative_drift"]
 
 #: Energy columns plotted first, in this order, when present. Any other
 #: column starting with ``E_`` or ``W_`` is added after them.
@@ -31,6 +32,52 @@ def _figure(nrows: int = 1, height: float = 4.0):
     FigureCanvasAgg(fig)
     axes = fig.subplots(nrows, 1, sharex=True, squeeze=False)[:, 0]
     return fig, axes
+
+
+def time_unit(duration: float) -> tuple[float, str]:
+    """Factor and unit name for showing times of a run lasting ``duration`` [s].
+
+    Microseconds below 1 ms, milliseconds below 1 s, seconds above:
+    ``t * factor`` is the shown number.
+    """
+    duration = abs(float(duration))
+    if duration < 1e-3:
+        return 1e6, "µs"
+    if duration < 1.0:
+        return 1e3, "ms"
+    return 1.0, "s"
+
+
+def per_depth(unit: str, dimension: int | None) -> str:
+    """``unit`` as stored for a run of ``dimension``: per metre of depth in 2D.
+
+    2D runs are plane strain per unit depth, so an energy is in J/m and a
+    force in N/m; 3D runs keep ``unit``. Unknown dimension: both spelled out.
+    """
+    if dimension == 3:
+        return unit
+    if dimension == 2:
+        return f"{unit}/m"
+    return f"{unit} (3D) or {unit}/m (2D)"
+
+
+def run_dimension_and_end(outdir: str | os.PathLike) -> tuple[int | None, float | None]:
+    """``run.dimension`` and ``run.t_end`` from ``outdir/deck.resolved.toml``.
+
+    (None, None) when the file is missing or unreadable (e.g. a history CSV
+    outside a run directory).
+    """
+    import tomllib
+
+    try:
+        with open(Path(outdir) / "deck.resolved.toml", "rb") as f:
+            run = tomllib.load(f).get("run", {})
+    except (OSError, tomllib.TOMLDecodeError):
+        return None, None
+    dim = run.get("dimension")
+    t_end = run.get("t_end")
+    return (int(dim) if dim in (2, 3) else None,
+            float(t_end) if isinstance(t_end, (int, float)) else None)
 
 
 def save_figure(fig, path, dpi: float | None = None) -> Path:
@@ -73,17 +120,12 @@ def relative_drift(e_total: np.ndarray, energies: list[np.ndarray]) -> np.ndarra
 
 def plot_history(csv_path: str | os.PathLike,
                  out_dir: str | os.PathLike | None = None,
-                 force_window: float | None = None) -> list[Path]:
-    """Plot the history CSV of a run.
+                 force_window: float | None = None, dimension: int | None = None,
+                 t_end: float | None = None) -> list[Path]:
+    """Plot the history CSV of a run into ``energies.png``, ``forces.png``, ``dt.png``.
 
-    Writes, when the needed columns exist:
-
-    * ``energies.png``: every ``E_*``/``W_*`` column against ``time``, and the
-      relative drift of ``E_total`` in a second panel;
-    * ``forces.png``: every ``F_*`` column against ``time``, and for each
-      wall with an impulse column ``I_wall_<name>`` its force averaged over
-      ``force_window`` (:func:`sphdyn.analysis.window_mean_force`, dashed);
-    * ``dt.png``: ``dt`` against ``step`` (or ``time`` if there is no step).
+    The figures are those of :func:`history_figures`, written when their
+    columns exist.
 
     Parameters
     ----------
@@ -94,6 +136,10 @@ def plot_history(csv_path: str | os.PathLike,
     force_window : float, optional
         Averaging window of the wall forces [s]; default the deck's default
         ``[output] force_window``.
+    dimension, t_end : optional
+        The run's dimension (2 or 3: units per depth or not) and end time [s]
+        (marks a last step shortened to land on it); default read from
+        ``deck.resolved.toml`` beside ``csv_path``.
 
     Returns
     -------
@@ -102,38 +148,66 @@ def plot_history(csv_path: str | os.PathLike,
     """
     csv_path = Path(csv_path)
     out_dir = Path(out_dir) if out_dir is not None else csv_path.parent
-    data = read_history_csv(csv_path)
+    if dimension is None or t_end is None:
+        dim_file, end_file = run_dimension_and_end(csv_path.parent)
+        dimension = dim_file if dimension is None else dimension
+        t_end = end_file if t_end is None else t_end
+    figures = history_figures(read_history_csv(csv_path), csv_path.name, force_window,
+                              dimension, t_end)
+    return [save_figure(fig, out_dir / f"{name}.png", 120) for name, fig in figures.items()]
+
+
+def _finish_axes(ax, title: str) -> None:
+    ax.set_title(title)
+    ax.legend(loc="best")
+    ax.grid(True, alpha=0.3)
+
+
+def history_figures(data: dict[str, np.ndarray], title: str = "",
+                    force_window: float | None = None, dimension: int | None = None,
+                    t_end: float | None = None) -> dict:
+    """The history figures of a run, unsaved, by name (``energies``, ``forces``, ``dt``).
+
+    * ``energies``: every ``E_*``/``W_*`` column against time, and the
+      relative drift of ``E_total`` in a second panel;
+    * ``forces``: every ``F_*`` column against time, and for each wall with
+      an impulse column ``I_wall_<name>`` its force averaged over
+      ``force_window`` (:func:`sphdyn.analysis.window_mean_force`, dashed);
+    * ``dt``: ``dt`` against ``step`` (or time if there is no step). When
+      the last row lies at ``t_end``, its step was shortened to land exactly
+      there: it is drawn as a separate, labelled marker, not as part of the
+      line, so it does not look like a collapse of the time step.
+
+    Times are shown in µs, ms or s from the run's duration (:func:`time_unit`);
+    energies and forces in J and N in 3D, J/m and N/m in 2D (``dimension``).
+    """
     columns = list(data)
-    written: list[Path] = []
+    figures: dict = {}
     time = data.get("time")
-    title = csv_path.name
+    tf, tu = time_unit(np.max(np.abs(time)) if time is not None and time.size else 0.0)
+    shown = time * tf if time is not None else None
 
     energy_cols = energy_columns(columns)
     if time is not None and energy_cols:
         has_total = "E_total" in data
         fig, axes = _figure(2 if has_total else 1)
-        ax = axes[0]
         for c in energy_cols:
-            ax.plot(time, data[c], label=c)
-        ax.set_ylabel("energy [J] (J/m in 2D)")
-        ax.set_title(f"Energy balance ({title})")
-        ax.legend(loc="best")
-        ax.grid(True, alpha=0.3)
+            axes[0].plot(shown, data[c], label=c)
+        axes[0].set_ylabel(f"energy [{per_depth('J', dimension)}]")
+        _finish_axes(axes[0], f"Energy balance ({title})")
         if has_total:
             drift = relative_drift(data["E_total"], [data[c] for c in energy_cols])
-            axes[1].plot(time, drift, color="k", label="E_total drift")
+            axes[1].plot(shown, drift, color="k", label="E_total drift")
             axes[1].set_ylabel("(E_total - E_total(0)) / max|E| [-]")
-            axes[1].set_title("Relative energy drift")
-            axes[1].legend(loc="best")
-            axes[1].grid(True, alpha=0.3)
-        axes[-1].set_xlabel("time [s]")
-        written.append(save_figure(fig, out_dir / "energies.png", 120))
+            _finish_axes(axes[1], "Relative energy drift")
+        axes[-1].set_xlabel(f"time [{tu}]")
+        figures["energies"] = fig
 
     force_cols = [c for c in columns if c.startswith("F_")]
     if time is not None and force_cols:
         fig, (ax,) = _figure()
         for c in force_cols:
-            ax.plot(time, data[c], label=c)
+            ax.plot(shown, data[c], label=c)
         if force_window is None:
             from ..deck.schema import Output
 
@@ -142,23 +216,27 @@ def plot_history(csv_path: str | os.PathLike,
             if c.startswith("I_wall_") and f"F_wall_{c[7:]}" in data:
                 from ..analysis import window_mean_force
 
-                ax.plot(time, window_mean_force(time, data[c], force_window), "--",
-                        label=f"F_wall_{c[7:]}, {force_window * 1e6:g} us mean")
-        ax.set_xlabel("time [s]")
-        ax.set_ylabel("force [N] (N/m in 2D)")
-        ax.set_title(f"Forces ({title})")
-        ax.legend(loc="best")
-        ax.grid(True, alpha=0.3)
-        written.append(save_figure(fig, out_dir / "forces.png", 120))
+                ax.plot(shown, window_mean_force(time, data[c], force_window), "--",
+                        label=f"F_wall_{c[7:]}, {force_window * 1e6:g} µs mean")
+        ax.set_xlabel(f"time [{tu}]")
+        ax.set_ylabel(f"force [{per_depth('N', dimension)}]")
+        _finish_axes(ax, f"Forces ({title})")
+        figures["forces"] = fig
 
     xkey = "step" if "step" in data else "time" if time is not None else None
     if "dt" in data and xkey is not None:
         fig, (ax,) = _figure()
-        ax.plot(data[xkey], data["dt"], label="dt")
-        ax.set_xlabel("step [-]" if xkey == "step" else "time [s]")
+        x = data["step"] if xkey == "step" else shown
+        dt = data["dt"]
+        last_shortened = (t_end is not None and time is not None and dt.size > 1
+                          and time[-1] >= t_end * (1 - 1e-12) and dt[-1] < dt[-2])
+        n = dt.size - 1 if last_shortened else dt.size
+        ax.plot(x[:n], dt[:n], label="dt")
+        if last_shortened:
+            ax.plot(x[-1:], dt[-1:], "v", color="tab:red", linestyle="none",
+                    label=f"last step, shortened to end at t_end ({dt[-1]:.3g} s)")
+        ax.set_xlabel("step [-]" if xkey == "step" else f"time [{tu}]")
         ax.set_ylabel("time step dt [s]")
-        ax.set_title(f"Time step ({title})")
-        ax.legend(loc="best")
-        ax.grid(True, alpha=0.3)
-        written.append(save_figure(fig, out_dir / "dt.png", 120))
-    return written
+        _finish_axes(ax, f"Time step ({title})")
+        figures["dt"] = fig
+    return figures

@@ -20,7 +20,6 @@ pyplot, no global state) and saved atomically.
 from __future__ import annotations
 
 import math
-import textwrap
 import os
 import re
 import tomllib
@@ -28,12 +27,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .plots import save_figure
+from .plots import save_figure, time_unit
 from .frames import list_frames
 from .hdf5 import read_frame, read_frame_header
 
 __all__ = ["plot_snapshots", "select_frames", "slab_mask", "particle_spacing",
-           "field_values", "available_fields"]
+           "field_values", "available_fields", "run_labels", "particle_squares"]
 
 _AXES = {"x": 0, "y": 1, "z": 2}
 _TENSOR = ("xx", "xy", "xz", "yx", "yy", "yz", "zx", "zy", "zz")
@@ -235,11 +234,61 @@ def _display_scale(unit: str, magnitude: float) -> tuple[float, str]:
 
 
 def _time_label(t: float, t_max: float) -> str:
-    if t_max < 1e-3:
-        return f"t = {t * 1e6:.4g} µs"
-    if t_max < 1.0:
-        return f"t = {t * 1e3:.4g} ms"
-    return f"t = {t:.4g} s"
+    factor, unit = time_unit(t_max)
+    return f"t = {t * factor:.4g} {unit}"
+
+
+def _flat_deck(value, prefix: str = "", out: dict | None = None) -> dict:
+    """A resolved deck as ``{dotted key: value}``; tables in arrays keyed by name."""
+    out = {} if out is None else out
+    if isinstance(value, dict):
+        for k, v in value.items():
+            _flat_deck(v, f"{prefix}.{k}" if prefix else str(k), out)
+    elif isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+        for i, item in enumerate(value):
+            _flat_deck(item, f"{prefix}.{item.get('name', i)}", out)
+    else:
+        out[prefix] = value
+    return out
+
+
+def _deck_value(value) -> str:
+    if value is None:
+        return "absent"
+    if isinstance(value, float):
+        return f"{value:.4g}"
+    if isinstance(value, list):
+        return "[" + ", ".join(_deck_value(v) for v in value) + "]"
+    return str(value)
+
+
+def run_labels(outdirs, max_keys: int = 3) -> list[str]:
+    """Row labels of runs shown side by side: directory name, then the deck
+    values that differ between the runs (``key = value``, at most ``max_keys``
+    of them, then how many more).
+
+    Reads each run's ``deck.resolved.toml``; the title is left out (runs made
+    with ``--set`` share it). A run without that file shows only its name.
+    """
+    decks = []
+    for d in outdirs:
+        try:
+            with open(Path(d) / "deck.resolved.toml", "rb") as f:
+                flat = _flat_deck(tomllib.load(f))
+        except (OSError, tomllib.TOMLDecodeError):
+            flat = {}
+        flat.pop("run.title", None)
+        decks.append(flat)
+    keys = sorted({k for flat in decks for k in flat})
+    differ = [k for k in keys if len({repr(flat.get(k)) for flat in decks}) > 1]
+    labels = []
+    for d, flat in zip(outdirs, decks):
+        lines = [Path(d).name] + [f"{k} = {_deck_value(flat.get(k))}"
+                                  for k in differ[:max_keys]]
+        if len(differ) > max_keys:
+            lines.append(f"(+{len(differ) - max_keys} more differ)")
+        labels.append("\n".join(lines))
+    return labels
 
 
 def _run_info(outdir: Path) -> tuple[int | None, str]:
@@ -267,7 +316,7 @@ def _grid(n_panels: int, box_w: float, box_h: float) -> tuple[int, int]:
     return best
 
 
-def _squares(xy: np.ndarray, side: float) -> np.ndarray:
+def particle_squares(xy: np.ndarray, side: float) -> np.ndarray:
     """Vertices ``(N, 4, 2)`` of axis-aligned squares centred on ``xy``."""
     h = 0.5 * side
     corners = np.array([[-h, -h], [h, -h], [h, h], [-h, h]])
@@ -328,7 +377,8 @@ def plot_snapshots(outdir, field: str = "von_mises",
     outdir : str or os.PathLike, or a list of them
         Output directory of a run (with ``frames/frame_*.h5``). With several
         runs (e.g. the same case with different remedies) the figure has one
-        row per run, titled with the run's title, and one column per
+        row per run, labelled by :func:`run_labels` (directory name and the
+        deck values that differ between the runs), and one column per
         selected time; colour scale and axes are shared.
     field : str, optional
         What to colour by: any scalar field in the frames (``von_mises``,
@@ -387,6 +437,7 @@ def plot_snapshots(outdir, field: str = "von_mises",
     spacing = loaded[0][2]
     plane, slab = loaded[0][4], loaded[0][5]
     title = loaded[0][3]
+    row_labels = run_labels(runs) if len(runs) > 1 else [""]
     side = float(marker_size) if marker_size is not None else spacing
 
     # Shared colour scale.
@@ -465,7 +516,7 @@ def plot_snapshots(outdir, field: str = "von_mises",
     for idx, (row, col) in enumerate(slots):
         ax = axes[row, col]
         t, xy, values = panels[idx]
-        collection = PolyCollection(_squares(xy * 1e3, side * 1e3), cmap=cmap,
+        collection = PolyCollection(particle_squares(xy * 1e3, side * 1e3), cmap=cmap,
                                     norm=norm, edgecolors="face", linewidths=0.5,
                                     antialiaseds=True)
         collection.set_array(values * factor)
@@ -478,7 +529,7 @@ def plot_snapshots(outdir, field: str = "von_mises",
             ax.set_xlabel(f"{names[plane[0]]} [mm]")
             ax.xaxis.set_tick_params(labelbottom=True)
         if col == 0:
-            run_label = "" if len(runs) == 1 else textwrap.fill(loaded[row][3], 28) + "\n"
+            run_label = row_labels[row] + "\n" if row_labels[row] else ""
             ax.set_ylabel(f"{run_label}{names[plane[1]]} [mm]",
                           fontsize=10 if len(runs) == 1 else 8)
     label = field if not shown_unit else f"{field} [{shown_unit}]"

@@ -219,10 +219,12 @@ def drive(model_name: str, params: dict, path: str, *, strain: float | None = No
         order ``xx, yy, zz, xy, yz, xz`` (tensor shear); ``damage`` (n+1,);
         ``history`` (n+1, nh) and ``history_names``; ``x``, ``y`` the
         plotted strain and stress (for hydrostatic: volumetric strain and
-        pressure, compression positive; for shear: engineering gamma);
-        ``columns`` the components (``"xx"``, ``"xy"``) of the CSV's strain
-        and stress columns that control the path (signed, tension
-        positive); ``files``.
+        pressure, compression positive; for shear: engineering gamma) and
+        ``labels`` their names (for plots); ``columns`` the components
+        (``"xx"``, ``"xy"``) of the CSV's strain and stress columns that
+        control the path (signed, tension positive); ``params``,
+        ``bulk_modulus``, ``shear_modulus``, ``rate``, ``confinement`` (for
+        the title); ``files``.
     """
     if path not in PATHS:
         raise ValueError(f"unknown path {path!r}; choose one of {', '.join(PATHS)}")
@@ -272,17 +274,19 @@ def drive(model_name: str, params: dict, path: str, *, strain: float | None = No
         "t": np.array(rows_t), "strain": np.array(rows_e), "stress": np.array(rows_s),
         "damage": np.array(rows_d), "history": np.array(rows_h),
         "history_names": list(model.history_names), "model": model_name, "path": path,
+        "params": dict(params), "bulk_modulus": K, "shear_modulus": G, "rate": rate,
+        "confinement": confinement,
     }
     comp = 3 if path == "shear" else 0
     res["columns"] = (COMPONENTS[comp], COMPONENTS[comp])  # CSV strain, stress columns
     if path == "hydrostatic":
         res["x"] = -res["strain"][:, :3].sum(axis=1)
         res["y"] = -res["stress"][:, :3].mean(axis=1)
-        res["labels"] = ("volumetric strain (compression +) [-]", "pressure [MPa]")
+        res["labels"] = ("volumetric strain (compression +)", "pressure [MPa]")
     else:
         res["x"] = res["strain"][:, comp] * (2.0 if comp == 3 else 1.0)
         res["y"] = res["stress"][:, comp]
-        res["labels"] = (("shear strain gamma_xy" if comp == 3 else "strain eps_xx") + " [-]",
+        res["labels"] = ("shear strain gamma_xy" if comp == 3 else "strain eps_xx",
                          ("shear stress sigma_xy" if comp == 3 else "stress sigma_xx")
                          + " [MPa]")
     res["files"] = write_outputs(res, out) if out is not None else []
@@ -311,22 +315,51 @@ def write_outputs(res: dict, out) -> list[Path]:
                 w.writerow([repr(float(v)) for v in
                             [res["t"][k], *res["strain"][k], *res["stress"][k],
                              res["damage"][k], *res["history"][k][:nh]]])
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    png = save_figure(result_figure(res), out / f"{stem}.png", 110)
+    return [csv_path, png]
 
-    fig, ax = plt.subplots(1, 2, figsize=(10, 4))
-    ax[0].plot(res["x"], res["y"] / 1e6, "k-")   # display in MPa only
-    ax[0].set_xlabel(res["labels"][0])
+
+def _number(value) -> str:
+    return f"{value:.4g}" if isinstance(value, float) else str(value)
+
+
+def result_title(res: dict, max_params: int = 6) -> str:
+    """Title of a material-point figure: the model, the path and its rate
+    (and confinement), the elastic moduli, and the material values given
+    (``res["params"]``, SI, at most ``max_params``, then how many more)."""
+    head = f"{res['model']}: {res['path']}, rate {res['rate']:g} /s"
+    if res['path'] == "triaxial":
+        head += f", confinement {res['confinement'] * 1e-6:.4g} MPa"
+    moduli = (f"K = {res['bulk_modulus'] * 1e-9:.4g} GPa, "
+              f"G = {res['shear_modulus'] * 1e-9:.4g} GPa")
+    given = [f"{k} = {_number(v)}" for k, v in res.get("params", {}).items()
+             if isinstance(v, (int, float, bool))]
+    if len(given) > max_params:
+        given = given[:max_params] + [f"(+{len(given) - max_params} more)"]
+    return "\n".join([head, ", ".join([moduli] + given[:3])]
+                     + ([", ".join(given[3:])] if given[3:] else []))
+
+
+def result_figure(res: dict):
+    """Figure (unsaved) of a :func:`drive` result: stress and damage against
+    the controlling strain, shown in per mille, titled by :func:`result_title`."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    from matplotlib.ticker import MaxNLocator
+
+    fig = Figure(figsize=(10, 4.6), layout="constrained")
+    FigureCanvasAgg(fig)
+    ax = fig.subplots(1, 2)
+    strain_label = f"{res['labels'][0]} [‰]"
+    x = res["x"] * 1e3
+    ax[0].plot(x, res["y"] / 1e6, "k-")   # display in MPa only
     ax[0].set_ylabel(res["labels"][1])
-    ax[0].grid(True, alpha=0.3)
-    ax[1].plot(res["x"], res["damage"], "r-")
-    ax[1].set_xlabel(res["labels"][0])
+    ax[1].plot(x, res["damage"], "r-")
     ax[1].set_ylabel("damage [-]")
     ax[1].set_ylim(-0.02, 1.02)
-    ax[1].grid(True, alpha=0.3)
-    fig.suptitle(f"{res['model']}: {res['path']}")
-    fig.tight_layout()
-    png = out / f"{stem}.png"
-    save_figure(fig, png, 110)
-    return [csv_path, png]
+    for a in ax:
+        a.set_xlabel(strain_label)
+        a.xaxis.set_major_locator(MaxNLocator(nbins=6))
+        a.grid(True, alpha=0.3)
+    fig.suptitle(result_title(res), fontsize=10)
+    return fig
