@@ -240,7 +240,10 @@ def run_tests(tests, mutant: Mutant | None, timeout: float) -> tuple[str, float,
         except subprocess.TimeoutExpired:
             return "timeout", time.perf_counter() - t0, ""
         seconds = time.perf_counter() - t0
-        tail = "\n".join((proc.stdout + proc.stderr).strip().splitlines()[-5:])
+        lines = (proc.stdout + proc.stderr).strip().splitlines()
+        # the failing tests of the short summary (-ra), else the last lines
+        failed = [ln for ln in lines if ln.startswith(("FAILED ", "ERROR "))]
+        tail = "\n".join(failed or lines[-5:])
         outcome = {0: "passed", 1: "failed"}.get(proc.returncode,
                                                   f"error: pytest exit {proc.returncode}")
         return outcome, seconds, tail
@@ -312,7 +315,7 @@ def main(argv=None) -> int:
         verdict = judge(outcome)
         results.append((m, verdict, seconds))
         print(f"{m.name:28s} {verdict:9s} ({seconds:.0f} s)", flush=True)
-        if verdict.startswith("error"):
+        if verdict != "survived":  # which test caught it (or why it could not run)
             print("  " + tail.replace("\n", "\n  "), flush=True)
     table = markdown_table(results)
     print()
