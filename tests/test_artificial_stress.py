@@ -151,6 +151,13 @@ def test_pair_force_is_repulsive_with_the_stated_magnitude():
                              np.zeros(2))
     assert a[0, 0] == pytest.approx(m * 2 * (-EPS * s / RHO**2) * f**4 * Fh * 0.5 * dx,
                                     rel=1e-13)
+    # a non-integer exponent (pow instead of repeated squaring): f^2.5
+    a[:] = 0.0
+    artificial_stress_forces(x, np.full(2, m), np.full(2, h), R, np.full(2, Fh), offsets,
+                             idx, kid, dim, 1.0, np.full(2, dx), 2.5, a, np.zeros((2, 3)),
+                             np.zeros(2))
+    assert a[0, 0] == pytest.approx(m * 2 * (-EPS * s / RHO**2) * f**2.5 * Fh * 0.5 * dx,
+                                    rel=1e-13)
 
 
 DECK = """
@@ -214,10 +221,20 @@ geometry = { shape = "box", lo = [0.02, 0], hi = [0.03, 0.01] }
     s = build_stepper(d)
     p = s.particles
     assert np.array_equal(s.particles.as_eps, np.where(p.body == 0, 0.3, 0.0))
+    p.sig[:] = 0.0
     p.sig[:, 0, 0] = 1e5  # uniaxial tension everywhere
     s.part("sph")._accelerations()
-    assert np.all(s.particles.R[p.body == 1] == 0.0)
-    assert np.all(s.particles.R[p.body == 0, 0, 0] < 0.0)
+    R = s.particles.R
+    assert np.all(R[p.body == 1] == 0.0)
+    # first body: R = diag(-eps sigma_xx / rho^2, 0, 0) (Gray et al. 2001,
+    # eq. 4.8) with its own density; a diagonal stress needs no Jacobi
+    # rotation, so only the rounding of the product: 1e-14 relative
+    first = p.body == 0
+    expect = -0.3 * 1e5 / p.rho[first] ** 2
+    assert np.allclose(R[first, 0, 0], expect, rtol=1e-14, atol=0.0)
+    R_rest = R[first].copy()
+    R_rest[:, 0, 0] = 0.0
+    assert np.all(R_rest == 0.0)
     only = DECK.format(eps=0.0).replace("velocity = [1.0, 0]",
                                         "velocity = [1.0, 0]\nartificial_stress = 0.2")
     d = loads_deck(only)

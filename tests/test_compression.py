@@ -1,6 +1,7 @@
 """Compression between platens (sphdyn.compression) and the mesostructure UCS study."""
 
 import json
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -9,6 +10,7 @@ import pytest
 from sphdyn.cli import main
 from sphdyn.compression import compression_curve, ensemble_report
 from sphdyn.deck import loads_deck
+from sphdyn.io import read_history_csv
 from sphdyn.model import build_model
 from sphdyn.simulation import Simulation
 
@@ -51,6 +53,19 @@ vtk = false
 """
 
 
+def _scaled_copy(src, dst, force_scale, travel_scale):
+    """Copy run directory ``src`` to ``dst`` with the platen's force column
+    multiplied by ``force_scale`` and its travel by ``travel_scale`` (a run
+    with a known peak stress and strain at peak)."""
+    shutil.copytree(src, dst)
+    h = read_history_csv(src / "history.csv")
+    h["F_wall_platen"] = h["F_wall_platen"] * force_scale
+    h["d_wall_platen"] = h["d_wall_platen"] * travel_scale
+    lines = [",".join(h)] + [",".join(repr(float(h[k][i])) for k in h)
+                             for i in range(len(h["time"]))]
+    (dst / "history.csv").write_text("\n".join(lines) + "\n")
+
+
 def test_curve_of_an_elastic_column(tmp_path):
     # Strain = platen displacement / 20 mm, stress = force / 10 mm (2D, per
     # unit depth); the secant modulus after the waves have run 6 transits
@@ -69,12 +84,36 @@ def test_curve_of_an_elastic_column(tmp_path):
         compression_curve(tmp_path / "col", "lid")
     with pytest.raises(ValueError, match="velocity"):
         compression_curve(tmp_path / "col", "base")
-    # report: two runs (the same one twice) and a directory without a run
+    # report: three runs with known different peaks (copies of this one with
+    # the platen force scaled by 1.25 and 0.8, and the platen travel by 1.1)
+    # and a directory without a run
     (tmp_path / "empty").mkdir()
-    stats = ensemble_report([tmp_path / "col", tmp_path / "col", tmp_path / "empty"],
+    scales = {"s0": (1.0, 1.0), "s1": (1.25, 1.0), "s2": (0.8, 1.1)}
+    for name, (f_scale, d_scale) in scales.items():
+        _scaled_copy(tmp_path / "col", tmp_path / name, f_scale, d_scale)
+    stats = ensemble_report([tmp_path / k for k in scales] + [tmp_path / "empty"],
                             "platen", tmp_path / "rep", homogeneous=tmp_path / "col")
-    assert stats["skipped"] == 1 and stats["peak_stress"]["n"] == 2
-    assert stats["peak_stress"]["cov"] == 0.0
+    assert stats["skipped"] == 1 and stats["peak_stress"]["n"] == 3
+    peaks = c["peak_stress"] * np.array([f for f, _ in scales.values()])
+    strains = c["strain_at_peak"] * np.array([d for _, d in scales.values()])
+    # mean, sample standard deviation (n - 1) and CoV = std / mean written
+    # out; the values are the same floating-point operations in another
+    # order: 1e-12 relative. The CoV of (1, 1.25, 0.8) is 22.2 %, so a
+    # population std (n) instead of the sample std is off by 18 %.
+    for key, values in (("peak_stress", peaks), ("strain_at_peak", strains)):
+        mean = values.sum() / 3
+        std = np.sqrt(((values - mean) ** 2).sum() / 2)
+        assert stats[key]["mean"] == pytest.approx(mean, rel=1e-12)
+        assert stats[key]["std"] == pytest.approx(std, rel=1e-12)
+        assert stats[key]["cov"] == pytest.approx(std / mean, rel=1e-12)
+    assert stats["peak_stress"]["cov"] == pytest.approx(0.2218, abs=1e-4)
+    assert stats["homogeneous"]["peak_stress"] == c["peak_stress"]
+    rows = (tmp_path / "rep/ucs_samples.csv").read_text().split()
+    assert rows[0] == "sample,peak_stress_Pa,strain_at_peak" and len(rows) == 4
+    for row, peak, strain in zip(rows[1:], peaks, strains):
+        _, p_csv, e_csv = row.split(",")
+        assert float(p_csv) == pytest.approx(peak, rel=1e-12)
+        assert float(e_csv) == pytest.approx(strain, rel=1e-12)
     assert json.loads((tmp_path / "rep/ucs_statistics.json").read_text()) == stats
     assert (tmp_path / "rep/ucs_curves.png").stat().st_size > 5000
     assert main(["ucs", str(tmp_path / "col"), "--wall", "platen", "--out",

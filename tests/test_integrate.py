@@ -1,6 +1,7 @@
 """Leapfrog order of accuracy and kick bookkeeping (sphdyn.integrate)."""
 
 import numpy as np
+import pytest
 
 from sphdyn.integrate import cfl_time_step, drift, kick, kick_scratch
 from sphdyn.state import BC_FIXED, BC_VELOCITY
@@ -61,3 +62,39 @@ def test_cfl_time_step_picks_the_controlling_particle():
     v[0, 0] = 1000.0
     dt, k = cfl_time_step(h, c, v, 1.0, 0.3)
     assert k == 2 and np.isclose(dt, 0.3 * 1e-3 / 3000.0)
+
+
+def test_kick_books_the_contact_work_and_energies_over_several_blocks():
+    # 2.5 KICK_BLOCKs of particles with random masses, velocities,
+    # accelerations and a nonzero contact acceleration a_c (part of a), a
+    # fifth of them fixed or with a prescribed velocity: the kick returns
+    #   kinetic       = 1/2 sum m |v^n|^2,
+    #   contact work  = sum m a_c . v^n dt,
+    #   external work = sum m (v_target - v_free) . (v^{n-1/2} + v_target)/2
+    # with v^n = (v^{n-1/2} + v^{n+1/2}) / 2 (docstring of kick), written out
+    # here with numpy. Tolerance 1e-12 relative: the same sums taken in
+    # another order (blocks); a halved or doubled term is off by O(1).
+    from sphdyn.integrate import KICK_BLOCK
+    rng = np.random.default_rng(11)
+    n = 2 * KICK_BLOCK + KICK_BLOCK // 2
+    m = rng.uniform(0.5, 2.0, n)
+    v = rng.normal(size=(n, 3))
+    ac = rng.normal(size=(n, 3)) * 40.0
+    a = ac + rng.normal(size=(n, 3)) * 10.0
+    bc = rng.choice(np.array([0, BC_FIXED, BC_VELOCITY], np.int8), n, p=[0.8, 0.1, 0.1])
+    bcv = np.where((bc == BC_VELOCITY)[:, None], rng.normal(size=(n, 3)), 0.0)
+    dt = 0.01
+    v_old = v.copy()
+    free = v_old + dt * a
+    new = np.where((bc == 0)[:, None], free, bcv)  # fixed: bcv is zero there
+    mean = 0.5 * (v_old + new)
+    vm = np.zeros((n, 3))
+    ke, wc, we = kick(v, a, ac, m, bc, bcv, dt, vm, kick_scratch(n))
+    assert np.array_equal(v, new) and np.allclose(vm, mean, rtol=0, atol=1e-15)
+    ke_exact = 0.5 * np.sum(m * np.sum(mean**2, axis=1))
+    wc_exact = dt * np.sum(m * np.sum(ac * mean, axis=1))
+    we_exact = np.sum(m * np.sum((new - free) * mean, axis=1) * (bc != 0))
+    assert abs(wc_exact) > 1.0 and abs(we_exact) > 1.0  # neither is a trivial 0
+    assert ke == pytest.approx(ke_exact, rel=1e-12)
+    assert wc == pytest.approx(wc_exact, rel=1e-12)
+    assert we == pytest.approx(we_exact, rel=1e-12)

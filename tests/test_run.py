@@ -95,6 +95,52 @@ def test_restart_continues_to_the_same_result(tmp_path, variant):
     assert np.interp(ck_t, h_full["time"], h_full["I_wall_floor"]) > 0
 
 
+#: SMALL_DISC pressed onto its floor through a prescribed velocity of its
+#: top cap (1 m/s down, the disc starting at the same speed): the cap's
+#: reactions do work, so W_external is nonzero
+PRESSED_DISC = {
+    "velocity = [0, -5.0, 0]": "velocity = [0, -1.0, 0]",
+    "[[wall]]": """[[set]]
+name = "cap"
+region = { shape = "box", lo = [-1, 0.0112, -1], hi = [1, 1, 1] }
+[[boundary]]
+set = "cap"
+type = "velocity"
+velocity = [0, -1.0, 0]
+[[wall]]""",
+}
+
+
+def test_restart_restores_the_external_work(tmp_path):
+    # A restart must continue the energy accumulators, not only the
+    # particles: with a prescribed-velocity boundary W_external grows during
+    # the run, and a restart that started it again from 0 would shift
+    # W_external and E_total by the work done before the checkpoint. Run
+    # through, and stopped after 150 steps (exit checkpoint) then restarted:
+    # every history column and particle array bitwise equal.
+    full = _sim(tmp_path, "full", t_end="2 ms", **PRESSED_DISC)
+    full.run()
+    part = _sim(tmp_path, "part", t_end="2 ms", ck=1000, **PRESSED_DISC)
+    part.run(max_steps=150)
+    _, scalars, _ = read_checkpoint(tmp_path / "part" / "checkpoint.h5")
+    assert 0 < scalars["t"] < 2e-3
+    rest = Simulation.from_directory(tmp_path / "part")
+    assert rest.stepper.work_external == scalars["work_external"] != 0.0
+    rest.run()
+    for name, arr in full.particles.arrays().items():
+        assert np.array_equal(arr, getattr(rest.particles, name)), name
+    h_full = read_history_csv(tmp_path / "full/history.csv")
+    h_part = read_history_csv(tmp_path / "part/history.csv")
+    assert list(h_full) == list(h_part)
+    for col in h_full:
+        assert np.array_equal(h_full[col], h_part[col]), col
+    # the work before the checkpoint is a sizeable part of the total (so a
+    # restart from W = 0 is no last-digit difference) and the cap did press
+    before = np.interp(scalars["t"], h_full["time"], h_full["W_external"])
+    assert abs(before) > 0.01 * abs(h_full["W_external"][-1]) > 0.0
+    assert h_full["F_wall_floor"].max() > 0.0
+
+
 def test_particles_leaving_the_domain_stop_the_run_with_a_diagnosis(tmp_path):
     sim = _sim(tmp_path, "escape", t_end="20 ms",
                **{"[output]": "[domain]\nlo = [-0.02, -0.02, 0]\nhi = [0.02, 0.02, 0]\n"

@@ -210,3 +210,67 @@ def test_xsph_leaves_uniform_velocity_unchanged_and_smooths():
     xsph_velocity(c["x"], v2, c["m"], c["rho"], c["h"], nl.offsets, nl.idx, c["kid"],
                   c["sigma"], 2, 1.0, 0.5, vs)
     assert vs[n // 2 + 4, 0] < v2[n // 2 + 4, 0]
+
+
+def _pair_acceleration(x, v, m, rho, h, c, S, B, F, support_scale, alpha, beta):
+    """Acceleration and heating rate of particle 0 from particle 1, written out
+    from the docstring of :func:`forces` (Gray, Monaghan & Swift 2001;
+    Monaghan 1992 for Pi_ij), for the corrected form with matrices ``B``."""
+    d = x[0] - x[1]
+    g = F * d  # grad_0 W_01
+    vx = (v[0] - v[1]) @ d
+    pi = 0.0
+    if vx < 0.0:  # artificial viscosity on approaching pairs only
+        hij = support_scale * 0.5 * (h[0] + h[1])
+        mu = hij * vx / (d @ d + 0.01 * hij**2)
+        pi = (-alpha * 0.5 * (c[0] + c[1]) * mu + beta * mu**2) / (0.5 * (rho[0] + rho[1]))
+    acc = m[1] * (S[0] @ B[0] @ g + S[1] @ B[1] @ g - pi * g)
+    heat = 0.5 * m[1] * pi * ((v[0] - v[1]) @ g)
+    return acc, heat, pi
+
+
+@pytest.mark.parametrize("alpha,beta", [(1.0, 0.0), (0.0, 2.0), (1.0, 2.0)],
+                         ids=["alpha", "beta", "both"])
+@pytest.mark.parametrize("approach", [True, False])
+def test_pair_stress_and_viscosity_match_their_formulas(alpha, beta, approach):
+    # Two particles in 3D with unequal masses, densities, smoothing lengths,
+    # wave speeds, stresses and correction matrices, and a support scale
+    # kappa != 1: forces() against the formula written out above. The wave
+    # speeds are low (30 m/s) so that the beta term (mu^2) is of the same
+    # order as the alpha term (c mu); alpha and beta are also switched on
+    # one at a time, so a wrong sign or factor in either term changes the
+    # result by O(1). Tolerance: round-off only, 1e-12 of the largest term.
+    x = np.array([[0.0, 0.0, 0.0], [0.9e-3, 0.2e-3, -0.1e-3]])
+    sgn = 1.0 if approach else -1.0
+    v = np.array([[sgn * 4.0, -1.0, 0.5], [-sgn * 3.0, 0.5, 0.0]])
+    m = np.array([2.0e-3, 3.0e-3])
+    rho = np.array([2400.0, 2600.0])
+    h = np.array([1.2e-3, 1.4e-3])
+    c = np.array([30.0, 35.0])
+    rng = np.random.default_rng(3)
+    sig = rng.normal(scale=1e6, size=(2, 3, 3))
+    sig = 0.5 * (sig + sig.transpose(0, 2, 1))
+    B = np.eye(3) + 0.1 * rng.normal(size=(2, 3, 3))
+    S = np.zeros((2, 3, 3))
+    scaled_stress(sig, rho, S)
+    support_scale = 1.2
+    F = np.array([-4e9, -4e9])  # the pair factor of both rows (a symmetric pair)
+    offsets, idx = np.array([0, 1, 2]), np.array([1, 0], dtype=np.int32)
+    a = np.zeros((2, 3))
+    dedt = np.zeros(2)
+    forces(x, v, m, rho, h, c, S, B, F, offsets, idx, 3, support_scale, True, alpha, beta,
+           a, dedt)
+    acc, heat, pi = _pair_acceleration(x, v, m, rho, h, c, S, B, F[0], support_scale,
+                                       alpha, beta)
+    assert (pi != 0.0) == approach
+    scale = m[1] * np.abs(F[0] * (x[0] - x[1])).max() * (np.abs(S).max() + abs(pi))
+    assert np.abs(a[0] - acc).max() < 1e-12 * scale
+    assert dedt[0] == pytest.approx(heat, rel=1e-12, abs=0.0)
+    if approach:
+        # the viscous part alone, separately: with zero stress the
+        # acceleration is -m_j Pi_ij g_ij exactly
+        forces(x, v, m, rho, h, c, np.zeros_like(S), B, F, offsets, idx, 3, support_scale,
+               True, alpha, beta, a, dedt)
+        expect = -m[1] * pi * F[0] * (x[0] - x[1])
+        assert np.allclose(a[0], expect, rtol=1e-12, atol=0.0)
+        assert heat > 0.0  # viscosity only heats

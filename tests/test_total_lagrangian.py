@@ -296,3 +296,35 @@ def test_pair_viscosity_and_hourglass_match_their_formulas(approach):
     assert np.allclose(a[0], expect, rtol=1e-12, atol=1e-12 * np.abs(expect).max())
     heat0 = 0.5 * m[1] * pi * f * vx - (f_hg @ v[0]) / m[0]
     assert heat[0] == pytest.approx(heat0, rel=1e-12)
+
+
+def test_hourglass_coefficients_match_their_formula():
+    # hgk_ij = -(alpha/2) V_i V_j W_ij (E_i + E_j)/2 / |X_ij|^2 (docstring of
+    # hourglass_coefficients, Ganzenmueller 2015) for three particles with
+    # unequal volumes, Young's moduli and kernel values, for two alphas and
+    # for alpha = 0 (off: exactly zero). hgk is float32: tolerance one
+    # float32 rounding, 2^-23 relative (a doubled or halved factor is off by
+    # 100 % or 50 %).
+    X = np.array([[0.0, 0.0, 0.0], [1.1e-3, 0.2e-3, 0.0], [0.3e-3, -0.9e-3, 0.4e-3]])
+    vol = np.array([1.0e-9, 1.3e-9, 0.8e-9])
+    young = np.array([30e9, 45e9, 20e9])
+    offsets = np.array([0, 2, 4, 6])
+    idx = np.array([1, 2, 0, 2, 0, 1], dtype=np.int32)
+    w = np.array([2.0e8, 1.5e8, 2.0e8, 0.7e8, 1.5e8, 0.7e8])
+    rows = np.arange(3)
+    for alpha in (0.0, 10.0, 3.0):
+        hgk = np.full(6, 7.0, dtype=np.float32)
+        hourglass_coefficients(rows, X, vol, offsets, idx, w, young, alpha, hgk)
+        for i in rows:
+            for k in range(offsets[i], offsets[i + 1]):
+                j = idx[k]
+                r2 = float((X[j] - X[i]) @ (X[j] - X[i]))
+                expect = (-0.5 * alpha * vol[i] * vol[j] * w[k]
+                          * 0.5 * (young[i] + young[j]) / r2)
+                if alpha == 0.0:
+                    assert hgk[k] == 0.0
+                else:
+                    assert expect < 0.0
+                    assert float(hgk[k]) == pytest.approx(expect, rel=2.0**-23, abs=0.0)
+    # the pair factor is symmetric, so the hourglass force is antisymmetric
+    assert hgk[0] == hgk[2] and hgk[1] == hgk[4] and hgk[3] == hgk[5]

@@ -1,0 +1,329 @@
+"""Mutation check of the test suite: does a small wrong change in the source fail its tests?
+
+Each mutant names one file under ``src/``, an exact source snippet, its
+replacement and the test node ids that must catch it. For every mutant the
+script copies ``src/`` to a temporary directory, applies the one change
+there (the working tree is never touched), and runs only the named tests
+with ``PYTHONPATH`` pointing at the copy and a fresh ``NUMBA_CACHE_DIR``
+inside the temporary directory (so a cached compilation of the unchanged
+source cannot hide the change). The mutant is
+
+* ``caught``   if pytest reports failing tests (exit status 1) or the run
+  exceeds the time limit (an endless loop is a wrong program too),
+* ``survived`` if the tests pass,
+* ``error``    for any other outcome (a test id that does not exist, a
+  collection error, a copy that is not the one imported).
+
+A mutant whose snippet is not found exactly once in today's source is
+refused (the list cannot rot silently); ``tests/test_mutation_script.py``
+checks this for every mutant without running any.
+
+Usage (from the repository root; run it alone, it compiles the Numba
+kernels afresh for every mutant)::
+
+    python tools/mutation.py                 # baseline, then every mutant
+    python tools/mutation.py --list          # the mutants, nothing run
+    python tools/mutation.py --only wall_mass_alpha kick_contact_work_halved
+    python tools/mutation.py --no-baseline --markdown result.md
+
+The baseline runs all named tests once on an unchanged copy; a mutant
+whose tests already fail there could not be judged, so the script stops.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+SRC = ROOT / "src"
+
+
+@dataclass(frozen=True)
+class Mutant:
+    """One wrong change: ``old`` (found exactly once in ``src/<path>``) -> ``new``."""
+
+    name: str
+    area: str  # what it belongs to (kernels, neighbours, ..., issue 14 item)
+    path: str  # relative to src/
+    old: str
+    new: str
+    tests: tuple[str, ...]  # pytest node ids, relative to the repository root
+    what: str  # the change in words
+
+
+MUTANTS: tuple[Mutant, ...] = (
+    # ------------------------------------------------------------------ core
+    Mutant("kernel_cubic_2d_norm", "kernels", "sphdyn/kernels.py",
+           "(1.0 / 6.0, 5.0 / (14.0 * _PI), 1.0 / (4.0 * _PI))",
+           "(1.0 / 6.0, 15.0 / (14.0 * _PI), 1.0 / (4.0 * _PI))",
+           ("tests/test_kernels.py::test_zeroth_moment",),
+           "cubic spline 2D normalisation 5/(14 pi) -> the literature's 15/(14 pi)"),
+    Mutant("kernel_cubic_gradient", "kernels", "sphdyn/kernels.py",
+           "return 9.0 * q - 12.0", "return 9.0 * q - 11.0",
+           ("tests/test_kernels.py::test_grad_factor_and_second_derivative_vs_fd",),
+           "cubic spline w'(q)/q on q < 1: constant 12 -> 11"),
+    Mutant("neighbours_stencil", "neighbours", "sphdyn/neighbours/grid.py",
+           "return (max(cx - k, 0), min(cx + k, nx - 1)",
+           "return (max(cx - k + 1, 0), min(cx + k, nx - 1)",
+           ("tests/test_neighbours.py::test_random_cloud_matches_brute_force_and_kdtree",),
+           "cell stencil misses the cells on the -x side"),
+    Mutant("neighbours_ties", "neighbours", "sphdyn/neighbours/rows.py",
+           "hit = d0 * d0 + d1 * d1 + d2 * d2 < r * r",
+           "hit = d0 * d0 + d1 * d1 + d2 * d2 <= r * r",
+           ("tests/test_neighbours.py::test_cubic_lattice_ties_are_excluded",),
+           "3D pair test collects pairs exactly at the radius ('<' -> '<=')"),
+    Mutant("j2_hardening", "J2", "sphdyn/materials/j2.py",
+           "d_gamma = f / (3.0 * G + H)", "d_gamma = f / (3.0 * G)",
+           ("tests/test_materials.py::test_j2_uniaxial_stress_bilinear_and_unloading",),
+           "radial return without the hardening modulus in the consistency condition"),
+    Mutant("cscm_shear_surface", "CSCM", "sphdyn/materials/cscm/surface.py",
+           "math.exp(-p[P_BETA] * J1) + p[P_THETA] * J1",
+           "math.exp(-p[P_BETA] * J1) - p[P_THETA] * J1",
+           ("tests/test_cscm.py::test_uniaxial_compression_peak",),
+           "TXC shear surface: sign of the linear theta J1 term"),
+    Mutant("cscm_brittle_softening", "CSCM", "sphdyn/materials/cscm/damage.py",
+           "math.log(1.0 + D) / (D * gf)", "math.log(1.0 + D) / (2.0 * D * gf)",
+           ("tests/test_cscm.py::test_tension_fracture_energy_regularised",),
+           "brittle softening C with the fracture energy doubled"),
+    Mutant("checkpoint_float32", "checkpoints", "sphdyn/io/hdf5.py",
+           "g_scalars.attrs[name] = np.float64(value)",
+           "g_scalars.attrs[name] = np.float32(value)",
+           ("tests/test_io.py::TestHdf5::test_checkpoint_bitwise_round_trip",),
+           "checkpoint scalars stored in single precision"),
+    Mutant("checkpoint_wall_impulse", "checkpoints", "sphdyn/interactions/wall.py",
+           'self.impulse[...] = arrays["impulse"]', "self.impulse[...] = 0.0",
+           ("tests/test_run.py::test_restart_continues_to_the_same_result[updated_lagrangian]",),
+           "restart does not restore the wall impulse"),
+    # ------------------------------------------------------- issue 14, items 1-6
+    Mutant("ul_viscosity_beta_sign", "issue 14.1", "sphdyn/parts/sph/passes.py",
+           "-alpha * 0.5 * (ci + c[j]) * mu + beta * mu * mu",
+           "-alpha * 0.5 * (ci + c[j]) * mu - beta * mu * mu",
+           ("tests/test_sph_passes.py::test_pair_stress_and_viscosity_match_their_formulas",),
+           "updated-Lagrangian artificial viscosity: sign of the beta term"),
+    Mutant("wall_mass_alpha", "issue 14.2", "sphdyn/interactions/wall_contact.py",
+           "an = alpha * pen / (dt * dt)", "an = pen / (dt * dt)",
+           ("tests/test_walls.py::test_spring_acceleration_and_force_match_the_paper",
+            "tests/test_walls.py::test_mass_spring_in_numbers"),
+           "mass-based wall spring (eq. 8) without alpha (10x stiffer)"),
+    Mutant("wall_bulk_alpha", "issue 14.2", "sphdyn/interactions/wall_contact.py",
+           "k = alpha * kbulk[i] * vol0[i]", "k = kbulk[i] * vol0[i]",
+           ("tests/test_walls.py::test_spring_acceleration_and_force_match_the_paper",),
+           "bulk-modulus wall spring (eq. 9) without alpha"),
+    Mutant("wall_alpha_not_passed", "issue 14.2", "sphdyn/interactions/wall.py",
+           "w.alpha, w.friction, dt, a_out, p.wall_force",
+           "1.0, w.friction, dt, a_out, p.wall_force",
+           ("tests/test_walls.py::test_wall_interaction_passes_its_spring_to_the_kernel",),
+           "the Wall interaction passes alpha = 1 instead of the deck's"),
+    Mutant("tl_hourglass_doubled", "issue 14.3", "sphdyn/parts/sph/total_lagrangian.py",
+           "hgk[k] = -0.25 * alpha", "hgk[k] = -0.5 * alpha",
+           ("tests/test_total_lagrangian.py::test_hourglass_coefficients_match_their_formula",),
+           "total-Lagrangian hourglass coefficient doubled"),
+    Mutant("kick_contact_work_halved", "issue 14.4", "sphdyn/integrate.py",
+           "wc += mi * dt_kick * (a_contact", "wc += 0.5 * mi * dt_kick * (a_contact",
+           ("tests/test_integrate.py::"
+            "test_kick_books_the_contact_work_and_energies_over_several_blocks",),
+           "the kick's contact work halved"),
+    Mutant("restart_work_external", "issue 14.5", "sphdyn/stepper.py",
+           'self.work_external = float(scalars["work_external"])',
+           "self.work_external = 0.0",
+           ("tests/test_run.py::test_restart_restores_the_external_work",),
+           "restart does not restore the external work"),
+    Mutant("ensemble_population_std", "issue 14.6", "sphdyn/compression.py",
+           "np.std(values, ddof=1)", "np.std(values, ddof=0)",
+           ("tests/test_compression.py::test_curve_of_an_elastic_column",),
+           "ensemble CoV with the population instead of the sample std"),
+    Mutant("artificial_stress_rho", "issue 14.6",
+           "sphdyn/parts/sph/artificial_stress.py",
+           "f = -eps[i] / (rho[i] * rho[i])", "f = -eps[i] / rho[i]",
+           ("tests/test_artificial_stress.py::test_epsilon_per_body",),
+           "artificial stress divided by rho instead of rho^2"),
+    Mutant("artificial_stress_exponent", "issue 14.6",
+           "sphdyn/parts/sph/artificial_stress.py",
+           "fn = fij ** n_exp", "fn = fij ** int(n_exp)",
+           ("tests/test_artificial_stress.py::"
+            "test_pair_force_is_repulsive_with_the_stated_magnitude",),
+           "non-integer exponent n truncated to an integer"),
+)
+
+
+class MutantRefused(ValueError):
+    """The mutant's snippet is not found exactly once in the source."""
+
+
+def apply_mutant(mutant: Mutant, src_root: Path) -> None:
+    """Replace ``mutant.old`` by ``mutant.new`` in ``src_root/mutant.path`` (in place).
+
+    Raises :class:`MutantRefused` unless the snippet occurs exactly once.
+    """
+    path = Path(src_root) / mutant.path
+    text = path.read_text(encoding="utf-8")
+    count = text.count(mutant.old)
+    if count != 1:
+        raise MutantRefused(f"{mutant.name}: snippet found {count} times in {mutant.path} "
+                            f"(must be exactly once): {mutant.old!r}")
+    path.write_text(text.replace(mutant.old, mutant.new), encoding="utf-8")
+
+
+def check_mutants(mutants=MUTANTS, src_root: Path = SRC) -> list[str]:
+    """Problems of the mutant list against today's source (empty: all usable)."""
+    problems = []
+    names = [m.name for m in mutants]
+    if len(set(names)) != len(names):
+        problems.append("duplicate mutant names")
+    for m in mutants:
+        path = Path(src_root) / m.path
+        if not path.is_file():
+            problems.append(f"{m.name}: no file {m.path}")
+            continue
+        count = path.read_text(encoding="utf-8").count(m.old)
+        if count != 1:
+            problems.append(f"{m.name}: snippet found {count} times in {m.path}")
+        if m.new == m.old:
+            problems.append(f"{m.name}: the replacement equals the snippet")
+        if not m.tests:
+            problems.append(f"{m.name}: no tests named")
+    return problems
+
+
+def _copy_source(dest: Path) -> Path:
+    """Copy ``src/`` to ``dest/src`` without caches; return the copy's path."""
+    out = dest / "src"
+    shutil.copytree(SRC, out, ignore=shutil.ignore_patterns(
+        "__pycache__", "*.pyc", "*.nbi", "*.nbc", "*.egg-info"))
+    return out
+
+
+def _environment(src_copy: Path, cache: Path) -> dict[str, str]:
+    env = dict(os.environ)
+    env["PYTHONPATH"] = str(src_copy)
+    env["NUMBA_CACHE_DIR"] = str(cache)
+    env.pop("PYTEST_ADDOPTS", None)
+    return env
+
+
+def _imported_from(env: dict[str, str]) -> Path:
+    """The directory ``sphdyn`` is imported from under ``env``."""
+    out = subprocess.run([sys.executable, "-c", "import sphdyn; print(sphdyn.__file__)"],
+                         env=env, cwd=ROOT, capture_output=True, text=True, check=True)
+    return Path(out.stdout.strip()).resolve().parent
+
+
+def run_tests(tests, mutant: Mutant | None, timeout: float) -> tuple[str, float, str]:
+    """Run ``tests`` against a copy of ``src/`` with ``mutant`` applied (None: unchanged).
+
+    Returns (outcome, seconds, last lines of the output); outcome is
+    ``passed``, ``failed``, ``timeout`` or ``error: <why>``.
+    """
+    with tempfile.TemporaryDirectory(prefix="sphdyn-mutant-") as tmp:
+        tmp = Path(tmp)
+        src_copy = _copy_source(tmp)
+        if mutant is not None:
+            apply_mutant(mutant, src_copy)
+        env = _environment(src_copy, tmp / "numba_cache")
+        where = _imported_from(env)
+        if where != (src_copy / "sphdyn").resolve():
+            return f"error: sphdyn imported from {where}, not the copy", 0.0, ""
+        cmd = [sys.executable, "-m", "pytest", "-q", "-x", "-p", "no:cacheprovider",
+               f"--basetemp={tmp / 'pytest'}", *tests]
+        t0 = time.perf_counter()
+        try:
+            proc = subprocess.run(cmd, env=env, cwd=ROOT, capture_output=True, text=True,
+                                  timeout=timeout)
+        except subprocess.TimeoutExpired:
+            return "timeout", time.perf_counter() - t0, ""
+        seconds = time.perf_counter() - t0
+        lines = (proc.stdout + proc.stderr).strip().splitlines()
+        # the failing tests of the short summary (-ra), else the last lines
+        failed = [ln for ln in lines if ln.startswith(("FAILED ", "ERROR "))]
+        tail = "\n".join(failed or lines[-5:])
+        outcome = {0: "passed", 1: "failed"}.get(proc.returncode,
+                                                  f"error: pytest exit {proc.returncode}")
+        return outcome, seconds, tail
+
+
+def judge(outcome: str) -> str:
+    """Mutant verdict from the outcome of its tests."""
+    if outcome in ("failed", "timeout"):
+        return "caught"
+    if outcome == "passed":
+        return "survived"
+    return outcome
+
+
+def markdown_table(results) -> str:
+    """The results as a Markdown table plus the catch rate."""
+    lines = ["| mutant | area | change | tests | result | time [s] |",
+             "|---|---|---|---|---|---|"]
+    for m, verdict, seconds in results:
+        tests = "<br>".join(f"`{t.removeprefix('tests/')}`" for t in m.tests)
+        lines.append(f"| `{m.name}` | {m.area} | {m.what} | {tests} | {verdict} | "
+                     f"{seconds:.0f} |")
+    caught = sum(v == "caught" for _, v, _ in results)
+    lines.append("")
+    lines.append(f"Catch rate: {caught} of {len(results)} "
+                 f"({100.0 * caught / max(len(results), 1):.0f} %).")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None) -> int:
+    """Command line: see the module docstring. Exit status 0 if every mutant is caught."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--only", nargs="+", metavar="NAME", help="run only these mutants")
+    ap.add_argument("--list", action="store_true", help="list the mutants and exit")
+    ap.add_argument("--no-baseline", action="store_true",
+                    help="skip the run of all named tests on the unchanged source")
+    ap.add_argument("--timeout", type=float, default=1800.0,
+                    help="seconds per mutant before it counts as caught (default 1800)")
+    ap.add_argument("--markdown", type=Path, help="also write the table to this file")
+    args = ap.parse_args(argv)
+
+    mutants = list(MUTANTS)
+    if args.only:
+        unknown = set(args.only) - {m.name for m in mutants}
+        if unknown:
+            ap.error(f"unknown mutants: {', '.join(sorted(unknown))}")
+        mutants = [m for m in mutants if m.name in args.only]
+    if args.list:
+        for m in mutants:
+            print(f"{m.name:28s} {m.area:12s} {m.path}: {m.what}")
+        return 0
+    problems = check_mutants(mutants)
+    if problems:
+        print("refused:\n  " + "\n  ".join(problems), file=sys.stderr)
+        return 2
+
+    if not args.no_baseline:
+        tests = list(dict.fromkeys(t for m in mutants for t in m.tests))
+        print(f"baseline: {len(tests)} tests on the unchanged source ...", flush=True)
+        outcome, seconds, tail = run_tests(tests, None, args.timeout)
+        print(f"baseline: {outcome} ({seconds:.0f} s)", flush=True)
+        if outcome != "passed":
+            print(tail, file=sys.stderr)
+            return 2
+
+    results = []
+    for m in mutants:
+        outcome, seconds, tail = run_tests(m.tests, m, args.timeout)
+        verdict = judge(outcome)
+        results.append((m, verdict, seconds))
+        print(f"{m.name:28s} {verdict:9s} ({seconds:.0f} s)", flush=True)
+        if verdict != "survived":  # which test caught it (or why it could not run)
+            print("  " + tail.replace("\n", "\n  "), flush=True)
+    table = markdown_table(results)
+    print()
+    print(table)
+    if args.markdown:
+        args.markdown.write_text(table, encoding="utf-8")
+    return 0 if all(v == "caught" for _, v, _ in results) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
