@@ -52,6 +52,9 @@ SKIP = {
     "sphdyn ensemble examples/disc_impact_random_mass.toml --samples 100 "
     "--scheduler tcp://10.0.0.5:8786 --threads 1 --out /scratch/kappa":
         "needs a Dask scheduler at tcp://10.0.0.5:8786",
+    # the mutation check: 19 mutants, each a fresh compile (about 7 minutes)
+    "python tools/mutation.py --markdown mutation-result.md":
+        "runs the mutation check (minutes); tests/test_mutation_script.py checks its list",
     # starts an MPI job of 34 ranks
     "mpirun -np 34 dask-mpi --scheduler-file sched.json --nthreads 1 &":
         "starts an MPI job",
