@@ -138,7 +138,7 @@ name = "disc"
 material = "m"
 dx = 1e-3
 velocity = [{vx}, {-vel}, 0]
-geometry = {{ shape = "cylinder", centre = [0, 0.0106, 0], radius = 0.01, length = 1 }}
+geometry = {{ shape = "cylinder", centre = [0, 0.0106, 0], radius = 0.01 }}
 [[wall]]
 name = "floor"
 point = [0, 0, 0]
@@ -382,13 +382,13 @@ name = "a"
 material = "m"
 dx = 1e-3
 velocity = [8.0, 1.0, 0]
-geometry = {{ shape = "cylinder", centre = [-0.0115, 0.002, 0], radius = 0.01, length = 1 }}
+geometry = {{ shape = "cylinder", centre = [-0.0115, 0.002, 0], radius = 0.01 }}
 [[body]]
 name = "b"
 material = "m"
 dx = 1e-3
 velocity = [-4.0, 0, 0]
-geometry = {{ shape = "ring", centre = [0.0085, 0, 0], inner_radius = 0.003, outer_radius = 0.007, length = 1 }}
+geometry = {{ shape = "ring", centre = [0.0085, 0, 0], inner_radius = 0.003, outer_radius = 0.007 }}
 """
     s, _ = _solver(text)
     p0 = (s.particles.m[:, None] * s.particles.v).sum(axis=0)
