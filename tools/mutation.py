@@ -131,6 +131,10 @@ MUTANTS: tuple[Mutant, ...] = (
            ("tests/test_integrate.py::"
             "test_kick_books_the_contact_work_and_energies_over_several_blocks",),
            "the kick's contact work halved"),
+    Mutant("drift_y_uses_x_velocity", "integration", "sphdyn/integrate.py",
+           "x[i, 1] += dt * v[i, 1]", "x[i, 1] += dt * v[i, 0]",
+           ("tests/test_integrate.py::test_leapfrog_is_second_order",),
+           "the drift moves y with the x velocity"),
     Mutant("restart_work_external", "issue 14.5", "sphdyn/stepper.py",
            'self.work_external = float(scalars["work_external"])',
            "self.work_external = 0.0",
