@@ -3,8 +3,10 @@
 The paper's CSCM concrete disc (100 mm diameter, 20 mm deep, 3D) striking a
 rigid base at 15 m/s is run unchanged except for the particle spacing
 (``--set body.disc.dx=...``, spacings that divide the 20 mm depth and the
-100 mm diameter) with ``sphdyn run`` in a subprocess, one at a time, on one
-thread. From each run:
+100 mm diameter) and run to 300 us instead of 200 us (``run.t_end``: at
+200 us the disc is still on the base, so neither its rebound nor the total
+impulse is known there), with ``sphdyn run`` in a subprocess, one at a time,
+on one thread. From each run:
 
 * peak wall force: raw (``peak_F_wall_base`` of summary.json) and the peak
   of the mean over ``output.force_window`` = 5 us
@@ -13,13 +15,14 @@ thread. From each run:
   (I(t_c + 50 us) - I(t_c + 10 us)) / 40 us from the impulse column
   ``I_wall_base`` (exact, however sparse the history); t_c is the first
   record with a wall force;
-* total impulse I_wall_base at the end (200 us);
-* mean body velocity at the end: sum m v_y / sum m over the last frame
-  (checked against -15 m/s + I / M, momentum balance with the wall the only
-  external force);
-* damaged volume: sum of m / rho over the particles with damage > 0.9 in the
-  last frame (the threshold the docs use for "failed"), and its fraction of
-  the body's volume.
+* total impulse I_wall_base at 300 us, and the wall force left then;
+* mean body velocity at 300 us (the rebound velocity once the contact is
+  over): sum m v_y / sum m over the last frame (checked against
+  -15 m/s + I / M, momentum balance with the wall the only external force);
+* damaged volume at 200 us (the deck's end time, the figure in
+  docs/examples.md) and at 300 us: sum of m / rho over the particles with
+  damage > 0.9 (the threshold the docs use for "failed"), and its fraction
+  of the body's volume.
 
 The table gives each quantity per spacing and the relative change between
 the two finest spacings; a quantity is called converged when that change is
@@ -42,7 +45,7 @@ from pathlib import Path
 import numpy as np
 
 from sphdyn.io.frames import list_frames
-from sphdyn.io.hdf5 import read_frame
+from sphdyn.io.hdf5 import read_frame, read_frame_header
 from sphdyn.io.history import History
 
 HERE = Path(__file__).resolve().parent
@@ -53,6 +56,8 @@ SPACINGS_MM = (5.0, 4.0, 10.0 / 3.0, 2.5, 2.0)
 IMPACT_SPEED = 15.0            # m/s, the deck's body velocity
 DAMAGE_THRESHOLD = 0.9
 PLATEAU = (10e-6, 50e-6)       # s after first contact
+T_END = 300e-6                 # s, run end (the deck's is 200 us)
+T_DAMAGE = 200e-6              # s, the deck's end time: damage also measured there
 CONVERGED_PCT = 3.0
 WALL = "base"
 
@@ -68,6 +73,7 @@ def run_one(dx_mm: float, out: Path, threads: int) -> None:
     cmd = [sys.executable, "-m", "sphdyn", "run", str(DECK), "--out", str(out),
            "--threads", str(threads), "-q",
            "--set", f"body.disc.dx={dx_mm * 1e-3!r}",
+           "--set", f"run.t_end={T_END!r}",
            "--set", "output.vtk=false",
            "--set", 'output.fields=["velocity","damage","density","mass"]']
     subprocess.run(cmd, check=True, env=os.environ.copy())
@@ -82,11 +88,12 @@ def measure(out: Path, dx_mm: float) -> dict:
     t, force, impulse = h["time"], h[f"F_wall_{WALL}"], h[f"I_wall_{WALL}"]
     t_contact = t[np.flatnonzero(force > 0)[0]]
     i0, i1 = np.interp(t_contact + np.array(PLATEAU), t, impulse)
-    _, _, fields, _ = read_frame(list_frames(out)[-1])
-    m, rho = fields["mass"], fields["density"]
-    vol = m / rho
+    frames = list_frames(out)
+    _, _, fields, _ = read_frame(frames[-1])
+    m = fields["mass"]
     mass = m.sum()
-    damaged = fields["damage"] > DAMAGE_THRESHOLD
+    at_damage_time = min(frames, key=lambda f: abs(read_frame_header(f)[0] - T_DAMAGE))
+    _, _, early, _ = read_frame(at_damage_time)
     return {
         "dx_mm": dx_mm,
         "particles": summary["particles"],
@@ -96,22 +103,34 @@ def measure(out: Path, dx_mm: float) -> dict:
         "peak_force_5us_kN": 1e-3 * summary[f"peak_F_wall_{WALL}_mean"],
         "plateau_force_kN": 1e-3 * (i1 - i0) / (PLATEAU[1] - PLATEAU[0]),
         "impulse_Ns": float(impulse[-1]),
+        "end_force_kN": 1e-3 * float(force[-1]),
         "end_velocity_ms": float((m * fields["velocity"][:, 1]).sum() / mass),
         "end_velocity_momentum_ms": -IMPACT_SPEED + float(impulse[-1]) / mass,
-        "damaged_volume_cm3": 1e6 * float(vol[damaged].sum()),
-        "damaged_fraction_pct": 100.0 * float(vol[damaged].sum() / vol.sum()),
+        **_damaged("_200us", early),
+        **_damaged("_300us", fields),
         "_t": t, "_F": force,
     }
+
+
+def _damaged(suffix: str, fields: dict) -> dict:
+    """Volume [cm^3] and volume fraction [%] with damage above the threshold."""
+    vol = fields["mass"] / fields["density"]
+    failed = vol[fields["damage"] > DAMAGE_THRESHOLD].sum()
+    return {f"damaged_volume{suffix}_cm3": 1e6 * float(failed),
+            f"damaged_fraction{suffix}_pct": 100.0 * float(failed / vol.sum())}
 
 
 QUANTITIES = (  # key, label
     ("peak_force_kN", "peak wall force, raw [kN]"),
     ("peak_force_5us_kN", "peak wall force, 5 us mean [kN]"),
     ("plateau_force_kN", "force plateau, 10-50 us after contact [kN]"),
-    ("impulse_Ns", "total impulse at 200 us [N s]"),
-    ("end_velocity_ms", "mean body velocity at 200 us [m/s]"),
-    ("damaged_volume_cm3", "damaged volume, damage > 0.9 [cm^3]"),
-    ("damaged_fraction_pct", "damaged volume fraction [%]"),
+    ("impulse_Ns", "total impulse at 300 us [N s]"),
+    ("end_force_kN", "wall force left at 300 us [kN]"),
+    ("end_velocity_ms", "mean body velocity (rebound) at 300 us [m/s]"),
+    ("damaged_volume_200us_cm3", "damaged volume at 200 us, damage > 0.9 [cm^3]"),
+    ("damaged_fraction_200us_pct", "damaged volume fraction at 200 us [%]"),
+    ("damaged_volume_300us_cm3", "damaged volume at 300 us, damage > 0.9 [cm^3]"),
+    ("damaged_fraction_300us_pct", "damaged volume fraction at 300 us [%]"),
 )
 
 
@@ -172,7 +191,7 @@ def plot(results: list[dict], path: Path) -> None:
     ax_f.legend(fontsize=8)
     dx = np.array([r["dx_mm"] for r in results])
     for key, label in QUANTITIES:
-        if key == "damaged_fraction_pct":
+        if "fraction" in key or key == "end_force_kN":
             continue
         v = np.array([r[key] for r in results])
         ax_q.plot(dx, v / v[-1], "o-", label=label)
