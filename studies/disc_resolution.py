@@ -134,13 +134,21 @@ QUANTITIES = (  # key, label
 )
 
 
+def _relative_change_pct(coarse: float, fine: float) -> float:
+    """100 (fine / coarse - 1); 0 when both are 0 (e.g. no wall force left)."""
+    if coarse == 0.0:
+        return 0.0 if fine == 0.0 else float("inf")
+    return 100.0 * (fine / coarse - 1.0)
+
+
 def table_rows(results: list[dict]) -> list[dict]:
     """One row per quantity: its value per spacing and the relative change
     between the two finest spacings."""
     rows = []
     for key, label in QUANTITIES:
         values = [r[key] for r in results]
-        change = 100.0 * (values[-1] / values[-2] - 1.0) if len(values) > 1 else float("nan")
+        change = _relative_change_pct(values[-2], values[-1]) if len(values) > 1 \
+            else float("nan")
         rows.append({"quantity": label, **{f"dx={r['dx_mm']:.3g} mm": v
                                            for r, v in zip(results, values)},
                      "change_finest_pct": change,
