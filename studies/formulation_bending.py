@@ -28,7 +28,7 @@ the corrected reference gradients).
   plateau stress = mean wall force per unit depth over the middle half of
   the theoretical contact, divided by H.
 
-Run ``PYTHONPATH=src python studies/formulation_bending.py`` (about 10 min
+Run ``PYTHONPATH=src python studies/formulation_bending.py`` (about 16 min
 on one core); it writes ``docs/figures/formulation_bending.csv`` and
 ``docs/figures/formulation_bending.png`` and prints the table.
 """
