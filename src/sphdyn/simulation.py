@@ -118,7 +118,7 @@ class Simulation:
 
         ``threads``: a fixed Numba thread count, or None to let a
         :class:`~sphdyn.threads.ThreadTuner` keep the faster of all threads
-        and one (results are the same bits either way).
+        and half of them (results are the same bits either way).
 
         SIGINT or SIGTERM (in the main thread) end the run after the current
         step with all output and a checkpoint written; the summary's status
