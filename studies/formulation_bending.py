@@ -10,7 +10,8 @@ the corrected reference gradients).
 * **Cantilever** (``decks/cantilever.toml.tmpl``): free length L = 100 mm,
   thickness H = 10 mm, clamped by fixed particles at x < 0, released with the
   Euler-Bernoulli first-mode shape as initial velocity (set on the particles
-  through the Python API: a deck gives one velocity per body). The first
+  through the Python API; a deck can now give it as a [body.initial]
+  velocity expression, see docs/tensile-instability.md). The first
   bending period is measured from the zero crossings of the mean tip
   displacement and compared with
 
