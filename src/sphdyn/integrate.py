@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from .state import BC_FIXED, BC_VELOCITY
+from .state import BC_FIXED
 
 
 #: particles per block of the kick's energy sums: the sums are taken block by
