@@ -196,3 +196,18 @@ def test_history_flush_keeps_the_file_within_its_interval():
         flush.after_step(None)
     gaps = np.diff(writes[1:])
     assert writes[2] == 15.0 and np.all(gaps[1:] >= 20.0), writes
+
+
+def test_ctrl_c_outside_the_step_loop_is_one_line_and_130(tmp_path, monkeypatch, capsys):
+    # e.g. while a big model is being built: no traceback, exit 130
+    import sphdyn.model
+
+    def slow_build(deck):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(sphdyn.model, "build_model", slow_build)
+    deck = tmp_path / "d.toml"
+    deck.write_text(SMALL_DISC.format(t_end="3 ms", ck=0))
+    assert main(["check", str(deck)]) == 130
+    err = capsys.readouterr().err
+    assert "interrupted" in err and "Traceback" not in err

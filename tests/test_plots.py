@@ -35,7 +35,7 @@ def _history(t_end: float, n: int = 40, shortened: bool = True) -> dict:
 
 
 @pytest.mark.parametrize("duration, factor, unit", [
-    (4e-4, 1e6, "µs"), (12e-3, 1e3, "ms"), (2.0, 1.0, "s")])
+    (2.5e-7, 1e9, "ns"), (4e-4, 1e6, "µs"), (12e-3, 1e3, "ms"), (2.0, 1.0, "s")])
 def test_time_unit_follows_the_duration(duration, factor, unit):
     assert time_unit(duration) == (factor, unit)
 
@@ -85,8 +85,10 @@ def test_the_shortened_last_step_is_not_part_of_the_dt_line():
     data = _history(1e-3)
     ax = history_figures(data, dimension=2, t_end=1e-3)["dt"].axes[0]
     main, last = ax.get_lines()
-    assert np.array_equal(main.get_ydata(), data["dt"][:-1])
-    assert np.array_equal(last.get_ydata(), data["dt"][-1:])
+    # dt = 1e-3 / 39 = 25.6 us: shown in us
+    assert ax.get_ylabel() == "time step dt [µs]"
+    assert np.allclose(main.get_ydata(), data["dt"][:-1] * 1e6, rtol=1e-15)
+    assert np.allclose(last.get_ydata(), data["dt"][-1:] * 1e6, rtol=1e-15)
     assert "shortened" in last.get_label()
     # a run stopped before t_end (or without a known t_end) keeps every step
     assert len(history_figures(data, dimension=2, t_end=2e-3)["dt"].axes[0].get_lines()) == 1

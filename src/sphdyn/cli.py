@@ -564,6 +564,10 @@ def main(argv=None) -> int:
         print(f"sphdyn: {exc.diagnosis}\nAll output written so far is kept.",
               file=sys.stderr)
         return 1
+    except KeyboardInterrupt:  # Ctrl-C before stepping, or a second one during a run
+        print("sphdyn: interrupted (a run's checkpoint, if it wrote one, is kept; "
+              "resume with sphdyn restart DIR)", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":

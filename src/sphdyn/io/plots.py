@@ -37,10 +37,12 @@ def _figure(nrows: int = 1, height: float = 4.0):
 def time_unit(duration: float) -> tuple[float, str]:
     """Factor and unit name for showing times of a run lasting ``duration`` [s].
 
-    Microseconds below 1 ms, milliseconds below 1 s, seconds above:
-    ``t * factor`` is the shown number.
+    Nanoseconds below 1 us (time steps), microseconds below 1 ms,
+    milliseconds below 1 s, seconds above: ``t * factor`` is the shown number.
     """
     duration = abs(float(duration))
+    if 0.0 < duration < 1e-6:
+        return 1e9, "ns"
     if duration < 1e-3:
         return 1e6, "µs"
     if duration < 1.0:
@@ -227,16 +229,17 @@ def history_figures(data: dict[str, np.ndarray], title: str = "",
     if "dt" in data and xkey is not None:
         fig, (ax,) = _figure()
         x = data["step"] if xkey == "step" else shown
-        dt = data["dt"]
+        df, du = time_unit(np.max(np.abs(data["dt"])) if data["dt"].size else 0.0)
+        dt = data["dt"] * df
         last_shortened = (t_end is not None and time is not None and dt.size > 1
                           and time[-1] >= t_end * (1 - 1e-12) and dt[-1] < dt[-2])
         n = dt.size - 1 if last_shortened else dt.size
         ax.plot(x[:n], dt[:n], label="dt")
         if last_shortened:
             ax.plot(x[-1:], dt[-1:], "v", color="tab:red", linestyle="none",
-                    label=f"last step, shortened to end at t_end ({dt[-1]:.3g} s)")
+                    label=f"last step, shortened to end at t_end ({dt[-1]:.3g} {du})")
         ax.set_xlabel("step [-]" if xkey == "step" else f"time [{tu}]")
-        ax.set_ylabel("time step dt [s]")
+        ax.set_ylabel(f"time step dt [{du}]")
         _finish_axes(ax, f"Time step ({title})")
         figures["dt"] = fig
     return figures
