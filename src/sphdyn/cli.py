@@ -54,20 +54,24 @@ def _duration(text: str) -> float:
 
 
 def _writable_dir(path, flag: str) -> Path:
-    """Create directory ``path`` if needed and make sure a file can be written in it.
+    """Check that directory ``path`` can be made and written, without making it.
 
-    Raises a ValueError naming ``flag`` (the option that gave the path) when
-    the path is a file, lies under a file or cannot be written.
+    The path must not be a file or lie under one, and its nearest existing
+    directory (itself, or the ancestor it would be made in) must take a new
+    file. Raises a ValueError naming ``flag`` (the option that gave the path).
     """
     import tempfile
 
     path = Path(path)
-    if path.exists() and not path.is_dir():
-        raise ValueError(f"{flag} {path}: this is a file, not a directory. "
+    probe = path
+    while not probe.exists() and probe != probe.parent:
+        probe = probe.parent
+    if not probe.is_dir():
+        what = "this is a file" if probe == path else f"{probe} is a file"
+        raise ValueError(f"{flag} {path}: {what}, not a directory. "
                          f"Fix: give {flag} a directory (new or existing)")
     try:
-        path.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryFile(dir=path):
+        with tempfile.TemporaryFile(dir=probe):
             pass
     except OSError as exc:
         raise ValueError(f"{flag} {path}: cannot write there ({exc.strerror or exc}). "
@@ -75,25 +79,18 @@ def _writable_dir(path, flag: str) -> Path:
     return path
 
 
-def _print_warnings(lines) -> None:
-    for line in lines:
-        print(f"sphdyn: warning: {line}", file=sys.stderr)
-
-
 def cmd_run(args) -> int:
     from .deck import load_deck
-    from .preflight import check_deck
     from .simulation import Simulation
 
     deck = load_deck(args.deck, args.set)
-    check_deck(deck)  # refused before the output directory is made
     out = Path(args.out) if args.out else Path("out") / Path(args.deck).stem
     _writable_dir(out, "--out")
     sim = Simulation.from_deck(deck, out)
     print(f"sphdyn: {sim.particles.n} particles, {deck.run.dimension}D, "
           f"t_end = {deck.run.t_end:g} s, initial dt = {sim.stepper.dt0:.3e} s -> {out}")
     return _finish(sim.run(max_steps=args.max_steps, progress=not args.quiet and None,
-                           threads=args.threads or None), out)
+                           threads=args.threads), out)
 
 
 def cmd_restart(args) -> int:
@@ -111,7 +108,7 @@ def cmd_restart(args) -> int:
           f"(step {sim.stepper.step_count})")
     return _finish(sim.run(t_end=args.t_end, max_steps=args.max_steps,
                            progress=not args.quiet and None,
-                           threads=args.threads or None), args.dir)
+                           threads=args.threads), args.dir)
 
 
 def _finish(summary: dict, out) -> int:
@@ -134,14 +131,12 @@ def _finish(summary: dict, out) -> int:
 
 def cmd_ensemble(args) -> int:
     from .ensemble import run_ensemble, write_report
-    from .ensemble.plan import parse_vary, validate_grid
 
     out = Path(args.out) if args.out else Path("out") / f"{Path(args.deck).stem}-ensemble"
     if args.report:
         print(write_report(out))
         return 0
-    validate_grid(args.deck, parse_vary(args.vary), args.set or ())  # before anything
-    _writable_dir(out, "--out")
+    _writable_dir(out, "--out")  # the --vary grid is checked by the plan, before Dask
     path = run_ensemble(args.deck, args.samples, vary=args.vary or (), out=out,
                         scheduler=args.scheduler, workers=args.workers,
                         threads=args.threads, overrides=args.set or (),
@@ -153,11 +148,11 @@ def cmd_ensemble(args) -> int:
 def cmd_check(args) -> int:
     from .deck import load_deck
     from .model import build_model
-    from .preflight import check_deck, memory_limit, show_bytes
+    from .preflight import estimate_size, memory_limit, show_bytes
 
     deck = load_deck(args.deck, args.set)
-    estimate = check_deck(deck)
-    model = build_model(deck)
+    model = build_model(deck)  # refuses a model over the memory limit before building
+    estimate = estimate_size(deck)
     p = model.particles
     limit, source = memory_limit(deck)
     print(f"{args.deck}: OK")
@@ -341,8 +336,7 @@ def _material_params(name: str, params: dict) -> dict:
     except ValidationError as exc:
         raise ValueError("\n".join(f"--param {line}" for line in explain(exc, raw, schema))
                          ) from None
-    return {k: v for k, v in table.model_dump().items()
-            if k not in ("name", "model", "variation") and v is not None}
+    return table.values()
 
 
 def cmd_material_test(args) -> int:
@@ -368,8 +362,7 @@ def cmd_material_test(args) -> int:
             raise ValueError(f"--material: the deck has no material {args.material!r}; "
                              f"materials: {', '.join(mats)}")
         mat = mats[args.material]
-        params = {k: v for k, v in mat.model_dump().items()
-                  if k not in ("name", "model") and v is not None}
+        params = mat.values()
         if name and name != mat.model:
             raise ValueError(f"MODEL {name!r} differs from the deck material's "
                              f"model {mat.model!r}")

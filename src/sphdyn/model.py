@@ -93,13 +93,6 @@ def wall_specs(deck) -> list[WallSpec]:
         for w in deck.wall]
 
 
-def _material_params(mat) -> dict:
-    d = mat.model_dump()
-    for key in ("name", "model", "variation"):
-        d.pop(key, None)
-    return {k: v for k, v in d.items() if v is not None}
-
-
 def _phase_materials(deck, b: int, body, x: np.ndarray, dim: int, mat_index: dict,
                      photos: dict) -> tuple[np.ndarray, np.ndarray | None]:
     """Material index (N,) and mesostructure phase (N,) int8 of a body's particles.
@@ -162,7 +155,7 @@ def _material_groups(deck, particles: Particles, models: dict,
             z = standard_normal_field(particles.x[idx], var.correlation_length, rng)
             cls, mids = quantise(z, var.classes)
         f = factor_of(mids, var.cov, var.distribution)
-        base = _material_params(m)
+        base = m.values()
         for c in np.unique(cls):
             sub = idx[cls == c]
             values = {**base, var.parameter: base[var.parameter] * f[c]}
@@ -209,7 +202,7 @@ def build_model(deck) -> Model:
     mats = {m.name: m for m in deck.material}
     mat_index = {m.name: k for k, m in enumerate(deck.material)}
     models = {m.name: get_model(m.model) for m in deck.material}
-    params = {name: models[name].pack(_material_params(m)) for name, m in mats.items()}
+    params = {name: models[name].pack(m.values()) for name, m in mats.items()}
     n_hist = max([len(models[n].history_names) for n in mats] + [0])
     layouts = {models[n].history_names for n in mats} - {()}
     if len(layouts) > 1:

@@ -267,7 +267,6 @@ def check_placement(deck, positions: list[np.ndarray]) -> None:
         raise DeckError(problems)
 
 
-
 def checked_lattices(deck) -> tuple[SizeEstimate, list[np.ndarray]]:
     """The size estimate and the bodies' lattices, after every check of this module.
 
@@ -281,8 +280,3 @@ def checked_lattices(deck) -> tuple[SizeEstimate, list[np.ndarray]]:
     lattices = [lattice_from_shape(b.geometry.model_dump(), b.dx, dim) for b in deck.body]
     check_placement(deck, lattices)
     return estimate, lattices
-
-
-def check_deck(deck) -> SizeEstimate:
-    """Run every check of this module without building the model; the estimate."""
-    return checked_lattices(deck)[0]

@@ -79,12 +79,16 @@ class Simulation:
     # ---------------------------------------------------------------- set-up
     @classmethod
     def from_deck(cls, deck, outdir, events=()) -> "Simulation":
-        """A new run of ``deck`` in ``outdir``; ``events`` are added to the deck's."""
+        """A new run of ``deck`` in ``outdir``; ``events`` are added to the deck's.
+
+        The model is built (and checked: size, placement) before ``outdir`` is
+        made, so a refused deck leaves nothing behind.
+        """
         outdir = Path(outdir)
-        outdir.mkdir(parents=True, exist_ok=True)
-        dump_resolved(deck, outdir / RESOLVED)
         model = build_model(deck)
         stepper = build_stepper(deck, model, events=events)
+        outdir.mkdir(parents=True, exist_ok=True)
+        dump_resolved(deck, outdir / RESOLVED)
         return cls(deck, outdir, model, stepper, History(),
                    FrameWriter(outdir, vtk=deck.output.vtk), next_frame=0.0)
 

@@ -50,27 +50,6 @@ def memory_size(value: Any) -> float:
 
 
 @dataclass(frozen=True)
-class OnlyIn:
-    """After-validator: a key that means something only in ``dim`` dimensions.
-
-    In a deck of the other dimension the key must be absent (None); ``why``
-    says what the shape is there ("a 2D cylinder is a disc in the x-y
-    plane"). Read by :mod:`sphdyn.deck.docgen` through the metadata.
-    """
-
-    dim: int
-    why: str
-
-    def __call__(self, value: Any) -> Any:
-        actual = dimension()
-        if value is not None and actual is not None and actual != self.dim:
-            raise problem(f"this key means nothing in a {actual}D deck "
-                          f"(run.dimension = {actual}; {self.why})",
-                          f"remove it, or set run.dimension = {self.dim}")
-        return value
-
-
-@dataclass(frozen=True)
 class Bounds:
     """After-validator checking that a number lies in an interval.
 

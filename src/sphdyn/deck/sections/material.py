@@ -57,6 +57,12 @@ class MaterialSection(Section):
                           f"give {var.parameter} explicitly to vary it")
         return self
 
+    def values(self) -> dict:
+        """The model's parameters in SI units, as ``pack`` takes them: every key
+        but name, model and variation, absent (None) values left out."""
+        return {key: v for key, v in self.model_dump().items()
+                if key not in ("name", "model", "variation") and v is not None}
+
 
 def parameter_clashes(materials) -> list[tuple[int, str]]:
     """``(index, message)`` of validated materials whose model refuses the values
@@ -67,10 +73,8 @@ def parameter_clashes(materials) -> list[tuple[int, str]]:
     for k, mat in enumerate(materials):
         if mat.model not in available_models():
             continue
-        values = {key: v for key, v in mat.model_dump().items()
-                  if key not in ("name", "model", "variation") and v is not None}
         try:
-            get_model(mat.model).pack(values)
+            get_model(mat.model).pack(mat.values())
         except ValueError as exc:
             clashes.append((k, str(exc)))
     return clashes

@@ -7,7 +7,7 @@ from pydantic import AfterValidator, Field, ValidationInfo, field_validator
 from ..messages import problem, show_number
 from ..scope import dimension
 from ..units import LENGTH
-from ..values import (Axis, Corner, Direction, OnlyIn, Position, PositiveLength, Section,
+from ..values import (Axis, Corner, Direction, Position, PositiveLength, Section,
                       UpperCorner, UpperPosition, quantity)
 
 
@@ -36,16 +36,20 @@ def _axis_in_plane(axis: str) -> str:
 
 
 def _length_in_3d(length: Optional[float]) -> Optional[float]:
-    if length is None and dimension() == 3:
+    """A cylinder's or ring's length: required in 3D, refused in 2D."""
+    dim = dimension()
+    if length is None and dim == 3:
         raise problem("a cylinder or ring in a 3D deck needs a length",
                       "add length = \"100 mm\" (or a number in metres)")
+    if length is not None and dim == 2:
+        raise problem("this key means nothing in a 2D deck (run.dimension = 2; a "
+                      "cylinder or ring is then a disc or annulus in the x-y plane, "
+                      "per unit depth)", "remove it, or set run.dimension = 3")
     return length
 
 
 PlanarAxis = Annotated[Axis, AfterValidator(_axis_in_plane)]
-AxialLength = Annotated[Optional[PositiveLength], AfterValidator(_length_in_3d),
-                        AfterValidator(OnlyIn(3, "a cylinder or ring is then a disc or "
-                                                 "annulus in the x-y plane, per unit depth"))]
+AxialLength = Annotated[Optional[PositiveLength], AfterValidator(_length_in_3d)]
 
 
 class Cylinder(Section):
