@@ -34,6 +34,15 @@ def _add(total, value):
     return value if total is None else total + value
 
 
+def dofs(part) -> list:
+    """The kinematics tables the stepper kicks for ``part``: its translations
+    ``kin`` and, for parts with rotational degrees of freedom (beams), the
+    rotations ``kin.rot`` (angular velocity in ``v``, rotary inertia in ``m``:
+    the same kick, the kinetic energy :math:`\tfrac12 I\omega^2`)."""
+    rot = getattr(part.kin, "rot", None)
+    return [part.kin] if rot is None else [part.kin, rot]
+
+
 class Stepper:
     """Advance parts, interactions and events in time.
 
@@ -63,7 +72,8 @@ class Stepper:
         self.work_external = 0.0  # work of the boundary-condition reactions [J]
         self._kick_sums: dict[str, np.ndarray] = {}  # per part, grown with it
         for part in self.parts:
-            part.kin.add("v_mid", (3,))
+            for q in dofs(part):
+                q.add("v_mid", (3,))
         self.dt0, _, _ = self.stable_dt()
         self.dt_contact_step = self.dt0  # the step the penalty springs use
         for part in self.parts:
@@ -104,10 +114,10 @@ class Stepper:
             dt = min(dt, inter.stable_dt())
         return min(dt, self.dt_max), k, which
 
-    def _sums(self, part) -> np.ndarray:
-        sums = self._kick_sums.get(part.name)
-        if sums is None or sums.shape[0] <= part.kin.n // KICK_BLOCK:
-            sums = self._kick_sums[part.name] = kick_scratch(part.kin.n)
+    def _sums(self, key: str, n: int) -> np.ndarray:
+        sums = self._kick_sums.get(key)
+        if sums is None or sums.shape[0] <= n // KICK_BLOCK:
+            sums = self._kick_sums[key] = kick_scratch(n)
         return sums
 
     def _interaction_forces(self, dt: float) -> None:
@@ -130,10 +140,10 @@ class Stepper:
         dt_kick = 0.5 * dt if self.step_count == 0 else 0.5 * (self.dt_prev + dt)
         ke = wc = we = None
         for part in self.parts:
-            q = part.kin
-            k_, c_, e_ = kick(q.v, q.a, q.a_ext, q.m, q.bc, q.bc_v, dt_kick, q.v_mid,
-                              self._sums(part))
-            ke, wc, we = _add(ke, k_), _add(wc, c_), _add(we, e_)
+            for j, q in enumerate(dofs(part)):
+                k_, c_, e_ = kick(q.v, q.a, q.a_ext, q.m, q.bc, q.bc_v, dt_kick, q.v_mid,
+                                  self._sums(f"{part.name}.{j}", q.n))
+                ke, wc, we = _add(ke, k_), _add(wc, c_), _add(we, e_)
         self.work_contact += wc
         self.work_external += we
         self.kinetic, self.dt_step = ke, dt
@@ -189,8 +199,8 @@ class Stepper:
 
     def kinetic_now(self) -> float:
         """Kinetic energy of the current (mid-step) velocities [J]."""
-        return float(sum(0.5 * np.sum(p.kin.m * np.sum(p.kin.v * p.kin.v, axis=1))
-                         for p in self.parts))
+        return float(sum(0.5 * np.sum(q.m * np.sum(q.v * q.v, axis=1))
+                         for p in self.parts for q in dofs(p)))
 
     # --------------------------------------------------------- checkpoint
     def state(self) -> tuple[dict, dict[str, dict[str, np.ndarray]]]:
@@ -209,6 +219,8 @@ class Stepper:
             scalars.update({f"event.{ev.name}.{k}": v for k, v in ev.state().items()})
         for part in self.parts:
             groups[f"kin.{part.name}"] = part.kin.arrays()
+            if len(dofs(part)) > 1:
+                groups[f"rot.{part.name}"] = part.kin.rot.arrays()
         return scalars, groups
 
     def restore(self, scalars: dict, groups: dict) -> None:
@@ -234,6 +246,9 @@ class Stepper:
                 setattr(q, name, arr)  # a shape that does not fit raises
             if n_new > n_old:
                 q.notify_grown(n_old, n_new)
+            if len(dofs(part)) > 1:
+                for name, arr in groups[f"rot.{part.name}"].items():
+                    setattr(q.rot, name, arr)
         self.t = float(scalars["t"])
         self.step_count = int(scalars["step"])
         self.dt_prev = float(scalars["dt_prev"])

@@ -2,12 +2,15 @@
 
 :mod:`~sphdyn.state.store` holds arrays with a capacity and grows them in one
 place; :mod:`~sphdyn.state.particles` builds the kinematics every part has and
-the SPH particle fields on it. The FEM issue adds mesh state beside them.
+the SPH particle fields on it; :mod:`~sphdyn.state.mesh` the mesh nodes,
+elements and integration points of finite-element parts.
 """
 
 from .particles import (BC_FIXED, BC_FREE, BC_VELOCITY, KINEMATICS, PARTICLE_FIELDS,
                         Kinematics, Particles)
+from .mesh import POINT_FIELDS, Elements, MaterialPoints, Nodes
 from .store import STATE, WORK, ArrayStore
 
-__all__ = ["ArrayStore", "BC_FIXED", "BC_FREE", "BC_VELOCITY", "KINEMATICS",
-           "Kinematics", "PARTICLE_FIELDS", "Particles", "STATE", "WORK"]
+__all__ = ["ArrayStore", "BC_FIXED", "BC_FREE", "BC_VELOCITY", "Elements", "KINEMATICS",
+           "Kinematics", "MaterialPoints", "Nodes", "PARTICLE_FIELDS", "POINT_FIELDS",
+           "Particles", "STATE", "WORK"]
