@@ -35,7 +35,7 @@ def _add(total, value):
 
 
 def dofs(part) -> list:
-    """The kinematics tables the stepper kicks for ``part``: its translations
+    r"""The kinematics tables the stepper kicks for ``part``: its translations
     ``kin`` and, for parts with rotational degrees of freedom (beams), the
     rotations ``kin.rot`` (angular velocity in ``v``, rotary inertia in ``m``:
     the same kick, the kinetic energy :math:`\tfrac12 I\omega^2`)."""

@@ -1,0 +1,124 @@
+r"""Shape-function tables of the 8-node hexahedron and the 4-node quadrilateral.
+
+Node order is VTK's (= LS-DYNA's): the corners in the isoparametric cube
+:math:`\xi, \eta, \zeta \in [-1, 1]` are (-,-,-), (+,-,-), (+,+,-), (-,+,-),
+then the same four with :math:`\zeta = +1`; the quadrilateral is the first
+four with :math:`\zeta` dropped. Shape functions
+:math:`N_I = \prod_k (1 + \xi_k \xi_{kI}) / 2^d`.
+
+Everything here is computed once, in NumPy, from these definitions; the
+Numba kernels of :mod:`.solid` read the tables.
+
+* :func:`volume_table`: the element volume of a trilinear hexahedron is a
+  cubic form of the nodal coordinates,
+  :math:`V = \sum_{IJK} C_{IJK}\, x_I\, y_J\, z_K`, with
+  :math:`C_{IJK} = \int \det[\partial N_I/\partial\boldsymbol\xi,
+  \partial N_J/\partial\boldsymbol\xi, \partial N_K/\partial\boldsymbol\xi]\,
+  d\boldsymbol\xi` (exact with 2x2x2 Gauss points). C is fully antisymmetric
+  with 144 non-zero entries of :math:`\pm 1/12`, so
+  :math:`\partial V/\partial x_I = \sum_{JK} C_{IJK}\, y_J z_K` (and cyclic for
+  y, z) is 18 products per node: the "uniform strain" gradient of Flanagan &
+  Belytschko (1981, IJNME 17, eq. 79), :math:`b_{iI} = \frac1V \partial V/\partial
+  x_{iI}`, exact for any hexahedron, with
+  :math:`V = \tfrac13 \sum_I \mathbf x_I\cdot \partial V/\partial\mathbf x_I`
+  (Euler's theorem for a homogeneous cubic). In 2D the area is the quadratic
+  form :math:`A = \sum_{IJ} C_{IJ} x_I y_J`, :math:`A = \tfrac12 \sum_I
+  \mathbf x_I \cdot \partial A/\partial \mathbf x_I`.
+* :func:`hourglass_vectors`: the base vectors
+  :math:`\Gamma_{\alpha I}` of the hourglass modes (products
+  :math:`\eta\zeta, \zeta\xi, \xi\eta, \xi\eta\zeta` of the corner signs;
+  :math:`\xi\eta` in 2D), orthogonal to the rigid and linear fields
+  (Flanagan & Belytschko 1981, Table 1).
+* :func:`gauss_derivatives`: :math:`\partial N_I/\partial \boldsymbol\xi` at the
+  2x2x2 (2x2) Gauss points, for the selective-reduced element.
+"""
+
+from __future__ import annotations
+
+import functools
+import itertools
+
+import numpy as np
+
+#: corner signs (xi, eta, zeta) in VTK order
+HEX_SIGNS = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
+                      [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], dtype=float)
+QUAD_SIGNS = HEX_SIGNS[:4, :2].copy()
+
+#: element kind -> (dimension, nodes per element)
+SOLID_KINDS = {"hex8": (3, 8), "quad4": (2, 4)}
+
+
+def corner_signs(dim: int) -> np.ndarray:
+    """Corner signs (nen, dim) of the hexahedron (dim 3) or quadrilateral (dim 2)."""
+    return HEX_SIGNS if dim == 3 else QUAD_SIGNS
+
+
+def shape_derivatives(dim: int, xi: np.ndarray) -> np.ndarray:
+    r""":math:`\partial N_I/\partial \xi_k` (nen, dim) at the point ``xi`` (dim,)."""
+    s = corner_signs(dim)
+    f = 1.0 + s * xi  # (nen, dim)
+    out = np.empty_like(s)
+    for k in range(dim):
+        others = np.prod(np.delete(f, k, axis=1), axis=1)
+        out[:, k] = s[:, k] * others / 2 ** dim
+    return out
+
+
+def gauss_points(dim: int) -> np.ndarray:
+    """The 2^dim Gauss points (+-1/sqrt 3) in node order; weights are 1."""
+    g = 1.0 / np.sqrt(3.0)
+    return corner_signs(dim) * g
+
+
+@functools.cache
+def gauss_derivatives(dim: int) -> np.ndarray:
+    r""":math:`\partial N_I/\partial \boldsymbol\xi` (ngp, nen, dim) at the Gauss points."""
+    return np.array([shape_derivatives(dim, p) for p in gauss_points(dim)])
+
+
+@functools.cache
+def volume_coefficients(dim: int) -> np.ndarray:
+    r"""The dense form coefficients: C (8, 8, 8) of :math:`V = C_{IJK} x_I y_J z_K`
+    (dim 3) or C (4, 4) of :math:`A = C_{IJ} x_I y_J` (dim 2)."""
+    nen = 2 ** dim
+    C = np.zeros((nen,) * dim)
+    for d in gauss_derivatives(dim):  # exact: the integrand is of degree <= 2 per variable
+        for idx in itertools.product(range(nen), repeat=dim):
+            C[idx] += np.linalg.det(d[list(idx)].T)
+    C[np.abs(C) < 1e-12] = 0.0
+    return C
+
+
+@functools.cache
+def volume_table(dim: int) -> np.ndarray:
+    r"""Sparse form of :func:`volume_coefficients` for the kernels.
+
+    dim 3: int64 (8, 18, 3) rows ``(J, K, sign)`` with
+    :math:`\partial V/\partial x_I = \tfrac1{12} \sum_k s_k\, y_{J_k} z_{K_k}`,
+    :math:`\partial V/\partial y_I = \tfrac1{12} \sum_k s_k\, z_{J_k} x_{K_k}`,
+    :math:`\partial V/\partial z_I = \tfrac1{12} \sum_k s_k\, x_{J_k} y_{K_k}`.
+    dim 2: int64 (4, 2, 2) rows ``(J, sign)`` with
+    :math:`\partial A/\partial x_I = \tfrac12 \sum_k s_k y_{J_k}`,
+    :math:`\partial A/\partial y_I = -\tfrac12 \sum_k s_k x_{J_k}`.
+    """
+    C = volume_coefficients(dim)
+    nen = 2 ** dim
+    scale = 12.0 if dim == 3 else 2.0
+    rows = []
+    for i in range(nen):
+        nz = np.argwhere(C[i] != 0.0)
+        rows.append([list(jk) + [int(round(C[(i, *jk)] * scale))] for jk in nz])
+    width = {len(r) for r in rows}
+    assert len(width) == 1, "every node has the same number of terms"
+    return np.array(rows, dtype=np.int64)
+
+
+@functools.cache
+def hourglass_vectors(dim: int) -> np.ndarray:
+    r"""Hourglass base vectors :math:`\Gamma_{\alpha I}` (modes, nen): 4 in 3D, 1 in 2D."""
+    s = corner_signs(dim)
+    if dim == 2:
+        return (s[:, 0] * s[:, 1])[None, :].copy()
+    return np.array([s[:, 1] * s[:, 2], s[:, 2] * s[:, 0], s[:, 0] * s[:, 1],
+                     s[:, 0] * s[:, 1] * s[:, 2]])

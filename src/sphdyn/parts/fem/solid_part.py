@@ -1,0 +1,280 @@
+"""The solid finite-element part: hex8 (3D) or quad4 (2D plane strain) elements.
+
+One step of the part (the stepper calls these in order; state at
+:math:`t^n`: :math:`\\mathbf x^n, \\mathbf v^{n-1/2}, \\sigma^n, \\mathbf a^n`):
+
+1. :meth:`SolidPart.drift`: nodes to :math:`\\mathbf x^{n+1}`;
+2. :meth:`SolidPart.internal_forces`: velocity gradient on the mid-step
+   geometry, geometry at :math:`n+1` (:mod:`.solid`), the material update of
+   every group (the same group kernels as the particles,
+   :mod:`sphdyn.materials`: Jaumann-rotated hypoelastic, J2 or CSCM), then the
+   element nodal forces (stress, bulk viscosity, hourglass control) gathered
+   into the nodes' ``a``.
+
+Masses are lumped: each node gets ``1/nen`` of the mass of every element it
+belongs to. The stable step is the element bound of :mod:`.solid`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...integrate import drift
+from ...materials.base import von_mises
+from ...state import Elements, MaterialPoints, Nodes
+from ..base import register_part
+from .shapes import SOLID_KINDS, gauss_derivatives, hourglass_vectors, volume_table
+from .solid import (HG_STIFFNESS, HG_VISCOUS, element_time_step, gather_forces,
+                    node_element_list, reduced_forces, reduced_strain_rate,
+                    uniform_forces, uniform_strain_rate)
+
+INTEGRATIONS = ("one_point", "selective_reduced")
+HOURGLASS_FORMS = {"viscous": HG_VISCOUS, "stiffness": HG_STIFFNESS}
+
+
+@dataclass(frozen=True)
+class SolidSettings:
+    """Element formulation of a solid part (defaults: LS-DYNA's default solid).
+
+    integration : ``"one_point"`` (uniform strain with hourglass control) or
+        ``"selective_reduced"`` (2^d Gauss points, B-bar volumetric part).
+    hourglass : ``"viscous"`` or ``"stiffness"`` (Flanagan-Belytschko forms).
+    hourglass_coefficient : Q_hg (LS-DYNA's QH; 0.1 by default, 0 switches it off).
+    q1, q2 : quadratic and linear bulk-viscosity coefficients (1.5, 0.06).
+    cfl : factor on the stable element step (0.9, LS-DYNA's TSSFAC).
+    """
+
+    integration: str = "one_point"
+    hourglass: str = "viscous"
+    hourglass_coefficient: float = 0.1
+    q1: float = 1.5
+    q2: float = 0.06
+    cfl: float = 0.9
+
+    def __post_init__(self):
+        if self.integration not in INTEGRATIONS:
+            raise ValueError(f"integration must be one of {INTEGRATIONS}, "
+                             f"got {self.integration!r}")
+        if self.hourglass not in HOURGLASS_FORMS:
+            raise ValueError(f"hourglass must be one of {tuple(HOURGLASS_FORMS)}, "
+                             f"got {self.hourglass!r}")
+
+
+@dataclass
+class PointGroup:
+    """Integration points sharing one material: ``model.update`` runs over ``idx``."""
+
+    name: str
+    model: object
+    params: np.ndarray
+    idx: np.ndarray
+    material: int = 0
+
+
+@register_part("solid")
+class SolidPart:
+    """Hexahedra (dim 3) or plane-strain quadrilaterals (dim 2) of one mesh.
+
+    Parameters
+    ----------
+    name : the part's name (history columns and output blocks carry it).
+    nodes : :class:`~sphdyn.state.Nodes` with ``x``, ``x0``, ``v``, ``bc``;
+        masses are computed here (lumped).
+    elements : :class:`~sphdyn.state.Elements` with ``conn`` and ``mat``.
+    materials : one ``(model, params)`` per material index used in
+        ``elements.mat`` (a dict index -> pair).
+    settings : :class:`SolidSettings`.
+    """
+
+    def __init__(self, name: str, nodes: Nodes, elements: Elements, materials: dict,
+                 settings: SolidSettings = SolidSettings()):
+        self.name = name
+        self.kin = self.nodes = nodes
+        self.el = elements
+        self.s = settings
+        self.dim = nodes.dim
+        kind = {8: "hex8", 4: "quad4"}.get(elements.nen)
+        if kind is None or SOLID_KINDS[kind][0] != self.dim:
+            raise ValueError(f"part {name!r}: {elements.nen}-node elements do not fit "
+                             f"dimension {self.dim} (hex8 in 3D, quad4 in 2D)")
+        self.element_kind = kind
+        self.tab = volume_table(self.dim)
+        self.gam = np.ascontiguousarray(hourglass_vectors(self.dim))
+        self.dN = np.ascontiguousarray(gauss_derivatives(self.dim))
+        self.reduced = settings.integration == "selective_reduced"
+        self.ngp = self.dN.shape[0] if self.reduced else 1
+        self.hg_form = HOURGLASS_FORMS[settings.hourglass]
+        nen = elements.nen
+        for name_, tail in (("xl", (nen, 3)), ("g", (nen, 3)), ("fe", (nen, 3))):
+            elements.add(name_, tail)
+        ne = elements.n
+        n_hist = max([len(m.history_names) for m, _ in materials.values()] + [0])
+        pts = self.pts = MaterialPoints(ne * self.ngp, n_hist)
+        pts.elem = np.repeat(np.arange(ne), self.ngp)
+        pts.mat = elements.mat[pts.elem]
+        if self.reduced:
+            pts.add("Bg", (nen, 3))
+            pts.add("wg", ())
+        self.groups = []
+        for k, (model, params) in sorted(materials.items()):
+            idx = np.flatnonzero(pts.mat == k).astype(np.int64)
+            if idx.size:
+                self.groups.append(PointGroup(f"{name}:{k}", model, params, idx, k))
+        layouts = {g.model.history_names for g in self.groups} - {()}
+        if len(layouts) > 1:
+            raise ValueError(f"part {name!r}: materials with different history variables "
+                             "cannot share a part; split the mesh into parts")
+        pts.hist_names = list(next(iter(layouts), ()))
+        self.offsets, self.slots = node_element_list(elements.conn, nodes.n)
+        self._geometry(0.0)  # g, vol at x
+        elements.vol0 = elements.vol
+        bad = np.flatnonzero(elements.vol <= 0.0)
+        if bad.size:
+            raise ValueError(f"part {name!r}: elements {bad[:10].tolist()} have zero or "
+                             "negative volume (inverted node order or collapsed nodes)")
+        for g in self.groups:
+            rho0 = g.model.density(g.params)
+            pts.rho0[g.idx] = rho0
+            pts.rho[g.idx] = rho0
+            pts.c[g.idx] = g.model.wave_speed(g.params, rho0)
+            h0 = g.model.initial_history(g.params)
+            if len(h0):
+                pts.hist[np.ix_(g.idx, np.arange(len(h0)))] = h0
+        # element mass: the points' densities times their share of the volume
+        rho_el = pts.rho0.reshape(ne, self.ngp).mean(axis=1)
+        elements.m = rho_el * elements.vol0
+        pts.size = np.repeat(elements.vol0 ** (1.0 / self.dim), self.ngp)
+        nodes.m = np.bincount(elements.conn.ravel(), weights=np.repeat(elements.m / nen, nen),
+                              minlength=nodes.n)
+        self._geometry(0.0)  # densities from the masses
+
+    # ------------------------------------------------------------ kernels
+    def _geometry(self, dt: float) -> None:
+        """Velocity gradient (mid-step geometry) and the geometry at the current x."""
+        q, el, p = self.nodes, self.el, self.pts
+        if self.reduced:
+            reduced_strain_rate(q.x, q.v, el.conn, el.active, el.m, dt, self.dim, self.tab,
+                                self.dN, el.xl, el.g, p.Bg, p.wg, p.L, p.rho, el.vol)
+        else:
+            uniform_strain_rate(q.x, q.v, el.conn, el.active, el.m, dt, self.dim, self.tab,
+                                el.xl, el.g, p.L, p.rho, el.vol)
+
+    def _forces(self, dt: float) -> None:
+        """Element nodal forces gathered into the nodes' accelerations."""
+        q, el, p, s = self.nodes, self.el, self.pts, self.s
+        if self.reduced:
+            reduced_forces(el.conn, el.active, p.sig, p.L, p.rho, p.c, p.e, p.e_av, el.g,
+                           el.vol, p.Bg, p.wg, s.q1, s.q2, dt, self.dim, el.fe)
+        else:
+            uniform_forces(q.v, el.conn, el.active, p.sig, p.L, p.rho, p.c, p.e, p.e_av,
+                           el.xl, el.g, el.vol, self.gam, self.hg_form,
+                           s.hourglass_coefficient, el.hg, el.e_hg, s.q1, s.q2, dt,
+                           self.dim, el.fe)
+        gather_forces(el.fe, self.offsets, self.slots, q.m, q.a)
+
+    # ----------------------------------------------------------- protocol
+    def stable_dt(self) -> tuple[float, int]:
+        """Element step and the controlling element (:func:`.solid.element_time_step`)."""
+        el, p, s = self.el, self.pts, self.s
+        return element_time_step(el.g, el.vol, p.c, p.L, self.ngp, el.active, s.q1, s.q2,
+                                 s.cfl)
+
+    def start(self, dt: float) -> None:
+        """Accelerations of the initial state (no material update)."""
+        self._geometry(0.0)
+        self._forces(0.0)
+
+    def drift(self, dt: float) -> None:
+        drift(self.nodes.x, self.nodes.v, dt)
+
+    def update_geometry(self, t: float, dt: float) -> None:
+        return None  # the element geometry needs dt and is computed with the forces
+
+    def internal_forces(self, t: float, dt: float) -> None:
+        p = self.pts
+        self._geometry(dt)
+        for g in self.groups:
+            g.model.update(g.idx, p.L, dt, p.rho, p.sig, p.e, p.c, p.damage, p.hist,
+                           g.params, p.size)
+        self._forces(dt)
+
+    def point_masses(self) -> np.ndarray:
+        """Mass of each integration point (P,) [kg]: its element's, shared evenly."""
+        return np.repeat(self.el.m / self.ngp, self.ngp)
+
+    def energies(self) -> tuple[float, float]:
+        """Internal energy (material work, bulk viscosity, hourglass) and its
+        bulk-viscosity part [J] (J/m in 2D)."""
+        mp = self.point_masses()
+        act = np.repeat(self.el.active != 0, self.ngp)
+        ie = float(np.sum(mp[act] * self.pts.e[act])) + float(np.sum(self.el.e_hg))
+        return ie, float(np.sum(mp[act] * self.pts.e_av[act]))
+
+    def hourglass_energy(self) -> float:
+        """Work done against the hourglass forces [J]."""
+        return float(np.sum(self.el.e_hg))
+
+    def columns(self) -> dict[str, float]:
+        """``<name>_E_hourglass``: the hourglass work [J]."""
+        return {f"{self.name}_E_hourglass": self.hourglass_energy()}
+
+    # ------------------------------------------------------------- fields
+    def element_stress(self) -> np.ndarray:
+        """Cauchy stress (E, 3, 3) [Pa]: the mean of the element's points."""
+        return self.pts.sig.reshape(self.el.n, self.ngp, 3, 3).mean(axis=1)
+
+    def element_mean(self, values: np.ndarray) -> np.ndarray:
+        """Element mean (E, ...) of a per-point array (P, ...)."""
+        return values.reshape((self.el.n, self.ngp) + values.shape[1:]).mean(axis=1)
+
+    def fields(self) -> dict:
+        """Cell fields (per element) the part evaluates on demand."""
+        def vm():
+            s = self.element_stress()
+            return np.array([von_mises((t[0, 0], t[1, 1], t[2, 2], t[0, 1], t[1, 2],
+                                        t[0, 2])) for t in s])
+        out = {"stress": self.element_stress, "von_mises": vm,
+               "damage": lambda: self.element_mean(self.pts.damage),
+               "density": lambda: self.element_mean(self.pts.rho),
+               "hourglass_energy": lambda: self.el.e_hg.copy(),
+               "volume": lambda: self.el.vol.copy()}
+        for k, name in enumerate(self.pts.hist_names):
+            out[name] = (lambda k=k: self.element_mean(self.pts.hist[:, k]))
+        return out
+
+    # --------------------------------------------------------- checkpoint
+    def state(self) -> tuple[dict, dict[str, np.ndarray]]:
+        arrays = {f"el.{k}": v for k, v in self.el.arrays().items()}
+        arrays.update({f"pt.{k}": v for k, v in self.pts.arrays().items()})
+        return {}, arrays
+
+    def restore(self, scalars: dict, arrays: dict) -> None:
+        """Continue from a checkpoint (bitwise identical continuation)."""
+        for k, v in arrays.items():
+            store, name = (self.el, k[3:]) if k.startswith("el.") else (self.pts, k[3:])
+            setattr(store, name, v)
+        L = self.pts.L.copy()  # the checkpoint's (the geometry pass rewrites it)
+        self._geometry(0.0)  # work arrays (g, xl, Bg) of the restored positions
+        self.pts.L = L
+
+
+def solid_part(name: str, points: np.ndarray, cells: np.ndarray, dim: int, materials,
+               mat: np.ndarray | None = None,
+               settings: SolidSettings = SolidSettings()) -> SolidPart:
+    """A :class:`SolidPart` from node coordinates (N, 3) [m] and connectivity (E, nen).
+
+    ``materials``: a ``(model, params)`` pair for every element, or a dict
+    material index -> pair with ``mat`` (E,) the elements' indices.
+    """
+    nodes = Nodes(points.shape[0], dim)
+    nodes.x = points
+    nodes.x0 = points
+    el = Elements(cells.shape[0], cells.shape[1])
+    el.conn = cells
+    if not isinstance(materials, dict):
+        materials = {0: materials}
+    if mat is not None:
+        el.mat = mat
+    return SolidPart(name, nodes, el, materials, settings)

@@ -1,0 +1,307 @@
+"""Verification of the solid elements (hex8, plane-strain quad4): exact volume
+derivatives, patch tests, rigid rotation, hourglass and bulk-viscosity
+coefficients against their formulas, the stable step, the bar wave speed and
+energy conservation."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from fem_models import block, material, part
+from sphdyn.parts.fem.shapes import (corner_signs, gauss_derivatives, hourglass_vectors,
+                                     volume_table)
+from sphdyn.parts.fem.solid import volume_gradient
+from sphdyn.state import BC_VELOCITY
+from sphdyn.stepper import Stepper
+from stepping import step
+
+STEEL = dict(density=7850.0, E=210e9, nu=0.3)
+
+
+def gauss_volume(xe, dim):
+    """Exact volume of a trilinear (bilinear) element: 2^d Gauss points of det J."""
+    return sum(np.linalg.det(xe[:, :dim].T @ d) for d in gauss_derivatives(dim))
+
+
+def distorted(dim, rng, amount=0.15):
+    """Corners of a unit element moved at random by up to ``amount``."""
+    xe = np.zeros((2 ** dim, 3))
+    xe[:, :dim] = 0.5 * corner_signs(dim) + rng.uniform(-amount, amount, (2 ** dim, dim))
+    return xe
+
+
+def distorted_block(dim, div, rng, amount=0.2):
+    """A block whose interior nodes are moved by up to ``amount`` of the spacing."""
+    x, cells = block([0, 0, 0], [1, 1, 1], div, dim)
+    h = 1.0 / np.array(div[:dim])
+    inner = np.all((x[:, :dim] > 1e-9) & (x[:, :dim] < 1 - 1e-9), axis=1)
+    x[inner, :dim] += rng.uniform(-amount, amount, (inner.sum(), dim)) * h
+    return x, cells
+
+
+# ----------------------------------------------------------------- geometry
+@pytest.mark.parametrize("dim", [2, 3])
+def test_volume_gradient_is_the_derivative_of_the_exact_volume(dim):
+    """The 1/12 (1/2) table gives the Gauss volume (to round-off) and its
+    derivatives match central differences (step 1e-6: truncation error ~1e-12,
+    so a 1e-8 tolerance catches any wrong sign or factor)."""
+    rng = np.random.default_rng(1)
+    xe = distorted(dim, rng)
+    tab = volume_table(dim)
+    g = np.zeros((2 ** dim, 3))
+    V = volume_gradient(xe, dim, tab, g)
+    assert V == pytest.approx(gauss_volume(xe, dim), rel=1e-13)
+    h = 1e-6
+    for I in range(2 ** dim):
+        for k in range(dim):
+            xp, xm = xe.copy(), xe.copy()
+            xp[I, k] += h
+            xm[I, k] -= h
+            fd = (gauss_volume(xp, dim) - gauss_volume(xm, dim)) / (2 * h)
+            assert g[I, k] == pytest.approx(fd, abs=1e-8)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_hourglass_vectors_are_orthogonal_to_linear_fields(dim):
+    s = corner_signs(dim)
+    base = np.column_stack([np.ones(2 ** dim), s])
+    G = hourglass_vectors(dim)
+    assert G.shape == ({2: 1, 3: 4}[dim], 2 ** dim)
+    assert np.abs(G @ base).max() == 0.0
+    assert np.linalg.matrix_rank(np.vstack([base.T, G])) == 2 ** dim
+
+
+# --------------------------------------------------------------- patch tests
+@pytest.mark.parametrize("integration", ["one_point", "selective_reduced"])
+@pytest.mark.parametrize("dim", [2, 3])
+def test_patch_linear_velocity_gives_exact_constant_rate(dim, integration):
+    """A linear velocity field on a distorted mesh gives the same velocity
+    gradient at every integration point, to round-off (1e-12 relative)."""
+    rng = np.random.default_rng(2)
+    x, cells = distorted_block(dim, (3, 3, 3)[:dim], rng)
+    p = part(x, cells, dim, integration=integration)
+    A = np.zeros((3, 3))
+    A[:dim, :dim] = rng.normal(size=(dim, dim))
+    p.nodes.v = x @ A.T + 0.3
+    p._geometry(0.0)
+    assert np.abs(p.pts.L - A).max() < 1e-12 * np.abs(A).max()
+
+
+@pytest.mark.parametrize("integration", ["one_point", "selective_reduced"])
+@pytest.mark.parametrize("dim", [2, 3])
+def test_patch_constant_stress_balances_interior_nodes(dim, integration):
+    """Constant stress in a distorted mesh: the nodal forces are
+    -sigma . dV/dx of the whole block, so interior nodes carry none and the
+    nodes of the face x = 1 (unit area, edges included) carry -sigma . e_x in
+    total. Tolerance: round-off of sums of 1e6 Pa terms (1e-9 relative)."""
+    rng = np.random.default_rng(3)
+    x, cells = distorted_block(dim, (3, 3, 3)[:dim], rng)
+    p = part(x, cells, dim, integration=integration)
+    S = np.zeros((3, 3))
+    S[:dim, :dim] = np.array([[3.0, 1.0, 0.5], [1.0, -2.0, 0.7],
+                              [0.5, 0.7, 1.5]])[:dim, :dim] * 1e6
+    if dim == 2:
+        S[2, 2] = 0.4e6  # plane strain: sigma_zz does no in-plane work
+    p.pts.sig[:] = S
+    p._geometry(0.0)
+    p._forces(0.0)
+    f = p.nodes.a * p.nodes.m[:, None]
+    inner = np.all((x[:, :dim] > 1e-9) & (x[:, :dim] < 1 - 1e-9), axis=1)
+    assert inner.any()
+    assert np.abs(f[inner]).max() < 1e-9 * 1e6
+    face = np.isclose(x[:, 0], 1.0)
+    assert np.allclose(f[face].sum(axis=0), -S[:, 0], rtol=0, atol=1e-9 * 1e6)
+    assert np.abs(f.sum(axis=0)).max() < 1e-9 * 1e6
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_rigid_rotation_of_90_degrees_gives_no_stress(dim):
+    """Nodes moved on an exact rigid rotation (chord velocities) of a distorted
+    block: the mid-step gradient is exactly skew, so the stress stays at
+    round-off (below 1 Pa for E = 210 GPa) and no hourglass work is done."""
+    rng = np.random.default_rng(4)
+    x, cells = distorted_block(dim, (3, 3, 2)[:dim], rng)
+    p = part(x, cells, dim)
+    p.nodes.bc[:] = BC_VELOCITY
+    X = x - x.mean(axis=0)
+    omega = 50.0
+    t_end = 0.5 * math.pi / omega
+
+    def rotated(theta):
+        c, s = math.cos(theta), math.sin(theta)
+        R = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
+        return X @ R.T + x.mean(axis=0)
+
+    class Prescribe:
+        def before_step(self, st, dt, k, part_):
+            dt = min(dt, t_end - st.t)  # the step is shortened to land on t_end
+            p.nodes.bc_v = (rotated(omega * (st.t + dt)) - rotated(omega * st.t)) / dt
+
+    s = Stepper([p], monitors=[Prescribe()])
+    while s.t < t_end - 1e-12:
+        s.step(t_stop=t_end)
+    assert s.step_count > 100
+    assert np.allclose(p.nodes.x, rotated(0.5 * math.pi), atol=1e-12)
+    assert np.abs(p.pts.sig).max() < 1.0
+    assert abs(p.hourglass_energy()) < 1e-12
+
+
+def test_prestress_rotates_with_the_body():
+    """A uniaxial 100 MPa stress along x, rotated 90 degrees about z in 400
+    steps, ends along y: the Jaumann update's forward-Euler error is about
+    n (d theta)^2 = 0.6 %, so 1 % of the stress."""
+    rng = np.random.default_rng(5)
+    x, cells = distorted_block(3, (2, 2, 2), rng)
+    p = part(x, cells, 3, hourglass_coefficient=0.0)
+    p.pts.sig[:, 0, 0] = 100e6
+    p.nodes.bc[:] = BC_VELOCITY
+    X = x - x.mean(axis=0)
+    n_steps = 400
+    dth = 0.5 * math.pi / n_steps
+
+    def rotated(theta):
+        c, s = math.cos(theta), math.sin(theta)
+        return X @ np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]]).T
+
+    class Prescribe:
+        def before_step(self, st, dt, k, part_):
+            p.nodes.bc_v = (rotated(dth * (st.step_count + 1))
+                            - rotated(dth * st.step_count)) / dt
+
+    s = Stepper([p], monitors=[Prescribe()])
+    for _ in range(n_steps):
+        s.step()
+    sig = p.pts.sig
+    assert np.allclose(sig[:, 1, 1], 100e6, rtol=0.01)
+    assert np.abs(sig[:, 0, 0]).max() < 0.01 * 100e6
+    assert np.abs(sig[:, 0, 1]).max() < 0.01 * 100e6
+
+
+# -------------------------------------------------------------- coefficients
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("form", ["viscous", "stiffness"])
+def test_hourglass_force_of_a_cube_matches_its_formula(dim, form):
+    """A cube (square) of side a in a pure hourglass mode (x velocity u Gamma_I):
+    no strain, and the forces are -Q Gamma with Q = a_h (2^d u) (viscous,
+    a_h = Qhg rho c V^((d-1)/d) / 4) or Q = dt k_h (2^d u) (stiffness,
+    k_h = Qhg rho c^2 V sum(b^2) / d), opposing the motion; their work is
+    booked in e_hg."""
+    a, u, qh, dt = 0.1, 0.5, 0.1, 1e-6
+    x, cells = block([0, 0, 0], [a, a, a], (1, 1, 1)[:dim], dim)
+    p = part(x, cells, dim, hourglass=form, hourglass_coefficient=qh, q1=0.0, q2=0.0)
+    gam = hourglass_vectors(dim)[0]
+    p.nodes.v[cells[0], 0] = u * gam
+    p._geometry(0.0)
+    assert np.abs(p.pts.L).max() < 1e-12  # the mode has no uniform strain
+    p._forces(dt)
+    f = p.el.fe[0]
+    rho, c = STEEL["density"], p.pts.c[0]
+    K = 210e9 / (3 * (1 - 0.6))
+    G = 210e9 / 2.6
+    assert c == pytest.approx(math.sqrt((K + 4 * G / 3) / rho))
+    V = a ** dim
+    nen = 2 ** dim
+    if form == "viscous":
+        Q = qh * rho * c * V ** ((dim - 1) / dim) / 4 * nen * u
+    else:
+        # the uniform gradient at the centre: abs(dN_I/dx_k) = 1 / (2^(d-1) a)
+        bb = nen * dim / (2 ** (dim - 1) * a) ** 2
+        Q = dt * qh * rho * c * c * V * bb / dim * nen * u
+    assert np.allclose(f[:, 0], -Q * gam, rtol=1e-12)
+    assert np.abs(f[:, 1:]).max() < 1e-12 * Q
+    power = float(np.sum(f[:, 0] * p.nodes.v[cells[0], 0]))
+    assert power < 0.0  # it resists the mode
+    assert p.el.e_hg[0] == pytest.approx(-dt * power, rel=1e-12)
+
+
+def test_bulk_viscosity_pressure_and_heat_match_their_formula():
+    """A cube compressed at a uniform rate: q = rho l (Q1 l r^2 - Q2 c r),
+    l = a / sqrt(3) (the stable-step length of the cube), acts as a pressure
+    on the faces and heats the element by -q r dt / rho."""
+    a, r, dt = 0.1, -200.0, 1e-7
+    x, cells = block([0, 0, 0], [a, a, a], (1, 1, 1), 3)
+    p = part(x, cells, 3, hourglass_coefficient=0.0)
+    p.nodes.v = r / 3.0 * x  # trace of L = r
+    p._geometry(0.0)
+    assert np.trace(p.pts.L[0]) == pytest.approx(r)
+    p._forces(dt)
+    rho, c = p.pts.rho[0], p.pts.c[0]
+    ell = a / math.sqrt(3)
+    q = rho * ell * (1.5 * ell * r * r - 0.06 * c * r)
+    # the face x = a carries the pressure q: nodal x forces sum to +q a^2 (push out)
+    fx = p.el.fe[0][x[cells[0], 0] > a / 2, 0].sum()
+    assert fx == pytest.approx(q * a * a, rel=1e-12)
+    assert p.pts.e_av[0] == pytest.approx(-q * r * dt / rho, rel=1e-12)
+
+
+def test_stable_step_of_a_cube_and_of_the_bound():
+    """Cube at rest: dt = 0.9 (a / sqrt 3) / (Q2 c + sqrt((Q2 c)^2 + c^2))."""
+    a = 0.01
+    x, cells = block([0, 0, 0], [a, a, a], (1, 1, 1), 3)
+    p = part(x, cells, 3)
+    c = p.pts.c[0]
+    Q = 0.06 * c
+    dt, k = p.stable_dt()
+    assert k == 0
+    assert dt == pytest.approx(0.9 * a / math.sqrt(3) / (Q + math.sqrt(Q * Q + c * c)),
+                               rel=1e-12)
+
+
+# ------------------------------------------------------------ wave dynamics
+def free_bar_mode(integration="one_point", dim=3, periods=1.0):
+    """First free-free mode of a bar (L = 1 m, c = 1000 m/s, nu = 0): its
+    period from the end's displacement and the energy records."""
+    div = (40, 2, 2)[:dim]
+    x, cells = block([0, 0, 0], [1.0, 0.05, 0.05], div, dim)
+    mat = material(density=1000.0, E=1e9, nu=0.0)
+    p = part(x, cells, dim, mat=mat, integration=integration)
+    p.nodes.v[:, 0] = 1e-3 * np.cos(np.pi * x[:, 0])
+    s = Stepper([p])
+    T, u, E = [], [], []
+    while s.t < periods * 2e-3:
+        r = step(s)
+        T.append(r["time"])
+        E.append(r["E_total"])
+        u.append(p.nodes.x[0, 0] - p.nodes.x0[0, 0])
+    T, u, E = map(np.array, (T, u, E))
+    crossings = T[1:][np.diff(np.sign(u - u.mean())) != 0]
+    return 2 * np.mean(np.diff(crossings)), E
+
+
+@pytest.mark.parametrize("integration", ["one_point", "selective_reduced"])
+@pytest.mark.parametrize("dim", [2, 3])
+def test_bar_wave_speed_and_energy_over_ten_periods(dim, integration):
+    """Free-free bar, 40 elements along (nu = 0, so c = sqrt(E/rho) = 1000 m/s
+    in 3D and in plane strain): the first mode's period 2L/c within 1 %
+    (the 40-element dispersion error is ~0.05 %), and the total energy of the
+    vibration constant within 0.5 % over ten periods."""
+    period, E = free_bar_mode(integration, dim, periods=10.0)
+    assert period == pytest.approx(2e-3, rel=0.01)
+    assert (E.max() - E.min()) / E[0] < 0.005
+
+
+def test_checkpoint_restore_continues_bitwise():
+    """State, restore into a fresh part, step both: the same bits."""
+    x, cells = block([0, 0, 0], [1.0, 0.1, 0.1], (10, 1, 1), 3)
+    runs = []
+    for form in ("stiffness",):
+        a = part(x, cells, 3, hourglass=form)
+        a.nodes.v[:, 1] = 0.1 * x[:, 0] ** 2
+        sa = Stepper([a])
+        for _ in range(20):
+            sa.step()
+        scalars, groups = sa.state()
+        b = part(x, cells, 3, hourglass=form)
+        sb = Stepper([b])
+        sb.restore(scalars, {k: {n: v.copy() for n, v in g.items()} for k, g in groups.items()})
+        for _ in range(20):
+            sa.step()
+            sb.step()
+        runs.append((a, b))
+    for a, b in runs:
+        assert np.array_equal(a.nodes.x, b.nodes.x)
+        assert np.array_equal(a.pts.sig, b.pts.sig)
+        assert np.array_equal(a.el.hg, b.el.hg)
