@@ -5,7 +5,8 @@ Central differences (leapfrog, :mod:`sphdyn.integrate`), state at
 
 1. time step: the smallest of the parts' and interactions' stable steps and
    ``dt_max`` (monitors' ``before_step`` see it: the collapse guard);
-2. kick of every part to :math:`\mathbf v^{n+1/2}` with its boundary
+2. interactions' ``prescribe`` (prescribed velocities of the step), kick
+   of every part to :math:`\mathbf v^{n+1/2}` with its boundary
    conditions, booking the kinetic energy at :math:`t^n`, the work of the
    interaction accelerations ``a_ext`` and of the boundary reactions;
    interactions' ``after_kick`` (impulses) and ``constrain`` (tied DOFs);
@@ -138,6 +139,8 @@ class Stepper:
         if t_stop is not None and self.t + dt > t_stop:
             dt = max(t_stop - self.t, 0.0)
         dt_kick = 0.5 * dt if self.step_count == 0 else 0.5 * (self.dt_prev + dt)
+        for inter in self.interactions:
+            inter.prescribe(self.t, dt)
         ke = wc = we = None
         for part in self.parts:
             for j, q in enumerate(dofs(part)):
@@ -190,6 +193,8 @@ class Stepper:
             "E_kinetic": kinetic, "E_internal": ie, "E_viscous": iav,
             "E_contact": e_contact, "W_external": self.work_external,
             "E_total": kinetic + ie + e_contact - self.work_external,
+            # how quasi-static the run is: small (< 0.05 say) for a static answer
+            "KE_IE_ratio": kinetic / ie if ie > 0.0 else 0.0,
         }
         for part in self.parts:
             rec.update(part.columns())

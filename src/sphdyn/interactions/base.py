@@ -1,9 +1,11 @@
 """The Interaction protocol: forces between parts, or between a part and the world.
 
 Walls, particle-particle contact and (with the FEM issue) the SPH-FEM
-couplings. The :class:`~sphdyn.stepper.Stepper` asks each interaction
+couplings, prescribed motion, loads and damping. The :class:`~sphdyn.stepper.Stepper` asks each interaction
 
 * ``stable_dt()``: its stability limit (``inf`` if it needs none);
+* ``prescribe(t, dt)``: before the kick of the step [t, t + dt], the
+  velocities of prescribed degrees of freedom (``kin.bc_v``);
 * ``update_geometry(t)``: after the drift (contact neighbour lists);
 * ``forces(t, dt, a_out)``: accelerations **added** to ``a_out``, the
   ``a_ext`` of the part it acts on (``dt`` is the stable step, which
@@ -25,6 +27,7 @@ class Interaction(Protocol):
     name: str
 
     def stable_dt(self) -> float: ...
+    def prescribe(self, t: float, dt: float) -> None: ...
     def update_geometry(self, t: float) -> None: ...
     def forces(self, t: float, dt: float, a_out: np.ndarray) -> None: ...
     def after_kick(self, dt_kick: float) -> None: ...
@@ -39,6 +42,9 @@ class InteractionBase:
 
     def stable_dt(self) -> float:
         return np.inf
+
+    def prescribe(self, t: float, dt: float) -> None:
+        return None
 
     def update_geometry(self, t: float) -> None:
         return None

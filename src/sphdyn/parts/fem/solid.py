@@ -151,9 +151,12 @@ def uniform_strain_rate(x, v, conn, active, m_el, dt, dim, tab, xl, g, L, rho, v
     r"""Velocity gradient, volume and density of one-point elements.
 
     For each active element: :math:`L = \sum_I \mathbf v_I \otimes \mathbf b_I`
-    on the mid-step geometry (:math:`b = \partial V/\partial x / V`), then the
-    volume derivatives ``g`` (E, nen, 3), volume ``vol`` (E,) and density
-    ``rho = m_el / vol`` (E,) at :math:`\mathbf x^{n+1}`. ``xl`` (E, nen, 3)
+    and the density ``rho = m_el / V`` (E,) on the mid-step geometry (:math:`b
+    = \partial V/\partial x / V`), so the material's energy increment
+    :math:`\Delta t\,\bar\sigma:D / \rho` is the stress power of the mid-step
+    volume (with the volume at :math:`n+1` the energy balance would err at
+    first order in dt); then the volume derivatives ``g`` (E, nen, 3) and
+    volume ``vol`` (E,) at :math:`\mathbf x^{n+1}`. ``xl`` (E, nen, 3)
     scratch. ``L`` (E, 3, 3) out [1/s] (zz = 0 in 2D).
     """
     for e in prange(conn.shape[0]):
@@ -162,6 +165,7 @@ def uniform_strain_rate(x, v, conn, active, m_el, dt, dim, tab, xl, g, L, rho, v
         local_coordinates(x, v, 0.5 * dt, conn, e, xl[e])
         vm = volume_gradient(xl[e], dim, tab, g[e])
         inv = 1.0 / vm if vm > 0.0 else 0.0
+        rho[e] = m_el[e] * inv  # mid-step: the stress power sigma:D V^(n+1/2) dt
         for i in range(3):
             for j in range(3):
                 s = 0.0
@@ -170,7 +174,6 @@ def uniform_strain_rate(x, v, conn, active, m_el, dt, dim, tab, xl, g, L, rho, v
                 L[e, i, j] = s * inv
         local_coordinates(x, v, 0.0, conn, e, xl[e])
         vol[e] = volume_gradient(xl[e], dim, tab, g[e])
-        rho[e] = m_el[e] / vol[e] if vol[e] > 0.0 else 0.0
 
 
 @njit(cache=True, error_model="numpy")
@@ -280,7 +283,8 @@ def reduced_strain_rate(x, v, conn, active, m_el, dt, dim, tab, dN, xl, g, Bg, w
     by that of the uniform gradient (in-plane trace in 2D). Then at
     :math:`\mathbf x^{n+1}`: ``g`` (E, nen, 3) volume derivatives, ``vol`` (E,),
     ``Bg`` (P, nen, 3) the Gauss points' :math:`\nabla N_I`, ``wg`` (P,) their
-    :math:`\det J` (weight 1), ``rho`` (P,) the element density; ``L`` (P, 3, 3).
+    :math:`\det J` (weight 1); ``rho`` (P,) the element density and ``L``
+    (P, 3, 3) on the mid-step geometry.
     Point p of element e is ``e * ngp + k``.
     """
     ngp = dN.shape[0]
@@ -342,8 +346,8 @@ def reduced_strain_rate(x, v, conn, active, m_el, dt, dim, tab, dN, xl, g, Bg, w
                     Bg[p, I, 2] = (d0 * i02 + d1 * i12 + d2 * i22) if dim == 3 else 0.0
                 if stage == 1:
                     wg[p] = det
-                    rho[p] = m_el[e] / ve if ve > 0.0 else 0.0
                     continue
+                rho[p] = m_el[e] / ve if ve > 0.0 else 0.0  # mid-step, as above
                 tr = 0.0
                 for i in range(3):
                     for j in range(3):

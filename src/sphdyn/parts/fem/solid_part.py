@@ -146,8 +146,21 @@ class SolidPart:
         rho_el = pts.rho0.reshape(ne, self.ngp).mean(axis=1)
         elements.m = rho_el * elements.vol0
         pts.size = np.repeat(elements.vol0 ** (1.0 / self.dim), self.ngp)
-        nodes.m = np.bincount(elements.conn.ravel(), weights=np.repeat(elements.m / nen, nen),
-                              minlength=nodes.n)
+        share = lambda w: np.bincount(elements.conn.ravel(),  # noqa: E731
+                                      weights=np.repeat(w / nen, nen), minlength=nodes.n)
+        nodes.m = share(elements.m)
+        # what walls need of an item (as particles have): volume, density, bulk modulus
+        self.p = nodes
+        for name_ in ("vol0", "rho0", "bulk_modulus"):
+            nodes.add(name_, ())
+        nodes.vol0 = share(elements.vol0)
+        nodes.rho0 = np.divide(nodes.m, nodes.vol0, out=np.zeros(nodes.n),
+                               where=nodes.vol0 > 0)
+        k_el = np.zeros(ne)
+        for g in self.groups:
+            k_el[pts.elem[g.idx]] = g.model.bulk_modulus(g.params)
+        nodes.bulk_modulus = np.where(nodes.vol0 > 0, share(k_el * elements.vol0) /
+                                      np.where(nodes.vol0 > 0, nodes.vol0, 1.0), 0.0)
         self._geometry(0.0)  # densities from the masses
 
     # ------------------------------------------------------------ kernels

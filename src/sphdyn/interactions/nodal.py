@@ -1,0 +1,185 @@
+"""Prescribed motion, nodal loads and mass damping on a set of a part's items.
+
+These act on the items (mesh nodes or particles) of one part:
+
+* :class:`PrescribedMotion`: fixed items, or a velocity or displacement
+  reached over a ramp (LS-DYNA's BOUNDARY_SPC and BOUNDARY_PRESCRIBED_MOTION);
+  it reports the reaction force the constraint exerts;
+* :class:`NodalLoad`: a total force shared by the items, ramped;
+* :class:`MassDamping`: :math:`\\mathbf a \\mathrel{-}= c\\,\\mathbf v`
+  (mass-proportional damping, LS-DYNA's DAMPING_GLOBAL), the usual way to
+  reach a static state with an explicit code (dynamic relaxation).
+
+Ramps (:func:`ramp`) take a value from 0 at t = 0 to 1 at t = T: ``linear``
+or ``smooth`` (:math:`s - \\sin(2\\pi s)/2\\pi`, :math:`s = t/T`, whose rate
+starts and ends at zero, so a prescribed displacement starts and stops
+without a jerk).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..state import BC_FIXED, BC_VELOCITY
+from .base import InteractionBase
+
+RAMPS = ("linear", "smooth")
+
+
+def ramp(t: float, T: float, shape: str = "linear") -> float:
+    """Ramp value in [0, 1] at time ``t`` [s] for ramp time ``T`` [s] (1 if T = 0)."""
+    if T <= 0.0 or t >= T:
+        return 1.0
+    if t <= 0.0:
+        return 0.0
+    s = t / T
+    if shape == "smooth":
+        return s - math.sin(2.0 * math.pi * s) / (2.0 * math.pi)
+    return s
+
+
+class _SetInteraction(InteractionBase):
+    """An interaction on the items ``idx`` of one part."""
+
+    def __init__(self, name: str, part, idx: np.ndarray):
+        idx = np.asarray(idx, dtype=np.int64)
+        if idx.size == 0:
+            raise ValueError(f"{name}: the set is empty")
+        self.name = name
+        self.part = part
+        self.idx = idx
+
+
+class PrescribedMotion(_SetInteraction):
+    """Fixed items, or a prescribed velocity or displacement with a ramp.
+
+    Parameters
+    ----------
+    kind : ``"fixed"``, ``"velocity"`` (the velocity ``value`` [m/s] reached
+        over the ramp) or ``"displacement"`` (the displacement ``value`` [m]
+        reached over the ramp, then held).
+    value : (3,) vector.
+    ramp_time : T [s]; ``shape``: ``linear`` or ``smooth``.
+
+    Each step [t, t + dt] the items get the velocity that moves them exactly
+    along the displacement history: :math:`(d(t + \\Delta t) - d(t))/\\Delta t`
+    (the stepper calls :meth:`prescribe` with the step's own dt).
+
+    The reaction (column ``<name>_reaction_x|y|z``, N or N/m in 2D) is the
+    force the constraint exerts on the items at the kick:
+    :math:`\\sum m ((\\mathbf v^{n+1/2} - \\mathbf v^{n-1/2})/\\Delta t^n - \\mathbf a^n)`.
+    """
+
+    def __init__(self, name: str, part, idx, kind: str = "fixed", value=(0.0, 0.0, 0.0),
+                 ramp_time: float = 0.0, shape: str = "linear"):
+        super().__init__(name, part, idx)
+        if kind not in ("fixed", "velocity", "displacement"):
+            raise ValueError(f"{name}: kind must be fixed, velocity or displacement")
+        if shape not in RAMPS:
+            raise ValueError(f"{name}: ramp shape must be one of {RAMPS}")
+        self.kind, self.shape = kind, shape
+        self.value = np.asarray(value, dtype=float)
+        self.ramp_time = float(ramp_time)
+        q = part.kin
+        q.bc[self.idx] = BC_FIXED if kind == "fixed" else BC_VELOCITY
+        q.bc_v[self.idx] = 0.0
+        q.v[self.idx] = self.velocity(0.0, 0.0)
+        self.reaction = np.zeros(3)
+
+    def displacement(self, t: float) -> np.ndarray:
+        """Prescribed displacement at ``t`` [m] (``displacement`` kind)."""
+        return self.value * ramp(t, self.ramp_time, self.shape)
+
+    def velocity(self, t: float, dt: float) -> np.ndarray:
+        """Velocity over the step [t, t + dt] [m/s]."""
+        if self.kind == "fixed":
+            return np.zeros(3)
+        if self.kind == "velocity":
+            return self.value * ramp(t + 0.5 * dt, self.ramp_time, self.shape)
+        if dt <= 0.0:
+            return np.zeros(3)
+        return (self.displacement(t + dt) - self.displacement(t)) / dt
+
+    def prescribe(self, t: float, dt: float) -> None:
+        if self.kind != "fixed":
+            self.part.kin.bc_v[self.idx] = self.velocity(t, dt)
+
+    def forces(self, t: float, dt: float, a_out: np.ndarray) -> None:
+        return None
+
+    def after_kick(self, dt_kick: float) -> None:
+        q, i = self.part.kin, self.idx
+        if dt_kick <= 0.0:
+            return
+        v_new = q.v[i]
+        v_old = 2.0 * q.v_mid[i] - v_new
+        self.reaction = np.sum(q.m[i, None] * ((v_new - v_old) / dt_kick - q.a[i]), axis=0)
+
+    def columns(self, t: float) -> dict[str, float]:
+        r = self.reaction
+        return {f"{self.name}_reaction_x": float(r[0]), f"{self.name}_reaction_y": float(r[1]),
+                f"{self.name}_reaction_z": float(r[2])}
+
+
+class NodalLoad(_SetInteraction):
+    """A total force ``force`` (3,) [N] shared evenly by the items, times a ramp.
+
+    Column ``<name>_force``: the magnitude applied now. Its work is booked
+    with the interactions' (``E_contact`` is minus the work done).
+    """
+
+    def __init__(self, name: str, part, idx, force, ramp_time: float = 0.0,
+                 shape: str = "linear"):
+        super().__init__(name, part, idx)
+        self.force = np.asarray(force, dtype=float)
+        self.ramp_time, self.shape = float(ramp_time), shape
+        m = part.kin.m[self.idx]
+        if np.any(m <= 0.0):
+            raise ValueError(f"{name}: a load on items without mass")
+        self._per_mass = 1.0 / (self.idx.size * m)
+        self._now = 0.0
+
+    def forces(self, t: float, dt: float, a_out: np.ndarray) -> None:
+        self._now = ramp(t, self.ramp_time, self.shape)
+        a_out[self.idx] += (self._now * self._per_mass)[:, None] * self.force
+
+    def columns(self, t: float) -> dict[str, float]:
+        return {f"{self.name}_force": float(self._now * np.linalg.norm(self.force))}
+
+
+class MassDamping(_SetInteraction):
+    """Mass-proportional damping :math:`\\mathbf a \\mathrel{-}= c\\,\\mathbf v` [c in 1/s].
+
+    Critical damping of a mode of angular frequency :math:`\\omega` is
+    :math:`c = 2\\omega`: the fastest approach to a static state in that mode
+    (Underwood 1983, dynamic relaxation). The velocity used is the latest
+    (:math:`n + 1/2`). Column ``E_damping_<name>``: the energy it removed [J].
+    """
+
+    def __init__(self, name: str, part, idx, coefficient: float):
+        super().__init__(name, part, idx)
+        if coefficient < 0.0:
+            raise ValueError(f"{name}: the damping coefficient must be >= 0")
+        self.c = float(coefficient)
+        self._a = np.zeros((self.idx.size, 3))
+        self.removed = 0.0
+
+    def forces(self, t: float, dt: float, a_out: np.ndarray) -> None:
+        self._a = -self.c * self.part.kin.v[self.idx]
+        a_out[self.idx] += self._a
+
+    def after_kick(self, dt_kick: float) -> None:
+        q, i = self.part.kin, self.idx
+        self.removed -= float(np.sum(q.m[i, None] * self._a * q.v_mid[i])) * dt_kick
+
+    def columns(self, t: float) -> dict[str, float]:
+        return {f"E_damping_{self.name}": self.removed}
+
+    def state(self) -> tuple[dict, dict[str, np.ndarray]]:
+        return {"removed": self.removed}, {"a": self._a}
+
+    def restore(self, scalars: dict, arrays: dict) -> None:
+        self.removed = float(scalars["removed"])
+        self._a = arrays["a"].copy()
