@@ -288,6 +288,29 @@ def test_abaqus_c3d8r(tmp_path):
     assert np.all(element_jacobians(m.points, m.cells, "hex8") > 0.0)
 
 
+def test_abaqus_element_blocks_sets_and_trusses(tmp_path):
+    """Two hex blocks (the second with ELSET=UPPER) and a truss block: the
+    ELSET lands on the right elements, the truss needs kind= and its set
+    becomes a node set of the hex mesh."""
+    ref = block_mesh(LO, HI, (1, 1, 2), 3)
+    lines = ["*NODE"] + [f"{i + 1}, {', '.join(num(v) for v in p)}" for i, p in enumerate(ref.points)]
+    hexes = [f"{k + 1}, {', '.join(str(n + 1) for n in c)}" for k, c in enumerate(ref.cells)]
+    lines += ["*ELEMENT, TYPE=C3D8", hexes[0], "*ELEMENT, TYPE=C3D8R, ELSET=UPPER", hexes[1]]
+    lines += ["*ELEMENT, TYPE=T3D2, ELSET=BAR", "50, 1, 2", ""]
+    path = tmp_path / "two.inp"
+    path.write_text("\n".join(lines))
+    with pytest.raises(ValueError, match=r"several supported element kinds \(2 hex8, 1 line2\)"):
+        read_mesh(path, 3)
+    m = read_mesh(path, 3, kind="hex8")
+    assert m.element_set("UPPER").tolist() == [1] and m.element_ids.tolist() == [1, 2]
+    assert "BAR" not in m.element_sets and m.node_set("BAR").tolist() == [0, 1]
+    bars = read_mesh(path, 3, kind="line2")
+    assert bars.element_ids.tolist() == [50] and bars.element_set("BAR").tolist() == [0]
+    path.write_text("\n".join(lines + ["*ELSET, ELSET=BOTH", "UPPER, BAR", ""]))
+    with pytest.raises(ValueError, match=r"\*ELSET BOTH lists a set by name \(UPPER\)"):
+        read_mesh(path, 3, kind="hex8")
+
+
 def test_abaqus_cpe4r_plane_strain(tmp_path):
     """2D: nodes given as x, y only; the mesh numbered clockwise (as a surface
     with normal -z) comes back counter-clockwise."""
@@ -398,7 +421,16 @@ def test_unreadable_file(tmp_path, name, content):
     path = tmp_path / name
     path.write_text(content)
     with pytest.raises(ValueError, match=rf"mesh file '.*{name}': cannot read it as "
-                                         r"(Gmsh|Abaqus) mesh.*check that it is a complete"):
+                                         r"(Gmsh|Abaqus) mesh.*check that it is a complete") as err:
+        read_mesh(path, 3)
+    if name == "undefined.inp":
+        assert "id 9 is used but not defined" in str(err.value)
+
+
+def test_several_node_blocks_are_refused(tmp_path):
+    path = tmp_path / "nodes.inp"
+    path.write_text("*NODE\n1, 0., 0., 0.\n*NODE\n2, 1., 0., 0.\n*ELEMENT, TYPE=T3D2\n1, 1, 2\n")
+    with pytest.raises(ValueError, match=r"2 \*NODE blocks.*single \*NODE block"):
         read_mesh(path, 3)
 
 

@@ -430,40 +430,66 @@ def _gmsh_ids(text: str):
     return np.array(nodes, dtype=np.int64), np.array(elements, dtype=np.int64)
 
 
-def _abaqus_scan(text: str, label: str):
-    """Node ids and the integers of each ``*ELEMENT`` block, as meshio reads them."""
-    nodes, blocks, mode, n_node_blocks = [], [], None, 0
+def _abaqus_scan(text: str, label: str) -> dict:
+    """A pass over an Abaqus file that refuses what meshio 5.3 would misread
+    and records what it drops.
+
+    Returns a dict: ``nodes`` node ids in meshio's order, ``blocks`` the
+    integers of each ``*ELEMENT`` block (both None if a data line does not
+    parse; meshio then reports the file), ``elset_of_block`` each
+    ``*ELEMENT`` block's ``ELSET=`` value, ``elsets`` the names ``*ELSET``
+    defines.
+    """
+    nodes, blocks, params, elsets = [], [], [], set()
+    mode, name, n_node_blocks, ok = None, None, 0, True
     for line in text.splitlines():
         s = line.strip()
         if line.startswith("*"):
-            kw = s.partition(",")[0].replace("*", "").strip().upper()
-            mode = None if s.startswith("**") else kw
+            words = s.split(",")
+            mode = None if s.startswith("**") else words[0].replace("*", "").strip().upper()
+            opts = {k.strip().upper(): v.strip() for k, _, v in (w.partition("=") for w in words[1:])}
             if mode == "NODE":
                 n_node_blocks += 1
                 nodes = []
             elif mode == "ELEMENT":
                 blocks.append([])
-        elif s and mode == "NODE":
-            nodes.append(int(s.split(",")[0]))
-        elif s and mode == "ELEMENT":
-            blocks[-1] += [int(v) for v in s.split(",") if v.strip()]
+                params.append(opts.get("ELSET"))
+            elif mode in ("NSET", "ELSET"):
+                name = opts.get(mode)
+                if mode == "ELSET":
+                    elsets.add(name)
+            continue
+        if not s or mode is None:
+            continue
+        first = s.split(",")[0]
+        if mode in ("NSET", "ELSET") and not first.isnumeric():
+            raise ValueError(f"{label}: *{mode} {name} lists a set by name ({first}); the "
+                             "reader (meshio) does not resolve set names, so list the ids instead")
+        try:
+            if mode == "NODE":
+                nodes.append(int(first))
+            elif mode == "ELEMENT":
+                blocks[-1] += [int(v) for v in s.split(",") if v.strip()]
+        except ValueError:
+            ok = False
     if n_node_blocks > 1:
         raise ValueError(f"{label}: {n_node_blocks} *NODE blocks; the reader (meshio) keeps "
                          "only the last one, so merge all nodes into a single *NODE block")
-    return np.array(nodes, dtype=np.int64), blocks
+    return {"nodes": np.array(nodes, dtype=np.int64) if ok else None,
+            "blocks": blocks if ok else None, "elset_of_block": params, "elsets": elsets}
 
 
-def _file_ids(fmt: str, text: str, raw, label: str):
+def _file_ids(text: str, raw, abaqus: dict | None):
     """(node_ids, element_ids over all meshio blocks) or None if not recoverable."""
     sizes = [len(b) for b in raw.cells]
-    if fmt == "gmsh":
+    if abaqus is None:
         ids = _gmsh_ids(text)
         if ids is None:
             return None
         nodes, elements = ids
     else:
-        nodes, blocks = _abaqus_scan(text, label)
-        if len(blocks) != len(raw.cells):
+        nodes, blocks = abaqus["nodes"], abaqus["blocks"]
+        if blocks is None or len(blocks) != len(raw.cells):
             return None
         parts = []
         for ints, b in zip(blocks, raw.cells):
@@ -525,9 +551,13 @@ def _groups(raw) -> dict[str, list[np.ndarray]]:
         if name.startswith("gmsh:"):
             continue
         arrays = [np.zeros(0, np.int64)] * nb
-        for b, a in enumerate(list(per_block)[:nb]):
-            if a is not None:
-                arrays[b] = np.asarray(a, dtype=np.int64).reshape(-1)
+        try:
+            for b, a in enumerate(list(per_block)[:nb]):
+                if a is not None:
+                    arrays[b] = np.asarray(a, dtype=np.int64).reshape(-1)
+        except (TypeError, ValueError):
+            raise ValueError(f"set {name!r} could not be interpreted; list its element "
+                             "ids explicitly") from None
         groups[name] = arrays
     physical = (raw.cell_data or {}).get("gmsh:physical")
     if physical is not None:
@@ -604,8 +634,7 @@ def read_mesh(path, dim: int, kind: str | None = None) -> MeshData:
                          "relative to the deck)")
     fmt, fmt_label, reader = fmt
     text = path.read_bytes().decode("latin-1")
-    if fmt == "abaqus":
-        _abaqus_scan(text, label)  # refuse what meshio would misread
+    abaqus = _abaqus_scan(text, label) if fmt == "abaqus" else None
     try:
         raw = reader(path)
     except Exception as exc:  # meshio raises ReadError, ValueError, KeyError, ...
@@ -620,7 +649,7 @@ def read_mesh(path, dim: int, kind: str | None = None) -> MeshData:
     kind = _choose_kind(raw, dim, kind, label)
 
     try:
-        ids = _file_ids(fmt, text, raw, label)
+        ids = _file_ids(text, raw, abaqus)
     except (ValueError, IndexError):
         ids = None
     n_raw = len(raw.points)
@@ -674,8 +703,16 @@ def read_mesh(path, dim: int, kind: str | None = None) -> MeshData:
         mapped = node_map[np.concatenate(parts)]
         return mapped[mapped >= 0]
 
+    groups = _groups(raw)
+    if abaqus is not None and len(abaqus["elset_of_block"]) == len(raw.cells):
+        # meshio files *ELEMENT, ELSET=name under the wrong block when some
+        # *ELEMENT blocks have no ELSET; rebuild those sets from the blocks
+        params = abaqus["elset_of_block"]
+        for name in set(filter(None, params)) - abaqus["elsets"]:
+            groups[name] = [np.arange(len(b)) if p == name else np.zeros(0, np.int64)
+                            for p, b in zip(params, raw.cells)]
     element_sets, node_sets = {}, {}
-    for name, local in _groups(raw).items():
+    for name, local in groups.items():
         try:
             members = [elem_map[offset[b] + local[b]] for b in keep if local[b].size]
             nodes = nodes_of(local)
