@@ -233,6 +233,24 @@ def test_gmsh_hex_block_reads_as_block_mesh(tmp_path, version):
         m.element_set("Concrete")
 
 
+def test_gmsh_binary_file_numbers_by_position(tmp_path):
+    """Binary MSH 2.2 (written by meshio): read, ids are 1-based positions."""
+    import meshio
+
+    ref = block_mesh(LO, HI, (2, 1, 1), 3)
+    raw = meshio.Mesh(ref.points, [("hexahedron", ref.cells)],
+                      cell_data={"gmsh:physical": [np.array([4, 5])],
+                                 "gmsh:geometrical": [np.array([1, 1])]},
+                      field_data={"left": np.array([4, 3]), "right": np.array([5, 3])})
+    path = tmp_path / "binary.msh"
+    meshio.gmsh.write(str(path), raw, fmt_version="2.2", binary=True)
+    m = read_mesh(path, 3)
+    assert np.array_equal(m.points, ref.points) and np.array_equal(m.cells, ref.cells)
+    assert m.node_ids.tolist() == list(range(1, 13)) and m.element_ids.tolist() == [1, 2]
+    assert m.element_set("left").tolist() == [0] and m.element_set("right").tolist() == [1]
+    assert np.array_equal(m.node_set("right"), np.sort(ref.cells[1]))
+
+
 def test_gmsh_2d_with_line_group_needs_kind(tmp_path):
     ref = block_mesh([0, 0, 0], [0.2, 0.1, 0], (2, 1), 2)
     nodes = {i + 1: p for i, p in enumerate(ref.points)}

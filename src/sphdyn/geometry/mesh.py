@@ -542,7 +542,7 @@ def _choose_kind(raw, dim: int, kind, label: str) -> str:
     return next(iter(present))
 
 
-def _groups(raw) -> dict[str, list[np.ndarray]]:
+def _groups(raw, label: str) -> dict[str, list[np.ndarray]]:
     """Named groups as per-block local element indices (meshio cell_sets, or
     Gmsh physical tags + names)."""
     nb = len(raw.cells)
@@ -556,7 +556,7 @@ def _groups(raw) -> dict[str, list[np.ndarray]]:
                 if a is not None:
                     arrays[b] = np.asarray(a, dtype=np.int64).reshape(-1)
         except (TypeError, ValueError):
-            raise ValueError(f"set {name!r} could not be interpreted; list its element "
+            raise ValueError(f"{label}: set {name!r} could not be interpreted; list its element "
                              "ids explicitly") from None
         groups[name] = arrays
     physical = (raw.cell_data or {}).get("gmsh:physical")
@@ -567,6 +567,19 @@ def _groups(raw) -> dict[str, list[np.ndarray]]:
                                 else np.zeros(0, np.int64)
                                 for b, t in zip(raw.cells, physical)]
     return groups
+
+
+def _merge_repeats(cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Elements with the same nodes, kept once.
+
+    Returns ``order`` (the rows kept, first occurrences in file order) and
+    ``elem_map`` (E,): old row -> index into ``order``.
+    """
+    _, first, inverse = np.unique(np.sort(cells, axis=1), axis=0, return_index=True,
+                                  return_inverse=True)
+    rank = np.empty(first.size, np.int64)
+    rank[np.argsort(first)] = np.arange(first.size)
+    return np.sort(first), rank[inverse.reshape(-1)]
 
 
 def read_mesh(path, dim: int, kind: str | None = None) -> MeshData:
@@ -663,16 +676,8 @@ def read_mesh(path, dim: int, kind: str | None = None) -> MeshData:
     keep = [b for b, blk in enumerate(raw.cells) if _FROM_MESHIO.get(blk.type) == kind]
     cells = np.concatenate([np.asarray(raw.cells[b].data, dtype=np.int64) for b in keep])
     element_ids = np.concatenate([ids[1][starts[b]:starts[b + 1]] for b in keep])
-    offset = dict(zip(keep, np.cumsum([0] + [len(raw.cells[b]) for b in keep])))
 
-    # repeated elements (same node set) are kept once
-    _, first, inverse = np.unique(np.sort(cells, axis=1), axis=0, return_index=True,
-                                  return_inverse=True)
-    inverse = inverse.reshape(-1)
-    order = np.sort(first)
-    new_index = np.empty(first.size, np.int64)
-    new_index[np.argsort(first)] = np.arange(first.size)
-    elem_map = new_index[inverse]                       # old element -> new
+    order, elem_map = _merge_repeats(cells)
     cells, element_ids = cells[order], element_ids[order]
 
     # drop unused nodes, renumber in file order
@@ -695,15 +700,7 @@ def read_mesh(path, dim: int, kind: str | None = None) -> MeshData:
             clockwise = np.all(element_jacobians(points, cells, kind) < 0.0, axis=1)
             cells[clockwise] = cells[clockwise][:, [0, 3, 2, 1]]
 
-    def nodes_of(local):  # node indices (new numbering) of per-block elements
-        parts = [np.asarray(raw.cells[b].data, dtype=np.int64)[a].reshape(-1)
-                 for b, a in enumerate(local) if a.size]
-        if not parts:
-            return np.zeros(0, np.int64)
-        mapped = node_map[np.concatenate(parts)]
-        return mapped[mapped >= 0]
-
-    groups = _groups(raw)
+    groups = _groups(raw, label)
     if abaqus is not None and len(abaqus["elset_of_block"]) == len(raw.cells):
         # meshio files *ELEMENT, ELSET=name under the wrong block when some
         # *ELEMENT blocks have no ELSET; rebuild those sets from the blocks
@@ -711,22 +708,26 @@ def read_mesh(path, dim: int, kind: str | None = None) -> MeshData:
         for name in set(filter(None, params)) - abaqus["elsets"]:
             groups[name] = [np.arange(len(b)) if p == name else np.zeros(0, np.int64)
                             for p, b in zip(params, raw.cells)]
+    # element indices: block b's local element i is old element offset[b] + i
+    offset = dict(zip(keep, np.cumsum([0] + [len(raw.cells[b]) for b in keep])))
     element_sets, node_sets = {}, {}
     for name, local in groups.items():
         try:
             members = [elem_map[offset[b] + local[b]] for b in keep if local[b].size]
-            nodes = nodes_of(local)
+            nodes = [np.asarray(raw.cells[b].data, dtype=np.int64)[a].reshape(-1)
+                     for b, a in enumerate(local) if a.size]
         except IndexError:
             raise ValueError(f"{label}: group {name!r} refers to elements that do not "
                              "exist; check the file's sets") from None
         if members:
             element_sets[name] = np.concatenate(members)
-        if nodes.size:
-            node_sets[name] = nodes
+        nodes = node_map[np.concatenate(nodes)] if nodes else np.zeros(0, np.int64)
+        if np.any(nodes >= 0):
+            node_sets[name] = nodes[nodes >= 0]
     for name, idx in (raw.point_sets or {}).items():
-        mapped = node_map[np.asarray(idx, dtype=np.int64).reshape(-1)]
-        if np.any(mapped >= 0):
-            node_sets[name] = mapped[mapped >= 0]
+        nodes = node_map[np.asarray(idx, dtype=np.int64).reshape(-1)]
+        if np.any(nodes >= 0):
+            node_sets[name] = nodes[nodes >= 0]
         else:
             node_sets.pop(name, None)
     element_sets.setdefault("all", np.arange(cells.shape[0]))
