@@ -212,7 +212,8 @@ def test_gmsh_hex_block_reads_as_block_mesh(tmp_path, version):
     writer = write_msh22 if version == "2.2" else write_msh41
     m = read_mesh(writer(tmp_path / "block.msh", nodes, quads, hexes), 3)
     assert m.kind == "hex8"
-    assert m.n_nodes == ref.n_nodes and m.n_elements == ref.n_elements  # unused node, repeat dropped
+    # the unused node and the repeated element dropped
+    assert m.n_nodes == ref.n_nodes and m.n_elements == ref.n_elements
     assert rows(m.points) == rows(ref.points)                            # exact
     assert element_shapes(m) == element_shapes(ref)
     assert np.all(element_jacobians(m.points, m.cells, "hex8") > 0.0)
@@ -311,7 +312,8 @@ def test_abaqus_element_blocks_sets_and_trusses(tmp_path):
     ELSET lands on the right elements, the truss needs kind= and its set
     becomes a node set of the hex mesh."""
     ref = block_mesh(LO, HI, (1, 1, 2), 3)
-    lines = ["*NODE"] + [f"{i + 1}, {', '.join(num(v) for v in p)}" for i, p in enumerate(ref.points)]
+    lines = ["*NODE"] + [f"{i + 1}, {', '.join(num(v) for v in p)}"
+                         for i, p in enumerate(ref.points)]
     hexes = [f"{k + 1}, {', '.join(str(n + 1) for n in c)}" for k, c in enumerate(ref.cells)]
     lines += ["*ELEMENT, TYPE=C3D8", hexes[0], "*ELEMENT, TYPE=C3D8R, ELSET=UPPER", hexes[1]]
     lines += ["*ELEMENT, TYPE=T3D2, ELSET=BAR", "50, 1, 2", ""]
@@ -425,7 +427,8 @@ def test_check_elements_passes_a_distorted_mesh():
 # error messages
 # --------------------------------------------------------------------------
 def test_missing_file(tmp_path):
-    with pytest.raises(ValueError, match=r"mesh file '.*nothere\.msh': no such file; check the path"):
+    with pytest.raises(ValueError,
+                       match=r"mesh file '.*nothere\.msh': no such file; check the path"):
         read_mesh(tmp_path / "nothere.msh", 3)
 
 

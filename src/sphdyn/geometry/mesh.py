@@ -19,9 +19,10 @@ determinant at every corner (:func:`element_jacobians`).
 
 Files are read with :mod:`meshio`'s format readers (``meshio.gmsh.read``,
 ``meshio.abaqus.read``; not ``meshio.read``, which ends the process on a read
-error): Gmsh ``.msh`` (formats 2.2 and 4.1) and Abaqus ``.inp``. meshio 5.3 does not know the Abaqus plane-strain quads
-(``CPE4``, ``CPE4R``, ...); this module registers them with meshio's Abaqus
-reader as ``quad`` when it is imported.
+error): Gmsh ``.msh`` (formats 2.2 and 4.1) and Abaqus ``.inp``. meshio 5.3
+does not know the Abaqus plane-strain quads (``CPE4``, ``CPE4R``, ...); this
+module registers them with meshio's Abaqus reader as ``quad`` when it is
+imported.
 """
 
 from __future__ import annotations
@@ -130,7 +131,8 @@ class MeshData:
     def __post_init__(self):
         label = self.label
         if self.kind not in MESH_KINDS:
-            raise ValueError(f"{label}: kind must be one of {sorted(MESH_KINDS)}, got {self.kind!r}")
+            raise ValueError(f"{label}: kind must be one of {sorted(MESH_KINDS)}, "
+                             f"got {self.kind!r}")
         nen = MESH_KINDS[self.kind][0]
         self.points = np.ascontiguousarray(self.points, dtype=np.float64)
         self.cells = np.ascontiguousarray(self.cells, dtype=np.int64)
@@ -447,7 +449,8 @@ def _abaqus_scan(text: str, label: str) -> dict:
         if line.startswith("*"):
             words = s.split(",")
             mode = None if s.startswith("**") else words[0].replace("*", "").strip().upper()
-            opts = {k.strip().upper(): v.strip() for k, _, v in (w.partition("=") for w in words[1:])}
+            opts = {k.strip().upper(): v.strip()
+                    for k, _, v in (w.partition("=") for w in words[1:])}
             if mode == "NODE":
                 n_node_blocks += 1
                 nodes = []
@@ -525,7 +528,8 @@ def _choose_kind(raw, dim: int, kind, label: str) -> str:
             present[k] = present.get(k, 0) + len(b)
     if kind is not None:
         if kind not in allowed:
-            raise ValueError(f"{label}: kind must be one of {list(allowed)} in {dim}D, got {kind!r}")
+            raise ValueError(f"{label}: kind must be one of {list(allowed)} in {dim}D, "
+                             f"got {kind!r}")
         if kind not in present:
             raise ValueError(f"{label}: no {_TO_MESHIO[kind]} ({kind}) elements; the file holds "
                              f"{_holdings(raw)}")
@@ -690,10 +694,11 @@ def read_mesh(path, dim: int, kind: str | None = None) -> MeshData:
     if dim == 2:
         z = points[:, 2]
         tol = 1e-6 * max(np.ptp(points[:, 0]), np.ptp(points[:, 1]), np.finfo(float).tiny)
-        worst = int(np.argmax(np.abs(z - np.median(z))))
-        if abs(z[worst] - np.median(z)) > tol:
+        z_mid = np.median(z)
+        worst = int(np.argmax(np.abs(z - z_mid)))
+        if abs(z[worst] - z_mid) > tol:
             raise ValueError(f"{label}: a 2D mesh must lie in a plane z = const, but node "
-                             f"{node_ids[worst]} has z = {z[worst]:.6g} (median {np.median(z):.6g}); "
+                             f"{node_ids[worst]} has z = {z[worst]:.6g} (median {z_mid:.6g}); "
                              "mesh in the x-y plane or read it with dim=3")
         points[:, 2] = 0.0
         if kind == "quad4":
