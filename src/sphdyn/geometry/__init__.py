@@ -1,4 +1,5 @@
-"""Geometry: particle lattices filling primitives and particle regions.
+"""Geometry: particle lattices filling primitives, particle regions, and
+finite-element meshes (generated or read from Gmsh / Abaqus files).
 
 All positions are ``(n, 3)`` float64 arrays in metres (``z = 0`` in 2D); a
 lattice particle's nominal volume is ``dx**dim``.
@@ -13,6 +14,15 @@ from .lattice import (
     ring_lattice,
     sphere_lattice,
 )
+from .mesh import (
+    MESH_KINDS,
+    MeshData,
+    block_mesh,
+    check_elements,
+    element_jacobians,
+    line_mesh,
+    read_mesh,
+)
 from .regions import REGION_SHAPES, bounding_box, select
 
 __all__ = [
@@ -26,4 +36,11 @@ __all__ = [
     "lattice_from_shape",
     "select",
     "bounding_box",
+    "MESH_KINDS",
+    "MeshData",
+    "block_mesh",
+    "line_mesh",
+    "read_mesh",
+    "element_jacobians",
+    "check_elements",
 ]
