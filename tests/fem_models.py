@@ -2,26 +2,15 @@
 
 from __future__ import annotations
 
-import itertools
-
-import numpy as np
-
+from sphdyn.geometry.mesh import block_mesh
 from sphdyn.materials import get_model
 from sphdyn.parts.fem import SolidSettings, solid_part
 
 
 def block(lo, hi, div, dim=3):
-    """Structured block: points (N, 3), cells (E, 2**dim) in VTK order."""
-    axes = [np.linspace(lo[k], hi[k], div[k] + 1) for k in range(dim)]
-    grid = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, dim)
-    idx = np.arange(grid.shape[0]).reshape([d + 1 for d in div])
-    offs = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1),
-            (0, 1, 1)][: 2 ** dim]
-    cells = [[idx[tuple(np.add(c, o[:dim]))] for o in offs]
-             for c in itertools.product(*[range(d) for d in div])]
-    x = np.zeros((grid.shape[0], 3))
-    x[:, :dim] = grid
-    return x, np.array(cells, dtype=np.int64)
+    """Structured block (:func:`sphdyn.geometry.mesh.block_mesh`): points (N, 3), cells."""
+    mesh = block_mesh(lo, hi, div[:dim], dim)
+    return mesh.points.copy(), mesh.cells.copy()
 
 
 def material(model="elastic", **values):
