@@ -9,6 +9,9 @@
   reference neighbours, hourglass control) and particle-particle contact.
 * ``block3d``: an elastic 3D cube (concrete-like, E = 30 GPa) hitting a rigid
   wall at 10 m/s, with about ``--particles`` particles.
+* ``hex3d``: the same cube as about ``--elements`` one-point hex8 elements
+  with viscous hourglass control (LS-DYNA's default solid), the wall acting
+  on the nodes.
 
 Each case is an ordinary deck (built in code), so the benchmark runs exactly
 the code a user's deck runs. Timing excludes the first steps, which compile
@@ -106,16 +109,42 @@ def case_deck(case: str, particles: int | None = None):
     raise ValueError(f"unknown benchmark case {case!r}; choose rings2d, rings2d_tl or block3d")
 
 
+def hex3d_stepper(elements: int | None = None):
+    """The ``hex3d`` case: the block3d cube as hex8 elements on a rigid wall."""
+    import numpy as np
+
+    from .geometry.mesh import block_mesh
+    from .interactions import Wall, WallSpec
+    from .interactions.wall_contact import STIFFNESS_MASS
+    from .materials import get_model
+    from .parts.fem import solid_part
+    from .stepper import Stepper
+
+    side = max(1, round((elements or 100_000) ** (1 / 3)))
+    dx = 0.1 / side
+    mesh = block_mesh([0, 0, 0.5 * dx], [0.1, 0.1, 0.1 + 0.5 * dx], (side,) * 3, 3)
+    model = get_model("elastic")
+    part = solid_part("block", mesh.points, mesh.cells, 3,
+                      (model, model.pack({"density": 2400.0, "E": 3.0e10, "nu": 0.2})))
+    part.nodes.v[:, 2] = -10.0
+    wall = Wall(WallSpec("floor", np.zeros(3), np.array([0, 0, 1.0]), STIFFNESS_MASS,
+                         alpha=0.1, friction=0.0, thickness_factor=0.5), part)
+    return Stepper([part], [wall])
+
+
 def run_bench(case: str, steps: int = 1000, threads: int | None = None,
-              particles: int | None = None, warmup: int = 3) -> dict:
+              particles: int | None = None, warmup: int = 3,
+              elements: int | None = None) -> dict:
     """Run ``steps`` time steps of a case and time them (compilation excluded)."""
     from .assembly import build_stepper
 
     if threads:
         numba.set_num_threads(threads)
-    deck = case_deck(case, particles)
     t0 = time.perf_counter()
-    stepper = build_stepper(deck)
+    if case == "hex3d":
+        stepper = hex3d_stepper(elements)
+    else:
+        stepper = build_stepper(case_deck(case, particles))
     for _ in range(warmup):
         stepper.step()
     compile_s = time.perf_counter() - t0
@@ -123,9 +152,18 @@ def run_bench(case: str, steps: int = 1000, threads: int | None = None,
     for _ in range(steps):
         stepper.step()
     seconds = time.perf_counter() - t1
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # Linux: KiB
+    if case == "hex3d":
+        part = stepper.parts[0]
+        ne = part.el.n
+        return {
+            "case": case, "elements": ne, "nodes": part.nodes.n, "steps": steps,
+            "threads": numba.get_num_threads(), "seconds": seconds,
+            "compile_seconds": compile_s, "element_steps_per_s": ne * steps / seconds,
+            "peak_rss_mb": peak / 2**20, "bytes_per_element": peak / ne,
+        }
     n = stepper.particles.n
     sph = stepper.part("sph")
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # Linux: KiB
     return {
         "case": case, "particles": n, "steps": steps,
         "threads": numba.get_num_threads(), "seconds": seconds,

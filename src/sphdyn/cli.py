@@ -295,8 +295,11 @@ def cmd_bench(args) -> int:
         raise ValueError(f"--particles: the case {args.case} has a fixed particle count "
                          "(the rings of Gray et al. 2001). Fix: drop --particles, or "
                          "use it with block3d")
+    if args.elements is not None and args.case != "hex3d":
+        raise ValueError(f"--elements: the case {args.case} has no elements. Fix: use it "
+                         "with hex3d")
     print(main_json(case=args.case, steps=args.steps, threads=args.threads,
-                    particles=args.particles))
+                    particles=args.particles, elements=args.elements))
     return 0
 
 
@@ -499,11 +502,12 @@ def build_parser() -> argparse.ArgumentParser:
     i.set_defaults(func=cmd_info)
 
     b = sub.add_parser("bench", help="run a built-in benchmark, print one JSON line")
-    b.add_argument("case", choices=("rings2d", "rings2d_tl", "block3d"))
+    b.add_argument("case", choices=("rings2d", "rings2d_tl", "block3d", "hex3d"))
     b.add_argument("--steps", type=_whole(1), default=1000)
     b.add_argument("--threads", type=_whole(1), default=None, help="Numba threads (default: automatic)")
     b.add_argument("--particles", type=_whole(8), help="block3d: approximate particle "
                    "count (the rings cases have a fixed count)")
+    b.add_argument("--elements", type=_whole(1), help="hex3d: approximate element count")
     b.set_defaults(func=cmd_bench)
     mt = sub.add_parser("material-test", help="drive one material point along a load "
                         "path; CSV + plot into --out")
