@@ -97,18 +97,24 @@ class BeamSection:
     def rectangle(cls, b: float, h: float, shear_factor: float = 5.0 / 6.0) -> "BeamSection":
         r"""Solid rectangle, width ``b`` along local y, height ``h`` along local z [m].
 
-        :math:`A = bh`, :math:`I_y = bh^3/12`, :math:`I_z = hb^3/12`; Saint-Venant
-        torsion constant :math:`J = a c^3 [1/3 - 0.21 (c/a)(1 - c^4/(12 a^4))]`,
-        ``a`` the long and ``c`` the short side (Roark's Formulas, Young &
-        Budynas 2002, table 10.7 case 4; within 0.2 % of the series solution of
-        Timoshenko & Goodier 1970, sec. 109). Shear factor 5/6 (Timoshenko
-        1921; Cowper 1966 gives :math:`10(1+\nu)/(12+11\nu)`, 0.85 at
-        :math:`\nu = 0.3`).
+        :math:`A = bh`, :math:`I_y = bh^3/12`, :math:`I_z = hb^3/12`; the
+        Saint-Venant torsion constant from the series solution of the Prandtl
+        stress function (Timoshenko & Goodier 1970, *Theory of Elasticity*,
+        sec. 109), ``a`` the long and ``c`` the short side:
+
+        .. math:: J = \frac{a c^3}{3}\Big(1 - \frac{192}{\pi^5}\frac{c}{a}
+                  \sum_{n = 1, 3, 5, \ldots} \frac{1}{n^5}
+                  \tanh\frac{n\pi a}{2c}\Big)
+
+        (terms to n = 199: truncation below 1e-11). Shear factor 5/6
+        (Timoshenko 1921; Cowper 1966 gives :math:`10(1+\nu)/(12+11\nu)`,
+        0.85 at :math:`\nu = 0.3`).
         """
         if b <= 0 or h <= 0:
             raise ValueError(f"rectangle sides must be > 0, got b={b}, h={h}")
         a, c = max(b, h), min(b, h)
-        j = a * c ** 3 * (1.0 / 3.0 - 0.21 * (c / a) * (1.0 - c ** 4 / (12.0 * a ** 4)))
+        series = sum(math.tanh(n * math.pi * a / (2.0 * c)) / n ** 5 for n in range(1, 200, 2))
+        j = a * c ** 3 / 3.0 * (1.0 - 192.0 / math.pi ** 5 * (c / a) * series)
         return cls(b * h, b * h ** 3 / 12.0, h * b ** 3 / 12.0, j, shear_factor)
 
     @classmethod
