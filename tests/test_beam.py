@@ -12,6 +12,7 @@ import math
 import numpy as np
 import pytest
 from scipy.linalg import expm
+from scipy.integrate import quad
 from scipy.optimize import brentq
 
 from sphdyn.interactions.base import InteractionBase
@@ -196,25 +197,23 @@ def test_element_loads_are_objective():
     # element turned rigidly by 90 degrees about a skew axis (nodes and
     # triads): the loads turn with it, to round-off (1e-9 of the largest).
     sec = BeamSection.rectangle(0.04, 0.1)
-    rng = np.random.default_rng(3)
+    turns = np.random.default_rng(3).normal(scale=1e-3, size=(2, 3))
 
     def build(Q):
         p = straight(1, 0.5, sec)
         x = p.kin.x0 + np.array([[0, 0, 0], [2e-4, -3e-4, 5e-4]])
         p.kin.x[:] = x @ Q.T
-        for i, rv in enumerate(rng.normal(scale=1e-3, size=(2, 3))):
+        for i, rv in enumerate(turns):
             p.triad[i] = Q @ np.array(rotation_from_vector(*rv)).reshape(3, 3)
         return loads(p)
 
     f0, m0 = build(np.eye(3))
-    rng = np.random.default_rng(3)
     axis = np.array([1.0, 2.0, -0.5]) / np.linalg.norm([1.0, 2.0, -0.5])
     Q = np.array(rotation_from_vector(*(0.5 * math.pi * axis))).reshape(3, 3)
     f1, m1 = build(Q)
-    scale = max(np.abs(f0).max(), np.abs(m0).max())
+    assert np.abs(f0).max() > 1e3 and np.abs(m0).max() > 1e2  # a loaded element
     assert np.abs(f1 - f0 @ Q.T).max() < 1e-9 * np.abs(f0).max()
     assert np.abs(m1 - m0 @ Q.T).max() < 1e-9 * np.abs(m0).max()
-    assert scale > 0
 
 
 @pytest.mark.parametrize("L, b, h, n, bound", [(1.0, 0.03, 0.05, 8, "slender"),
@@ -225,7 +224,8 @@ def test_cantilever_tip_deflection(L, b, h, n, bound):
     # all: the residual vibration is below 1e-6 of the deflection. Tip
     # deflection w = P L^3/(3 E I) + P L/(kappa G A) (Timoshenko); P gives
     # w / L = 1e-3, so geometric nonlinearity is ~1e-6. Timoshenko elements are
-    # nodally exact for an end load, hence 0.1 % against Timoshenko; the
+    # nodally exact for an end load, hence 1e-4 against Timoshenko (reached:
+    # 1e-6); the
     # slender beam (L/h = 20, shear 0.2 %) is also within 2 % of
     # Euler-Bernoulli, the stocky one (L/h = 3, shear 8.7 %) is not.
     sec = BeamSection.rectangle(b, h)
@@ -240,7 +240,7 @@ def test_cantilever_tip_deflection(L, b, h, n, bound):
     while s.t < 6.0 * T1:
         s.step()
     w = p.kin.x[tip, 2]
-    assert w == pytest.approx(P * w_t_unit, rel=1e-3)
+    assert w == pytest.approx(P * w_t_unit, rel=1e-4)
     if bound == "slender":
         assert w == pytest.approx(P * w_eb_unit, rel=0.02)
     else:
@@ -275,6 +275,8 @@ def test_cantilever_first_frequency(case):
     # 1.875^2 sqrt(EI/(rho A L^4)) / 2 pi. Stocky (L/h = 3, 10 elements,
     # physical rotary inertia, scale 1): within 2 % of the Timoshenko
     # frequency (shear and rotary inertia), which is 7.7 % below Euler-Bernoulli.
+    # Reached: -0.75 % and -0.39 %. The stocky beam with the default scaled
+    # rotary inertia (3 times) is 3.5 % low: the scale is for slender beams.
     if case == "slender":
         L, b, h, scale = 1.0, 0.03, 0.05, 3.0
     else:
@@ -290,6 +292,9 @@ def test_cantilever_first_frequency(case):
     else:
         assert f == pytest.approx(f_t, rel=0.02)
         assert f_t < 0.95 * f_eb
+        p3 = cantilever(10, L, b, h)
+        mode_velocity(p3, 1e-4 * L * 2 * math.pi * f_t)
+        assert tip_frequency(p3, 3.0, 1.0 / f_t) < 0.98 * f_t
 
 
 def test_free_vibration_conserves_energy():
@@ -363,6 +368,7 @@ def test_rigid_rotation_makes_no_strain():
     # strains of order 1 - cos 90 deg = 1 (N ~ EA, M ~ EI pi/(2L)). Bounds:
     # |N| <= 2.5 rho A omega^2 L^2/8 at every step, |M| <= 1e-5 EI/L, |T| <= 1e-5 GJ/L;
     # the chord and the triads end turned by the same angle (1e-6 rad).
+    # Reached: N = 2.06 rho A omega^2 L^2/8, M = 2e-6 EI/L, T = 0, triads 2e-7.
     L, n = 1.0, 4
     sec = BeamSection.circle(0.05)
     p = straight(n, L, sec)
@@ -380,14 +386,14 @@ def test_rigid_rotation_makes_no_strain():
         m_max = max(m_max, np.abs(res[:, 2:6]).max())
         t_max = max(t_max, np.abs(res[:, 1]).max())
     assert s.step_count > 500
-    EA, EI = E * sec.area, E * sec.iy
+    EI = E * sec.iy
     assert n_max <= 2.5 * RHO * sec.area * w ** 2 * L ** 2 / 8
     assert m_max <= 1e-5 * EI / L
     assert t_max <= 1e-5 * G * sec.j / L
     chord = p.kin.x[-1] - p.kin.x[0]
     angle = math.atan2(chord[1], chord[0])
     Rz = np.array(rotation_from_vector(0.0, 0.0, angle)).reshape(3, 3)
-    assert abs(angle - 0.5 * math.pi) < 1e-3  # a quarter turn (rigid rotation rate)
+    assert abs(angle - 0.5 * math.pi) < 1e-4  # a quarter turn (rigid rotation rate)
     assert np.abs(p.triad - Rz).max() < 1e-6
 
 
@@ -503,13 +509,14 @@ def test_j2_truss_in_uniaxial_tension(H):
     # plastic work plus the elastic energy: the internal energy matches the
     # work of the reactions to 1e-3 (Stepper.record pairs the work booked
     # at t^n with the energy at t^{n+1}: a lag of N v dt / 2, 1/(2 steps) =
-    # 4e-4 of the work over these 1150 steps), and the area under the
-    # stress-strain line, A L0 (sigma_y eps - sigma_y^2/2E + H eps^2/2), to
-    # 5 % (the small-strain estimate of the elastic triangle and hardening)
+    # 4e-4 of the work over these 1150 steps), and the work of the axial
+    # force, A L0 int sigma(eps) exp(eps) d eps (dl = l d eps), to 2e-3 (reached 4e-4)
     rec = s.record()
     assert abs(rec["E_total"]) < 1e-3 * rec["E_internal"]
-    assert rec["E_internal"] == pytest.approx(sec.area * 0.2 * (sy * eps - sy ** 2 / (2 * E))
-                                              + sec.area * 0.2 * H * eps ** 2 / 2, rel=0.05)
+    ey = sy / E
+    work = quad(lambda t: E * t * math.exp(t), 0.0, ey)[0] + quad(
+        lambda t: (sy + H * t) / (1.0 + H / E) * math.exp(t), ey, eps)[0]
+    assert rec["E_internal"] == pytest.approx(sec.area * 0.2 * work, rel=2e-3)
     q, _ = pull(lateral_iterations=1)
     assert abs(q.points.sig[0, 1, 1]) > 0.01 * sy
 
