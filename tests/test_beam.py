@@ -245,6 +245,14 @@ def test_cantilever_tip_deflection(L, b, h, n, bound):
         assert w == pytest.approx(P * w_eb_unit, rel=0.02)
     else:
         assert abs(w / (P * w_eb_unit) - 1.0) > 0.05
+    # output fields: the resultants of the static state are P (shear in every
+    # element) and P L (end moment at the clamp), to the same 1e-4
+    fields, cols = p.fields(), p.columns()
+    assert np.abs(fields["shear_z"]()) == pytest.approx(np.full(n, P), rel=1e-4)
+    assert abs(fields["moment_y"]()[0, 0]) == pytest.approx(P * L, rel=1e-4)
+    assert cols["beam_moment_max"] == pytest.approx(P * L, rel=1e-4)
+    assert np.abs(fields["moment_z"]()).max() < 1e-9 * P * L
+    assert np.abs(fields["axial_force"]()).max() < 1e-2 * P  # P sin(slope) ~ 1.5e-3 P
     # the damping's dissipation closes the balance: E_total ~ 0 to 1 % of the
     # work of the load, P w
     rec = s.record()
