@@ -182,3 +182,35 @@ def test_rigid_wall_acts_on_mesh_nodes():
     assert 8.0 < vz < 10.1
     assert lowest > 0.0
     assert max(abs(r["E_total"] - e0) for r in rows) < 0.03 * e0
+
+
+@pytest.mark.slow
+def test_cantilever_of_hexes_first_frequency_matches_timoshenko():
+    """4 x 4 x 40 selective-reduced hexes (L = 1 m, h = 0.1 m, nu = 0),
+    clamped, released with the first mode's velocity: the frequency from
+    the tip's zero crossings within 2 % of the Timoshenko beam's (shear
+    factor 5/6, rotary inertia), solved independently in tests/test_beam.py
+    (measured +0.47 %)."""
+    from test_beam import timoshenko_frequency
+
+    L, h = 1.0, 0.1
+    x, cells = block([0, 0, 0], [L, h, h], (40, 4, 4), 3)
+    p = part(x, cells, 3, mat=material(density=RHO, E=E, nu=0.0),
+             integration="selective_reduced")
+    bl = 1.8751040687
+    sg = (math.cosh(bl) + math.cos(bl)) / (math.sinh(bl) + math.sin(bl))
+    s_ = bl * x[:, 0] / L
+    p.nodes.v[:, 1] = 0.01 * (np.cosh(s_) - np.cos(s_) - sg * (np.sinh(s_) - np.sin(s_)))
+    clamp = PrescribedMotion("clamp", p, np.flatnonzero(x[:, 0] == 0.0))
+    s = Stepper([p], [clamp])
+    f_ref = timoshenko_frequency(L, h * h, h ** 4 / 12, 5 / 6, rho=RHO, E=E, G=E / 2)
+    tip = np.flatnonzero(np.isclose(x[:, 0], L))
+    t_prev, w_prev, crossings = 0.0, 0.0, []
+    while s.t < 2.2 / f_ref:
+        s.step()
+        w = float(np.mean(p.nodes.x[tip, 1] - x[tip, 1]))
+        if s.step_count > 1 and w_prev * w < 0.0:
+            crossings.append(t_prev + (s.t - t_prev) * w_prev / (w_prev - w))
+        t_prev, w_prev = s.t, w
+    f = (len(crossings) - 1) / (2.0 * (crossings[-1] - crossings[0]))
+    assert f == pytest.approx(f_ref, rel=0.02)
