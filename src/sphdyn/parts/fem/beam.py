@@ -445,15 +445,18 @@ def truss_stable_dt(x, conn, c, scale):
 
 # ------------------------------------------------------------------- gather
 @njit(cache=True, error_model="numpy", parallel=True)
-def gather_forces(ptr, ent, fe, m, v, damping, a, power):
+def gather_loads(ptr, ent, fe, col, m, v, damping, a, power):
     r"""Nodal accelerations from the element loads (gather, no races).
 
-    :math:`a_i = \sum_{e\ni i} f_{e,i}/m_i - c\,v_i` with the mass-proportional
-    damping coefficient ``c`` [1/s] (0: none) acting on the half-step
-    velocity; ``power`` (N,) out, the damping power :math:`c\, m_i |v_i|^2`
-    [W]. ``ptr`` (N+1,), ``ent`` (2E,) the node -> (2 element + end) CSR
-    list; ``fe`` (E, 2, 6); ``m`` (N,) [kg]; ``a`` (N, 3) out (zero for a
-    massless node).
+    :math:`a_i = \sum_{e\ni i} f_{e,i}/m_i - c\,v_i` for the three columns
+    ``col:col+3`` of ``fe`` (E, 2, 6): 0 for the forces [N] with the masses
+    ``m`` [kg] and velocities ``v`` [m/s], 3 for the moments [N m] with the
+    rotary inertias [kg m^2] and angular velocities [rad/s] (isotropic
+    inertia: Euler's equations have no gyroscopic term). ``c`` is the
+    mass-proportional damping coefficient [1/s] (0: none) acting on the
+    half-step velocity; ``power`` (N,) in/out adds the damping power
+    :math:`c\, m_i |v_i|^2` [W]. ``ptr`` (N+1,), ``ent`` (2E,) the node ->
+    (2 element + end) CSR list; ``a`` (N, 3) out (zero where m = 0).
     """
     for i in prange(m.shape[0]):
         f0 = 0.0
@@ -462,9 +465,9 @@ def gather_forces(ptr, ent, fe, m, v, damping, a, power):
         for k in range(ptr[i], ptr[i + 1]):
             e = ent[k] // 2
             s = ent[k] % 2
-            f0 += fe[e, s, 0]
-            f1 += fe[e, s, 1]
-            f2 += fe[e, s, 2]
+            f0 += fe[e, s, col]
+            f1 += fe[e, s, col + 1]
+            f2 += fe[e, s, col + 2]
         if m[i] > 0.0:
             a[i, 0] = f0 / m[i] - damping * v[i, 0]
             a[i, 1] = f1 / m[i] - damping * v[i, 1]
@@ -473,38 +476,7 @@ def gather_forces(ptr, ent, fe, m, v, damping, a, power):
             a[i, 0] = 0.0
             a[i, 1] = 0.0
             a[i, 2] = 0.0
-        power[i] = damping * m[i] * (v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2)
-
-
-@njit(cache=True, error_model="numpy", parallel=True)
-def gather_moments(ptr, ent, fe, inertia, w, damping, ra, power):
-    r"""Nodal angular accelerations :math:`\sum_e m_{e,i}/I_i - c\,\omega_i`.
-
-    The rotary inertia is isotropic (one value per node), so Euler's
-    equations have no gyroscopic term. ``fe`` columns 3:6 are the moments
-    [N m]; ``inertia`` (N,) [kg m^2]; ``w`` (N, 3) angular velocity [rad/s];
-    ``ra`` (N, 3) out [rad/s^2]; ``power`` (N,) in/out, adds
-    :math:`c I_i|\omega_i|^2` [W]. Other arguments as :func:`gather_forces`.
-    """
-    for i in prange(inertia.shape[0]):
-        f0 = 0.0
-        f1 = 0.0
-        f2 = 0.0
-        for k in range(ptr[i], ptr[i + 1]):
-            e = ent[k] // 2
-            s = ent[k] % 2
-            f0 += fe[e, s, 3]
-            f1 += fe[e, s, 4]
-            f2 += fe[e, s, 5]
-        if inertia[i] > 0.0:
-            ra[i, 0] = f0 / inertia[i] - damping * w[i, 0]
-            ra[i, 1] = f1 / inertia[i] - damping * w[i, 1]
-            ra[i, 2] = f2 / inertia[i] - damping * w[i, 2]
-        else:
-            ra[i, 0] = 0.0
-            ra[i, 1] = 0.0
-            ra[i, 2] = 0.0
-        power[i] += damping * inertia[i] * (w[i, 0] ** 2 + w[i, 1] ** 2 + w[i, 2] ** 2)
+        power[i] += damping * m[i] * (v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2)
 
 
 @njit(cache=True, error_model="numpy")

@@ -73,7 +73,7 @@ from ...state.store import STATE
 from ..base import register_part
 from .beam import (N_RES, RES_L, RES_MY_A, RES_MY_B, RES_MZ_A, RES_MZ_B, RES_N, RES_T,
                    RES_VY, RES_VZ, beam_forces, beam_stable_dt, drift_rotations,
-                   gather_forces, gather_moments, lateral_ratio, lateral_secant, ordered_sum,
+                   gather_loads, lateral_ratio, lateral_secant, ordered_sum,
                    truss_forces, truss_gradient, truss_kinematics, truss_stable_dt)
 
 
@@ -393,11 +393,12 @@ class LinePart:
                 self._uniaxial_update(dt)
                 el.l_prev = self.points.l_now
             truss_forces(kin.x, el.conn, self.points.sig, self.section.area, el.fe, el.res)
-        gather_forces(self.ptr, self.ent, el.fe, kin.m, kin.v, self.damping, kin.a,
-                      kin.damp_power)
+        kin.damp_power[:] = 0.0
+        gather_loads(self.ptr, self.ent, el.fe, 0, kin.m, kin.v, self.damping, kin.a,
+                     kin.damp_power)
         if self.beam:
-            gather_moments(self.ptr, self.ent, el.fe, kin.rot.m, kin.rot.v, self.damping,
-                           kin.rot.a, kin.damp_power)
+            gather_loads(self.ptr, self.ent, el.fe, 3, kin.rot.m, kin.rot.v, self.damping,
+                         kin.rot.a, kin.damp_power)
 
     def _uniaxial_update(self, dt: float) -> None:
         """Material update of the truss points under uniaxial stress (module docstring)."""
