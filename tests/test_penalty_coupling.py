@@ -233,8 +233,8 @@ def test_closest_point_on_a_warped_face():
                                              ("bulk", 2.0)])
 def test_particle_at_a_penetration_gets_the_paper_spring_split_by_the_shape_functions(
         dim, stiffness, alpha):
-    # A particle (dx = 1 mm, t_p = 0.5 mm; its body's other one far away) placed over the top face of a
-    # tilted 2x2(x2) block at parametric point (0.3, -0.6) with penetration
+    # A particle (dx = 1 mm, t_p = 0.5 mm; its body's other one far away)
+    # placed over a top face of a tilted 2x2(x2) block at parametric point (0.3, -0.6) with penetration
     # delta = 0.2 mm along the face normal. Expected, written out:
     #   mass (eq. 8): F = alpha m delta / dt^2;
     #   bulk (eq. 9): F = m alpha K V^((d-2)/d) delta / (rho0 V), K = E/(3(1-2nu)).
@@ -489,7 +489,9 @@ def test_sliding_particle_decelerates_at_mu_g(dim):
     # a body force g = 1e5 m/s^2 into the face, mu = 0.3; it starts at the
     # spring's equilibrium penetration g dt^2 / alpha, so the normal force is
     # m g. Over the sliding phase (0.9 v0 > v > 0.1 v0) the velocity falls
-    # linearly at mu g (least-squares slope within 1 %); at every step the
+    # linearly at mu g and the mean normal force is m g (least-squares slope
+    # and mean within 1e-4; reached 7e-9 and 7e-8: the step varies a little
+    # with the speed, and so the mass spring); at every step the
     # velocity does not grow and does not reverse (>= 0), and it stops (v = 0
     # to 1e-9 m/s) at v0 / (mu g) (not 1 % earlier, at most 5 steps later: the
     # last step's friction is capped so as not to reverse the sliding, the
@@ -520,8 +522,8 @@ def test_sliding_particle_decelerates_at_mu_g(dim):
     t, v = np.array(t), np.array(v)
     sliding = (v < 0.9 * v0) & (v > 0.1 * v0)
     slope = np.polyfit(t[sliding], v[sliding], 1)[0]
-    assert -slope == pytest.approx(mu * g, rel=1e-2)
-    assert np.mean(fn) == pytest.approx(sph.p.m.sum() * g, rel=1e-2)
+    assert -slope == pytest.approx(mu * g, rel=1e-4)
+    assert np.mean(fn) == pytest.approx(sph.p.m.sum() * g, rel=1e-4)
     stopped = t[np.argmax(v < 1e-9)]
     assert v[-1] < 1e-9 and stop_time * 0.99 < stopped < stop_time + 5 * dt
 
