@@ -5,6 +5,7 @@ All positions are ``(n, 3)`` float64 arrays in metres (``z = 0`` in 2D); a
 lattice particle's nominal volume is ``dx**dim``.
 """
 
+from .convert import element_centroids, elements_to_particles
 from .lattice import (
     RULES,
     SHAPES,
@@ -43,4 +44,6 @@ __all__ = [
     "read_mesh",
     "element_jacobians",
     "check_elements",
+    "element_centroids",
+    "elements_to_particles",
 ]

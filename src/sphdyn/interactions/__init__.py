@@ -1,11 +1,12 @@
-"""Interactions: walls, particle contact (and the SPH-FEM couplings to come).
+"""Interactions: walls, particle contact, the SPH-FEM penalty coupling, nodal ones.
 
 See :mod:`sphdyn.interactions.base` for the protocol the stepper uses.
 """
 
 from .base import Interaction, InteractionBase
 from .contact import ParticleContact
+from .penalty_coupling import PenaltyCoupling
 from .wall import STIFFNESS, Wall, WallSpec
 
-__all__ = ["Interaction", "InteractionBase", "ParticleContact", "STIFFNESS", "Wall",
-           "WallSpec"]
+__all__ = ["Interaction", "InteractionBase", "ParticleContact", "PenaltyCoupling", "STIFFNESS",
+           "Wall", "WallSpec"]

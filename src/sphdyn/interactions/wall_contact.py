@@ -42,6 +42,38 @@ STIFFNESS_MASS = 0
 STIFFNESS_BULK = 1
 
 
+@njit(cache=True, error_model="numpy")
+def contact_thickness(vol0, dim, thickness_factor):
+    r"""Contact thickness :math:`t = f_t V^{1/d}` of one particle [m].
+
+    ``vol0`` its nominal volume [m^dim], ``thickness_factor`` :math:`f_t`
+    (0.5: the particle's cell touches the surface when its centre is half a
+    spacing away).
+    """
+    return thickness_factor * vol0 ** (1.0 / dim)
+
+
+@njit(cache=True, error_model="numpy")
+def spring_acceleration(pen, method, alpha, dt, kbulk, vol0, rho0, dim):
+    r"""Normal acceleration [m/s^2] of a particle pressed ``pen`` [m] into a surface.
+
+    * mass-based, Hušek et al. (2017) eq. (8): :math:`k = \alpha m/\Delta t^2`,
+      so :math:`a = \alpha\,\delta/\Delta t^2` whatever the mass;
+    * bulk-based, eq. (9): :math:`k = \alpha K A/L = \alpha K V^{(d-2)/d}`
+      acting on the nominal inertia :math:`\rho_0 V`:
+      :math:`a = k\delta/(\rho_0 V)`.
+
+    The force the particle feels and exerts is :math:`m a` (module
+    docstring). ``kbulk`` [Pa], ``vol0`` [m^dim], ``rho0`` [kg/m^3] and
+    ``dt`` [s] are the particle's bulk modulus, nominal volume, reference
+    density and the stable step.
+    """
+    if method == STIFFNESS_MASS:
+        return alpha * pen / (dt * dt)
+    k = alpha * kbulk * vol0 ** ((dim - 2.0) / dim)
+    return k * pen / (rho0 * vol0)
+
+
 @njit(cache=True, error_model="numpy", parallel=True)
 def wall_contact(x, v, m, vol0, rho, kbulk, dim, point, normal, wall_v,
                  thickness_factor, method, alpha, friction, dt, a_contact, force):
@@ -66,7 +98,6 @@ def wall_contact(x, v, m, vol0, rho, kbulk, dim, point, normal, wall_v,
     n_contact : int, number of particles in contact.
     """
     n = x.shape[0]
-    inv_d = 1.0 / dim
     count = 0
     for i in prange(n):
         force[i, 0] = 0.0
@@ -74,17 +105,11 @@ def wall_contact(x, v, m, vol0, rho, kbulk, dim, point, normal, wall_v,
         force[i, 2] = 0.0
         gap = ((x[i, 0] - point[0]) * normal[0] + (x[i, 1] - point[1]) * normal[1]
                + (x[i, 2] - point[2]) * normal[2])
-        size = vol0[i] ** inv_d
-        pen = thickness_factor * size - gap
+        pen = contact_thickness(vol0[i], dim, thickness_factor) - gap
         if pen <= 0.0:
             continue
         count += 1
-        inertia = rho[i] * vol0[i]
-        if method == STIFFNESS_MASS:
-            an = alpha * pen / (dt * dt)
-        else:
-            k = alpha * kbulk[i] * vol0[i] ** ((dim - 2.0) * inv_d)
-            an = k * pen / inertia
+        an = spring_acceleration(pen, method, alpha, dt, kbulk[i], vol0[i], rho[i], dim)
         a0 = an * normal[0]
         a1 = an * normal[1]
         a2 = an * normal[2]

@@ -1,0 +1,103 @@
+r"""Coupled SPH-FEM models from one mesh: chosen elements become particles.
+
+The thesis builds its coupled models from a finite-element mesh (chapter 4,
+"Coupling SPH and FEM"): the elements of the region that will fragment are
+replaced by SPH particles, one per element, and the rest of the mesh stays
+finite elements; the two are then tied by a contact (penalty) interface,
+:class:`sphdyn.interactions.penalty_coupling.PenaltyCoupling`.
+
+A particle made from element :math:`e` sits at the element's centroid and
+carries its volume,
+
+.. math::
+    V_e = \int_{\Omega_e} d\Omega = \int_{[-1,1]^d} \det J\, d\boldsymbol\xi,
+    \qquad
+    \mathbf x_e = \frac1{V_e}\int_{[-1,1]^d} \mathbf x(\boldsymbol\xi)\,
+    \det J\, d\boldsymbol\xi,
+
+with the isoparametric map :math:`\mathbf x(\boldsymbol\xi) = \sum_a
+N_a(\boldsymbol\xi)\mathbf x_a` (trilinear hex8, bilinear quad4). The
+integrands are polynomials of degree at most 3 in each natural coordinate
+(:math:`\mathbf x` is of degree 1, :math:`\det J` of degree 2), so the
+:math:`2^d` Gauss points integrate both exactly. The particle's mass is the
+element's, :math:`\rho V_e`, when the particle gets the element's material.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .mesh import _CORNERS, MESH_KINDS, _shape_gradients
+
+__all__ = ["element_centroids", "elements_to_particles"]
+
+
+def element_centroids(points, cells, kind: str) -> tuple[np.ndarray, np.ndarray]:
+    r"""Volume-weighted centroids and volumes of hex8 or quad4 elements.
+
+    :math:`V_e = \sum_g \det J(\boldsymbol\xi_g)` and
+    :math:`\mathbf x_e = \sum_g \mathbf x(\boldsymbol\xi_g) \det J(\boldsymbol\xi_g) / V_e`
+    over the :math:`2^d` Gauss points :math:`\pm 1/\sqrt 3` (unit weights;
+    exact, see the module docstring).
+
+    Parameters
+    ----------
+    points : (N, 3) node positions [m] (z = 0 in 2D).
+    cells : (E, nen) connectivity, VTK node order (:mod:`sphdyn.geometry.mesh`).
+    kind : ``"hex8"`` or ``"quad4"``.
+
+    Returns
+    -------
+    centroids : (E, 3) [m]; volumes : (E,) [m^3] (hex8) or [m^2] (quad4,
+    per unit depth).
+    """
+    if kind not in ("hex8", "quad4"):
+        raise ValueError(f"elements_to_particles needs hex8 or quad4 elements, got {kind!r}")
+    d = MESH_KINDS[kind][1]
+    xg = _CORNERS[kind] / np.sqrt(3.0)                      # (G, d) Gauss points
+    N = np.prod(1.0 + _CORNERS[kind][None, :, :] * xg[:, None, :], axis=2) / 2.0**d  # (G, nen)
+    dN = _shape_gradients(kind, xg)                         # (G, nen, d)
+    x = np.asarray(points, dtype=np.float64)[np.asarray(cells, dtype=np.int64)]  # (E, nen, 3)
+    jac = np.einsum("eai,gaj->egij", x[:, :, :d], dN)       # (E, G, d, d)
+    det = np.linalg.det(jac)                                # (E, G)
+    vol = det.sum(axis=1)
+    xq = np.einsum("ga,eai->egi", N, x)                     # (E, G, 3) Gauss points in space
+    centroids = np.einsum("eg,egi->ei", det, xq) / vol[:, None]
+    return centroids, vol
+
+
+def elements_to_particles(points, cells, kind: str, element_mask):
+    """Turn the selected elements into particles; keep the rest as a mesh.
+
+    Parameters
+    ----------
+    points : (N, 3) node positions [m].
+    cells : (E, nen) connectivity (hex8 or quad4, VTK node order).
+    kind : ``"hex8"`` or ``"quad4"``.
+    element_mask : (E,) bool, or an index array of the elements to convert.
+
+    Returns
+    -------
+    centroids : (k, 3) [m], the particles' positions (the elements' centroids,
+        :func:`element_centroids`), in element order.
+    volumes : (k,) [m^dim], the particles' volumes (mass = density times it).
+    remaining_cells : (E - k, nen) int64, the other elements in their order,
+        renumbered onto the kept nodes.
+    kept_node_index : (n_kept,) int64, ascending: the old index of every kept
+        node, so the remaining mesh's points are ``points[kept_node_index]``.
+        Nodes used only by converted elements are dropped.
+    """
+    cells = np.asarray(cells, dtype=np.int64)
+    mask = np.asarray(element_mask)
+    if mask.dtype != np.bool_:
+        sel = np.zeros(cells.shape[0], dtype=bool)
+        sel[mask.astype(np.int64)] = True
+        mask = sel
+    if mask.shape != (cells.shape[0],):
+        raise ValueError(f"element_mask must have shape ({cells.shape[0]},), got {mask.shape}")
+    centroids, volumes = element_centroids(points, cells[mask], kind)
+    rest = cells[~mask]
+    kept = np.unique(rest)
+    new_index = np.full(np.asarray(points).shape[0], -1, dtype=np.int64)
+    new_index[kept] = np.arange(kept.size)
+    return centroids, volumes, new_index[rest], kept

@@ -1,0 +1,358 @@
+r"""SPH-FEM coupling by penalty contact: particles as slave nodes, element faces as master.
+
+The thesis couples SPH and finite elements with "the penalty-based contact
+algorithm with the nodal penetration detection in which the nodes would be
+represented by SPH particles" (chapter 4, "Coupling SPH and FEM"). Here each
+particle :math:`p` of an SPH part is a slave node; the master surface is a set
+of boundary faces of a solid part (by default all exterior faces,
+:func:`~.penalty_geometry.exterior_faces`).
+
+Contact of one particle. For each candidate face the closest point
+:math:`\mathbf x_c = \sum_a N_a(\xi,\eta)\,\mathbf x_a` and the outward
+normal :math:`\mathbf n` there are found (:func:`~.penalty_geometry.closest_point`);
+the particle takes the face with the closest point (ties: the lower face
+index). With :math:`\mathbf r = \mathbf x_p - \mathbf x_c` and the contact
+thickness :math:`t_p = f_t V_p^{1/d}` (as at the rigid wall,
+:mod:`.wall_contact`) the gap and the contact direction are
+
+* :math:`g = \mathbf r\cdot\mathbf n - t_p`, :math:`\hat{\mathbf e} =
+  \mathbf n`, when the closest point is inside the face (the particle is in
+  front of or behind the face itself);
+* :math:`g = |\mathbf r| - t_p`, :math:`\hat{\mathbf e} = \mathbf r/|\mathbf r|`,
+  when it is on the face's boundary and the particle is in front of the
+  face's plane (the particle's sphere touches an edge or a corner: continuous
+  with the first case); no contact when it is on the boundary and behind.
+
+If :math:`g < 0` the penetration :math:`\delta = -g` gives the particle the
+normal acceleration of the wall's spring, :func:`~.wall_contact.spring_acceleration`
+(Hušek et al. 2017, eq. 8: :math:`k = \alpha m/\Delta t^2`, or eq. 9:
+:math:`k = \alpha K A/L` on the nominal inertia :math:`\rho_0 V`), and the
+force
+
+.. math:: \mathbf F_p = m_p a_n \hat{\mathbf e} + \mathbf F_t,\qquad
+          \mathbf F_a = -N_a(\xi, \eta)\,\mathbf F_p \quad (a \in \text{face}),
+
+so the face nodes take the equal and opposite force shared with the face's
+shape functions at the contact point: linear momentum is conserved exactly
+(:math:`\sum_a N_a = 1`) and the normal part derives from the potential
+:math:`\tfrac12 k\delta^2` (at the closest point :math:`\partial g/\partial
+\mathbf x_a = -N_a \hat{\mathbf e}`), so the interface stores its energy
+(``E_contact``) and gives it back.
+
+Friction (optional, coefficient :math:`\mu`) acts on the relative tangential
+velocity :math:`\mathbf v_t` of the particle and the face point,
+:math:`\mathbf v_r = \mathbf v_p - \sum_a N_a \mathbf v_a`,
+:math:`\mathbf v_t = \mathbf v_r - (\mathbf v_r\cdot\hat{\mathbf e})\hat{\mathbf e}`:
+:math:`\mathbf F_t = -\min(\mu |F_n|,\ m^\ast |\mathbf v_t|/\Delta t)\,
+\mathbf v_t/|\mathbf v_t|` with the effective mass of the contact
+:math:`1/m^\ast = 1/m_p + \sum_a N_a^2/m_a`: the regularised Coulomb law of
+the wall, capped so that one step cannot reverse the relative sliding.
+
+Zero-mass particles (initial cracks) are pushed out with the spring's
+acceleration and exert no force, as at the wall.
+
+Limitations: one face per particle (at a concave corner of the master
+surface a particle is held out of the nearer face only); the master faces are
+those of the reference mesh (eroded elements do not expose new faces).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from .base import InteractionBase
+from .penalty_geometry import candidate_pairs, closest_point, exterior_faces, face_shapes
+from .wall import STIFFNESS
+from .wall_contact import STIFFNESS_BULK, contact_thickness, spring_acceleration
+
+#: relative lateral offset under which a clamped closest point counts as inside the face
+_INSIDE_RTOL = 1e-9
+
+
+@njit(cache=True, error_model="numpy", parallel=True)
+def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, faces,
+                            offsets, cand, thickness_factor, method, alpha, friction, dt,
+                            a_p, a_n, face_of, shares, force, normal_force):
+    r"""Particle-face penalty forces (module docstring) into the particles' and nodes' ``a``.
+
+    Parameters
+    ----------
+    xp, vp : (N, 3) particle positions [m] and mid-step velocities [m/s].
+    mp, vol0, rho0, kbulk : (N,) mass [kg], nominal volume [m^dim], reference
+        density [kg/m^3], bulk modulus [Pa] (kg/m, m^2 per unit depth in 2D).
+    dim : 2 or 3.
+    xn, vn, mn : (M, 3), (M, 3), (M,) node positions, velocities, masses.
+    faces : (F, nf) master faces (4 nodes in 3D, 2 in 2D).
+    offsets, cand : CSR candidate faces of each particle
+        (:func:`~.penalty_geometry.candidate_pairs`).
+    thickness_factor, method, alpha, friction, dt : the contact law
+        (:func:`~.wall_contact.spring_acceleration`, Coulomb coefficient,
+        stable step [s]).
+    a_p : (N, 3) in/out, the particles' accelerations are **added** [m/s^2].
+    a_n : (M, 3) in/out, the nodes' accelerations are **added** [m/s^2].
+    face_of : (N,) out, the face each particle touches (-1: none).
+    shares : (N, 4, 3) out, the force on each node of that face [N]
+        (:math:`-N_a \mathbf F_p`; rows past nf unused).
+    force : (N, 3) out, the force on each particle [N] (N/m in 2D).
+    normal_force : (N,) out, its component along the contact direction [N].
+
+    Returns
+    -------
+    n_contact : int, particles in contact.
+
+    The particle loop is parallel and writes only its own rows; the nodes'
+    share is then gathered serially, in particle order (4 adds per contact;
+    deterministic on any number of threads).
+    """
+    n = xp.shape[0]
+    nf = faces.shape[1]
+    count = 0
+    for i in prange(n):
+        face_of[i] = -1
+        force[i, 0] = 0.0
+        force[i, 1] = 0.0
+        force[i, 2] = 0.0
+        normal_force[i] = 0.0
+        best = np.inf
+        bf = -1
+        for k in range(offsets[i], offsets[i + 1]):
+            f = cand[k]
+            res = closest_point(xp[i], xn, faces[f])
+            r0 = xp[i, 0] - res[2]
+            r1 = xp[i, 1] - res[3]
+            r2 = xp[i, 2] - res[4]
+            d2 = r0 * r0 + r1 * r1 + r2 * r2
+            if d2 < best or (d2 == best and f < bf):
+                best = d2
+                bf = f
+        if bf < 0:
+            continue
+        xi, eta, cx, cy, cz, nx, ny, nz, clamped = closest_point(xp[i], xn, faces[bf])
+        r0 = xp[i, 0] - cx
+        r1 = xp[i, 1] - cy
+        r2 = xp[i, 2] - cz
+        rn = r0 * nx + r1 * ny + r2 * nz
+        tp = contact_thickness(vol0[i], dim, thickness_factor)
+        l0 = r0 - rn * nx
+        l1 = r1 - rn * ny
+        l2 = r2 - rn * nz
+        lat = np.sqrt(l0 * l0 + l1 * l1 + l2 * l2)
+        if (not clamped) or lat <= _INSIDE_RTOL * tp:
+            gap = rn - tp
+            e0, e1, e2 = nx, ny, nz
+        elif rn > 0.0:
+            dist = np.sqrt(r0 * r0 + r1 * r1 + r2 * r2)
+            gap = dist - tp
+            e0, e1, e2 = r0 / dist, r1 / dist, r2 / dist
+        else:
+            continue
+        if gap >= 0.0:
+            continue
+        count += 1
+        an = spring_acceleration(-gap, method, alpha, dt, kbulk[i], vol0[i], rho0[i], dim)
+        if mp[i] <= 0.0:  # pushed out, no force of its own
+            a_p[i, 0] += an * e0
+            a_p[i, 1] += an * e1
+            a_p[i, 2] += an * e2
+            continue
+        N = face_shapes(xi, eta, nf)
+        fn = mp[i] * an
+        f0 = fn * e0
+        f1 = fn * e1
+        f2 = fn * e2
+        if friction > 0.0:
+            w0 = vp[i, 0]
+            w1 = vp[i, 1]
+            w2 = vp[i, 2]
+            inv_meff = 1.0 / mp[i]
+            for a in range(nf):
+                node = faces[bf, a]
+                w0 -= N[a] * vn[node, 0]
+                w1 -= N[a] * vn[node, 1]
+                w2 -= N[a] * vn[node, 2]
+                if mn[node] > 0.0:
+                    inv_meff += N[a] * N[a] / mn[node]
+            wn = w0 * e0 + w1 * e1 + w2 * e2
+            t0 = w0 - wn * e0
+            t1 = w1 - wn * e1
+            t2 = w2 - wn * e2
+            vt = np.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
+            if vt > 0.0:
+                ft = min(friction * fn, vt / (dt * inv_meff))
+                f0 -= ft * t0 / vt
+                f1 -= ft * t1 / vt
+                f2 -= ft * t2 / vt
+        a_p[i, 0] += f0 / mp[i]
+        a_p[i, 1] += f1 / mp[i]
+        a_p[i, 2] += f2 / mp[i]
+        force[i, 0] = f0
+        force[i, 1] = f1
+        force[i, 2] = f2
+        normal_force[i] = fn
+        face_of[i] = bf
+        for a in range(4):
+            s = N[a]
+            shares[i, a, 0] = -s * f0
+            shares[i, a, 1] = -s * f1
+            shares[i, a, 2] = -s * f2
+    for i in range(n):
+        f = face_of[i]
+        if f < 0:
+            continue
+        for a in range(nf):
+            node = faces[f, a]
+            if mn[node] > 0.0:
+                a_n[node, 0] += shares[i, a, 0] / mn[node]
+                a_n[node, 1] += shares[i, a, 1] / mn[node]
+                a_n[node, 2] += shares[i, a, 2] / mn[node]
+    return count
+
+
+@njit(cache=True, error_model="numpy", parallel=True)
+def _max_shift(x, x_ref, rows):
+    """Largest displacement [m] of the items ``rows`` (R,) since ``x_ref`` (N, 3)."""
+    m = 0.0
+    for k in prange(rows.shape[0]):
+        i = rows[k]
+        d0 = x[i, 0] - x_ref[i, 0]
+        d1 = x[i, 1] - x_ref[i, 1]
+        d2 = x[i, 2] - x_ref[i, 2]
+        d = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        if d != d:
+            d = np.inf
+        m = max(m, d)
+    return m
+
+
+class PenaltyCoupling(InteractionBase):
+    """Penalty contact of an SPH part's particles with a solid part's faces.
+
+    Parameters
+    ----------
+    name : the interaction's name (history columns ``F_<name>``: total normal
+        force on the interface [N] (N/m in 2D), ``contacts_<name>``: number
+        of particles in contact).
+    sph_part : the SPH part (its particles are the slaves; ``x, v, m, vol0,
+        rho0, bulk_modulus``).
+    solid_part : the solid part (its nodes carry the master faces).
+    faces : (F, 4) quadrilaterals (3D) or (F, 2) segments (2D) of the solid
+        part's node ids, oriented outward (:mod:`.penalty_geometry`);
+        default: all exterior faces of the mesh.
+    stiffness : ``"mass"`` (eq. 8) or ``"bulk"`` (eq. 9).
+    alpha : penalty factor of the spring.
+    thickness_factor : contact thickness in units of the particle size
+        :math:`V^{1/d}` (0.5: particle cells touch the face).
+    friction : Coulomb coefficient.
+    skin_factor : Verlet skin of the candidate list in units of the largest
+        contact thickness.
+
+    The candidate list holds the faces whose bounding box, grown by the reach
+    :math:`2 t_{max}` plus the skin, holds a particle; it is built again when
+    the largest particle displacement plus the largest face-node displacement
+    since the build exceed the skin (then no pair within the reach can have
+    been missed: a face point moves at most as far as its nodes).
+    """
+
+    def __init__(self, name: str, sph_part, solid_part, faces=None, stiffness: str = "mass",
+                 alpha: float = 0.1, thickness_factor: float = 0.5, friction: float = 0.0,
+                 skin_factor: float = 1.0):
+        if stiffness not in STIFFNESS:
+            raise ValueError(f"{name}: stiffness must be one of {tuple(STIFFNESS)}, "
+                             f"got {stiffness!r}")
+        if alpha <= 0.0 or thickness_factor <= 0.0 or friction < 0.0 or skin_factor <= 0.0:
+            raise ValueError(f"{name}: alpha, thickness_factor and skin_factor must be > 0 "
+                             "and friction >= 0")
+        self.name = name
+        self.part = sph_part
+        self.solid = solid_part
+        self.method = STIFFNESS[stiffness]
+        self.alpha, self.thickness_factor = float(alpha), float(thickness_factor)
+        self.friction, self.skin_factor = float(friction), float(skin_factor)
+        dim = solid_part.dim
+        faces = exterior_faces(solid_part.el.conn) if faces is None else faces
+        self.faces = np.ascontiguousarray(faces, dtype=np.int64)
+        if self.faces.ndim != 2 or self.faces.shape[1] != (4 if dim == 3 else 2):
+            raise ValueError(f"{name}: faces must have shape (F, {4 if dim == 3 else 2}) "
+                             f"in {dim}D, got {self.faces.shape}")
+        self.master_nodes = np.unique(self.faces)
+        self.count = 0
+        self.n_builds = 0
+        self.total_normal = 0.0
+        self._allocate()
+        sph_part.p.on_grow(lambda n_old, n_new: self._allocate())
+
+    # ------------------------------------------------------------- set-up
+    def _allocate(self) -> None:
+        """Work arrays, the time-step limit and the candidate list for the particles."""
+        p = self.part.p
+        n = p.n
+        self.face_of = np.full(n, -1, dtype=np.int64)
+        self.shares = np.zeros((n, 4, 3))
+        self.force = np.zeros((n, 3))
+        self.normal_force = np.zeros(n)
+        self._all = np.arange(n, dtype=np.int64)
+        t_max = float(np.max(self.thickness_factor * p.vol0 ** (1.0 / p.dim))) if n else 0.0
+        self.reach = 2.0 * t_max
+        self.skin = self.skin_factor * t_max
+        self._dt = self._limit()
+        self._build()
+
+    def _limit(self) -> float:
+        r"""Stable step of the bulk springs: :math:`1/\omega_{max}` (half the limit
+        :math:`2/\omega`) with :math:`\omega^2 = k_{eff}(1/m_p + 1/m_{node})`,
+        :math:`k_{eff} = k\,m_p/(\rho_0 V)`, the smallest master-node mass (the
+        whole force on one node, the worst case); mass springs: inf, their
+        :math:`\omega\Delta t` is fixed by alpha."""
+        p = self.part.p
+        if self.method != STIFFNESS_BULK or p.n == 0:
+            return np.inf
+        mn = self.solid.nodes.m[self.master_nodes]
+        m_node = float(mn[mn > 0].min()) if np.any(mn > 0) else np.inf
+        k = self.alpha * p.bulk_modulus * p.vol0 ** ((p.dim - 2.0) / p.dim)
+        w2 = k / (p.rho0 * p.vol0) * (1.0 + p.m / m_node)
+        return float(1.0 / np.sqrt(w2.max()))
+
+    def _build(self) -> None:
+        p, q = self.part.p, self.solid.nodes
+        self.offsets, self.cand = candidate_pairs(p.x, q.x, self.faces,
+                                                  self.reach + self.skin, p.dim)
+        self.xp_ref = p.x.copy()
+        self.xn_ref = q.x.copy()
+        self.n_builds += 1
+
+    # ----------------------------------------------------------- protocol
+    def stable_dt(self) -> float:
+        return self._dt
+
+    def update_geometry(self, t: float) -> None:
+        p, q = self.part.p, self.solid.nodes
+        shift = (_max_shift(p.x, self.xp_ref, self._all)
+                 + _max_shift(q.x, self.xn_ref, self.master_nodes))
+        if not shift < self.skin:
+            self._build()
+
+    def forces(self, t: float, dt: float, a_out: np.ndarray) -> None:
+        p, q = self.part.p, self.solid.nodes
+        # the nodes' share goes to their a_ext, except when the caller asks
+        # into a scratch array (the stepper's restore refreshes the columns)
+        a_n = q.a_ext if a_out is p.a_ext else np.zeros_like(q.a_ext)
+        self.count = int(penalty_coupling_forces(
+            p.x, p.v, p.m, p.vol0, p.rho0, p.bulk_modulus, p.dim, q.x, q.v, q.m, self.faces,
+            self.offsets, self.cand, self.thickness_factor, self.method, self.alpha,
+            self.friction, dt, a_out, a_n, self.face_of, self.shares, self.force,
+            self.normal_force))
+        self.total_normal = float(self.normal_force.sum())
+
+    def columns(self, t: float) -> dict[str, float]:
+        return {f"F_{self.name}": self.total_normal, f"contacts_{self.name}": float(self.count)}
+
+    def state(self) -> tuple[dict, dict[str, np.ndarray]]:
+        return {}, {"offsets": self.offsets, "cand": self.cand, "xp_ref": self.xp_ref,
+                    "xn_ref": self.xn_ref}
+
+    def restore(self, scalars: dict, arrays: dict) -> None:
+        self.offsets = arrays["offsets"].copy()
+        self.cand = arrays["cand"].copy()
+        self.xp_ref = arrays["xp_ref"].copy()
+        self.xn_ref = arrays["xn_ref"].copy()
