@@ -71,6 +71,7 @@ def _mesh_vtu(vtk_dir: Path, name: str, index: int) -> Path:
 
 
 def _write_mesh_vtus(vtk_dir: Path, index: int, meshes: dict[str, MeshFrame]) -> None:
+    """Write ``vtk_dir/<name>/frame_<index>.vtu`` for every mesh block."""
     for name, m in meshes.items():
         write_mesh_vtu(_mesh_vtu(vtk_dir, name, index), m.points, m.cells, m.kind,
                        m.point_data, m.cell_data)
@@ -176,9 +177,9 @@ class FrameWriter:
         for f in (self.frames_dir / _frame_name(index, ".h5"),
                   self.vtk_dir / _frame_name(index, ".vtu")):
             f.unlink(missing_ok=True)
-        mesh_dirs = [d for d in self.vtk_dir.iterdir() if d.is_dir()] \
-            if self.vtk_dir.is_dir() else []
-        for d in mesh_dirs:
+        if not self.vtk_dir.is_dir():
+            return
+        for d in [d for d in self.vtk_dir.iterdir() if d.is_dir()]:  # mesh blocks
             (d / _frame_name(index, ".vtu")).unlink(missing_ok=True)
             if not any(d.iterdir()):
                 d.rmdir()  # the mesh has no frame left
