@@ -2,13 +2,21 @@
 
 Layout of an output directory::
 
-    outdir/frames/frame_00000.h5   native frames (always), see sphdyn.io.hdf5
-    outdir/vtk/frame_00000.vtu     ParaView frames (if vtk=True)
-    outdir/particles.pvd           ParaView time series of the .vtu files
+    outdir/frames/frame_00000.h5        native frames (always), see sphdyn.io.hdf5
+    outdir/vtk/frame_00000.vtu          ParaView particle frames (if vtk=True)
+    outdir/vtk/<mesh>/frame_00000.vtu   ParaView frames of each mesh block
+    outdir/particles.pvd                ParaView time series of the .vtu files
 
 Every file is written atomically. The ``.pvd`` is rewritten after each frame,
 so it always lists exactly the complete ``.vtu`` files. Runs made without VTK
 output can be converted afterwards with :func:`export_vtk`.
+
+Frames may carry finite-element mesh blocks beside the particles
+(:class:`~sphdyn.io.meshes.MeshFrame`, by name). The ``.pvd`` then lists, at
+every time step, the particles (part 0, name ``"particles"``) and each mesh
+(parts 1, 2, ... in order of first appearance, named after the mesh), which
+ParaView shows as one multiblock time series. A run without meshes writes
+exactly the single-block files it always did.
 """
 
 from __future__ import annotations
@@ -21,8 +29,10 @@ from pathlib import Path
 import numpy as np
 
 from .atomic import atomic_write_text
-from .hdf5 import read_frame, read_frame_header, write_frame
-from .vtk import write_pvd, write_vtu
+from .hdf5 import (read_frame, read_frame_header, read_frame_mesh_names,
+                   read_frame_meshes, write_frame)
+from .meshes import PARTICLES_BLOCK, MeshFrame
+from .vtk import PvdDataSet, write_mesh_vtu, write_pvd, write_vtu
 
 __all__ = ["FrameWriter", "list_frames", "export_vtk", "export_csv"]
 
@@ -55,6 +65,42 @@ def _frame_index(path: Path) -> int:
     return int(m.group(1))
 
 
+def _mesh_vtu(vtk_dir: Path, name: str, index: int) -> Path:
+    """The ``.vtu`` file of mesh ``name`` in frame ``index``."""
+    return vtk_dir / name / _frame_name(index, ".vtu")
+
+
+def _write_mesh_vtus(vtk_dir: Path, index: int, meshes: dict[str, MeshFrame]) -> None:
+    """Write ``vtk_dir/<name>/frame_<index>.vtu`` for every mesh block."""
+    for name, m in meshes.items():
+        write_mesh_vtu(_mesh_vtu(vtk_dir, name, index), m.points, m.cells, m.kind,
+                       m.point_data, m.cell_data)
+
+
+def _pvd_entries(vtk_dir: Path, frames: list[tuple[float, int, tuple[str, ...]]]
+                 ) -> list[tuple[float, str] | PvdDataSet]:
+    """``.pvd`` entries of the frames' ``.vtu`` files that exist.
+
+    ``frames`` holds ``(time [s], index, mesh names)`` per frame. Without any
+    mesh the entries are single-block ``(time, file)`` pairs; otherwise each
+    time step lists the particles (part 0) and its meshes, a mesh keeping the
+    part number of its first appearance.
+    """
+    multi = any(names for _, _, names in frames)
+    parts = {PARTICLES_BLOCK: 0}
+    entries: list[tuple[float, str] | PvdDataSet] = []
+    for t, index, names in frames:
+        blocks = [(PARTICLES_BLOCK, vtk_dir / _frame_name(index, ".vtu"))]
+        blocks += [(name, _mesh_vtu(vtk_dir, name, index)) for name in names]
+        for name, vtu in blocks:
+            part = parts.setdefault(name, len(parts))
+            if not vtu.exists():
+                continue
+            file = vtu.relative_to(vtk_dir.parent).as_posix()
+            entries.append(PvdDataSet(t, file, part, name) if multi else (t, file))
+    return entries
+
+
 def _split_position(fields: dict[str, np.ndarray]
                     ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     if "position" not in fields:
@@ -70,12 +116,13 @@ class FrameWriter:
     outdir : str or os.PathLike
         Output directory (created if needed).
     vtk : bool, optional
-        Also write ``vtk/frame_*.vtu`` and keep ``particles.pvd`` up to date.
+        Also write ``vtk/frame_*.vtu`` (and ``vtk/<mesh>/frame_*.vtu`` for
+        frames with meshes) and keep ``particles.pvd`` up to date.
     start_after : float, optional
         Restart time [s]. Frames with ``time <= start_after`` are kept and
         numbering continues after the last of them; frames with a later time
         belong to the abandoned part of the previous run and are deleted
-        (``.h5`` and ``.vtu``) and dropped from the ``.pvd``.
+        (``.h5`` and every ``.vtu``) and dropped from the ``.pvd``.
     overwrite : bool, optional
         Fresh run (``start_after=None``) over a directory that already holds
         frames: if True (default) they are deleted, as the new run replaces
@@ -115,6 +162,10 @@ class FrameWriter:
                 dropped.append(_frame_index(f))
         self._times = [t for t, _ in kept]
         self._indices = [i for _, i in kept]
+        # Mesh block names of every frame, for the .pvd.
+        self._mesh_names = [tuple(read_frame_mesh_names(self.frames_dir /
+                                                        _frame_name(i, ".h5")))
+                            for _, i in kept]
         self.next_index = self._indices[-1] + 1 if kept else 0
         # The .pvd stops listing the dropped frames before they are deleted.
         if vtk or self.pvd_path.exists():
@@ -126,16 +177,19 @@ class FrameWriter:
         for f in (self.frames_dir / _frame_name(index, ".h5"),
                   self.vtk_dir / _frame_name(index, ".vtu")):
             f.unlink(missing_ok=True)
+        if not self.vtk_dir.is_dir():
+            return
+        for d in [d for d in self.vtk_dir.iterdir() if d.is_dir()]:  # mesh blocks
+            (d / _frame_name(index, ".vtu")).unlink(missing_ok=True)
+            if not any(d.iterdir()):
+                d.rmdir()  # the mesh has no frame left
 
     def _write_pvd(self) -> None:
-        entries = []
-        for t, i in zip(self._times, self._indices):
-            vtu = self.vtk_dir / _frame_name(i, ".vtu")
-            if vtu.exists():
-                entries.append((t, f"{VTK_DIR}/{vtu.name}"))
-        write_pvd(self.pvd_path, entries)
+        frames = list(zip(self._times, self._indices, self._mesh_names))
+        write_pvd(self.pvd_path, _pvd_entries(self.vtk_dir, frames))
 
-    def write(self, t: float, step: int, fields: dict[str, np.ndarray]) -> int:
+    def write(self, t: float, step: int, fields: dict[str, np.ndarray],
+              meshes: dict[str, MeshFrame] | None = None) -> int:
         """Write one frame; returns its index.
 
         Parameters
@@ -147,6 +201,13 @@ class FrameWriter:
         fields : dict of str to ndarray
             Output fields (see :func:`sphdyn.io.fields.particle_fields`);
             ``"position"`` is required when writing VTK.
+        meshes : dict of str to MeshFrame, optional
+            Finite-element blocks of the frame by name (letters, digits,
+            ``_ . -``; not ``"particles"``), written into the ``.h5`` frame
+            and, with VTK output, as ``vtk/<name>/frame_<index>.vtu`` listed
+            in the ``.pvd`` beside the particles. ParaView fixes the blocks of
+            the series at the first time step: give the same meshes in every
+            frame.
 
         Returns
         -------
@@ -158,12 +219,16 @@ class FrameWriter:
                              f"time {self._times[-1]}")
         if self.vtk:
             x, point_data = _split_position(fields)
+        meshes = dict(meshes or {})
         index = self.next_index
-        write_frame(self.frames_dir / _frame_name(index, ".h5"), t, step, fields)
+        write_frame(self.frames_dir / _frame_name(index, ".h5"), t, step, fields,
+                    meshes=meshes)
         if self.vtk:
             write_vtu(self.vtk_dir / _frame_name(index, ".vtu"), x, point_data)
+            _write_mesh_vtus(self.vtk_dir, index, meshes)
         self._times.append(float(t))
         self._indices.append(index)
+        self._mesh_names.append(tuple(meshes))
         self.next_index = index + 1
         if self.vtk:
             self._write_pvd()
@@ -185,7 +250,8 @@ class FrameWriter:
 
 
 def export_vtk(outdir: str | os.PathLike) -> Path:
-    """(Re)generate ``vtk/*.vtu`` and ``particles.pvd`` from the native frames.
+    """(Re)generate ``vtk/*.vtu``, the mesh blocks' ``vtk/<mesh>/*.vtu`` and
+    ``particles.pvd`` from the native frames.
 
     Returns
     -------
@@ -193,14 +259,17 @@ def export_vtk(outdir: str | os.PathLike) -> Path:
         The ``.pvd`` file written.
     """
     outdir = Path(outdir)
-    entries = []
+    vtk_dir = outdir / VTK_DIR
+    frames = []
     for f in list_frames(outdir):
+        index = _frame_index(f)
         t, _, fields, _ = read_frame(f)
         x, point_data = _split_position(fields)
-        vtu = outdir / VTK_DIR / f.with_suffix(".vtu").name
-        write_vtu(vtu, x, point_data)
-        entries.append((t, f"{VTK_DIR}/{vtu.name}"))
-    return write_pvd(outdir / PVD_NAME, entries)
+        write_vtu(vtk_dir / _frame_name(index, ".vtu"), x, point_data)
+        meshes = read_frame_meshes(f)
+        _write_mesh_vtus(vtk_dir, index, meshes)
+        frames.append((t, index, tuple(meshes)))
+    return write_pvd(outdir / PVD_NAME, _pvd_entries(vtk_dir, frames))
 
 
 _TENSOR_SUFFIXES = ("xx", "xy", "xz", "yx", "yy", "yz", "zx", "zy", "zz")

@@ -4,6 +4,13 @@ Frame file layout (``write_frame``)::
 
     /                attrs: sphdyn_format="frame", format_version, time, step, <attrs>
     /<field name>    one dataset per field, dtype and shape as given
+    /meshes/<name>   optional mesh blocks (see sphdyn.io.meshes), each with
+                     attrs: kind ("hex8", "quad4", "line2")
+                     points (N, 3), cells (E, nen), point_data/<f>, cell_data/<f>
+
+A frame without meshes has no ``meshes`` group (the layout of particle-only
+frames is unchanged); every frame holds its own connectivity, so a frame file
+is readable alone.
 
 Checkpoint file layout (``write_checkpoint``)::
 
@@ -27,14 +34,17 @@ import h5py
 import numpy as np
 
 from .atomic import atomic_path
+from .meshes import MeshFrame, check_mesh_name
 
 __all__ = [
-    "write_frame", "read_frame", "read_frame_header",
+    "write_frame", "read_frame", "read_frame_header", "read_frame_meshes",
+    "read_frame_mesh_names",
     "write_checkpoint", "read_checkpoint",
 ]
 
 FORMAT_VERSION = 1
 _RESERVED_FRAME_ATTRS = ("sphdyn_format", "format_version", "time", "step")
+MESHES_GROUP = "meshes"
 
 
 def _check_name(name: str, what: str) -> None:
@@ -64,10 +74,30 @@ def _check_format(f: h5py.File, expected: str, path: Path) -> None:
 
 # --------------------------------------------------------------------------- frames
 
+def _write_mesh(group: h5py.Group, mesh: MeshFrame) -> None:
+    """Store one mesh block in ``group`` (see the module docstring)."""
+    group.attrs["kind"] = mesh.kind
+    group.create_dataset("points", data=mesh.points)
+    group.create_dataset("cells", data=mesh.cells)
+    for sub, data in (("point_data", mesh.point_data), ("cell_data", mesh.cell_data)):
+        g = group.create_group(sub, track_order=True)
+        for name, arr in data.items():
+            g.create_dataset(name, data=arr)
+
+
+def _read_mesh(group: h5py.Group) -> MeshFrame:
+    """Inverse of :func:`_write_mesh`."""
+    return MeshFrame(points=group["points"][()], cells=group["cells"][()],
+                     kind=_to_python(group.attrs["kind"]),
+                     point_data={k: v[()] for k, v in group["point_data"].items()},
+                     cell_data={k: v[()] for k, v in group["cell_data"].items()})
+
+
 def write_frame(path: str | os.PathLike, t: float, step: int,
                 fields: dict[str, np.ndarray],
-                attrs: dict[str, Any] | None = None) -> Path:
-    """Write one particle frame to its own HDF5 file (atomically).
+                attrs: dict[str, Any] | None = None,
+                meshes: dict[str, MeshFrame] | None = None) -> Path:
+    """Write one frame (particles, optional mesh blocks) to its own HDF5 file (atomically).
 
     Parameters
     ----------
@@ -83,6 +113,10 @@ def write_frame(path: str | os.PathLike, t: float, step: int,
         Extra root attributes (numbers, strings, small arrays). The names
         ``time``, ``step``, ``sphdyn_format`` and ``format_version`` are
         reserved.
+    meshes : dict of str to MeshFrame, optional
+        Mesh blocks by name (:func:`sphdyn.io.meshes.check_mesh_name`),
+        written under ``/meshes/<name>`` in the order given; none (or an
+        empty dict) writes no ``meshes`` group.
 
     Returns
     -------
@@ -95,6 +129,13 @@ def write_frame(path: str | os.PathLike, t: float, step: int,
         raise ValueError(f"reserved frame attribute names: {clash}")
     for name in fields:
         _check_name(name, "field")
+    meshes = dict(meshes or {})
+    if meshes and MESHES_GROUP in fields:
+        raise ValueError(f"a frame with meshes cannot have a field named {MESHES_GROUP!r}")
+    for name, mesh in meshes.items():
+        check_mesh_name(name)
+        if not isinstance(mesh, MeshFrame):
+            raise TypeError(f"mesh {name!r} must be a MeshFrame, got {type(mesh).__name__}")
     path = Path(path)
     with atomic_path(path) as tmp:
         with h5py.File(tmp, "w", track_order=True) as f:
@@ -106,6 +147,10 @@ def write_frame(path: str | os.PathLike, t: float, step: int,
                 f.attrs[key] = value
             for name, data in fields.items():
                 f.create_dataset(name, data=np.asarray(data))
+            if meshes:
+                g_meshes = f.create_group(MESHES_GROUP, track_order=True)
+                for name, mesh in meshes.items():
+                    _write_mesh(g_meshes.create_group(name, track_order=True), mesh)
     return path
 
 
@@ -140,7 +185,8 @@ def read_frame(path: str | os.PathLike
     step : int
         Time-step number.
     fields : dict of str to ndarray
-        The datasets, in the order they were written.
+        The datasets, in the order they were written (mesh blocks are not
+        among them: see :func:`read_frame_meshes`).
     attrs : dict
         The extra attributes given to :func:`write_frame`.
     """
@@ -151,6 +197,33 @@ def read_frame(path: str | os.PathLike
         fields = {name: ds[()] for name, ds in f.items()
                   if isinstance(ds, h5py.Dataset)}
     return t, step, fields, attrs
+
+
+def read_frame_mesh_names(path: str | os.PathLike) -> list[str]:
+    """Names of the mesh blocks of a frame file, in the order written ([] if none)."""
+    path = Path(path)
+    with h5py.File(path, "r") as f:
+        _check_format(f, "frame", path)
+        group = f.get(MESHES_GROUP)
+        return list(group.keys()) if isinstance(group, h5py.Group) else []
+
+
+def read_frame_meshes(path: str | os.PathLike) -> dict[str, MeshFrame]:
+    """Read the mesh blocks of a frame written by :func:`write_frame`.
+
+    Returns
+    -------
+    dict of str to MeshFrame
+        The blocks by name, in the order written; empty for a particle-only
+        frame. Arrays have the dtypes and shapes given to :func:`write_frame`.
+    """
+    path = Path(path)
+    with h5py.File(path, "r") as f:
+        _check_format(f, "frame", path)
+        group = f.get(MESHES_GROUP)
+        if not isinstance(group, h5py.Group):
+            return {}
+        return {name: _read_mesh(g) for name, g in group.items()}
 
 
 # ---------------------------------------------------------------------- checkpoints
