@@ -17,7 +17,8 @@ Numba kernels of :mod:`.solid` read the tables.
   d\boldsymbol\xi` (exact with 2x2x2 Gauss points). C is fully antisymmetric
   with 144 non-zero entries of :math:`\pm 1/12`, so
   :math:`\partial V/\partial x_I = \sum_{JK} C_{IJK}\, y_J z_K` (and cyclic for
-  y, z) is 18 products per node: the "uniform strain" gradient of Flanagan &
+  y, z) is 18 terms per node, 6 products when grouped by J: the "uniform
+  strain" gradient of Flanagan &
   Belytschko (1981, IJNME 17, eq. 79), :math:`b_{iI} = \frac1V \partial V/\partial
   x_{iI}`, exact for any hexahedron, with
   :math:`V = \tfrac13 \sum_I \mathbf x_I\cdot \partial V/\partial\mathbf x_I`
@@ -94,24 +95,40 @@ def volume_coefficients(dim: int) -> np.ndarray:
 def volume_table(dim: int) -> np.ndarray:
     r"""Sparse form of :func:`volume_coefficients` for the kernels.
 
-    dim 3: int64 (8, 18, 3) rows ``(J, K, sign)`` with
-    :math:`\partial V/\partial x_I = \tfrac1{12} \sum_k s_k\, y_{J_k} z_{K_k}`,
-    :math:`\partial V/\partial y_I = \tfrac1{12} \sum_k s_k\, z_{J_k} x_{K_k}`,
-    :math:`\partial V/\partial z_I = \tfrac1{12} \sum_k s_k\, x_{J_k} y_{K_k}`.
+    dim 3: int64 (8, 6, 5) rows ``(J, P1, P2, M1, M2)``: the 18 terms of
+    :math:`\partial V/\partial x_I` grouped by J (six per node, each with two
+    or four K of balanced signs), so that
+
+    .. math:: \partial V/\partial x_I = \tfrac1{12} \sum_J y_J\,
+              (z_{P1} + z_{P2} - z_{M1} - z_{M2})
+
+    and cyclically :math:`\partial V/\partial y_I` with :math:`z_J (x_P - x_M)`,
+    :math:`\partial V/\partial z_I` with :math:`x_J (y_P - y_M)`: 18 products
+    per node instead of 54. A missing second pair points at row 8, a row of
+    zeros the kernels keep after the eight nodes.
     dim 2: int64 (4, 2, 2) rows ``(J, sign)`` with
     :math:`\partial A/\partial x_I = \tfrac12 \sum_k s_k y_{J_k}`,
     :math:`\partial A/\partial y_I = -\tfrac12 \sum_k s_k x_{J_k}`.
     """
     C = volume_coefficients(dim)
     nen = 2 ** dim
-    scale = 12.0 if dim == 3 else 2.0
-    rows = []
+    if dim == 2:
+        rows = [[[j, int(round(2.0 * C[i, j]))] for j in np.flatnonzero(C[i])]
+                for i in range(nen)]
+        return np.array(rows, dtype=np.int64)
+    table = np.full((nen, 6, 5), nen, dtype=np.int64)  # nen: the zero row
     for i in range(nen):
-        nz = np.argwhere(C[i] != 0.0)
-        rows.append([list(jk) + [int(round(C[(i, *jk)] * scale))] for jk in nz])
-    width = {len(r) for r in rows}
-    assert len(width) == 1, "every node has the same number of terms"
-    return np.array(rows, dtype=np.int64)
+        js = sorted({int(j) for j, _ in np.argwhere(C[i] != 0.0)})
+        assert len(js) == 6, "six neighbours J per node"
+        for g, j in enumerate(js):
+            ks = np.flatnonzero(C[i, j])
+            plus = [int(k) for k in ks if C[i, j, k] > 0]
+            minus = [int(k) for k in ks if C[i, j, k] < 0]
+            assert len(plus) == len(minus) and np.allclose(np.abs(C[i, j, ks]), 1 / 12)
+            table[i, g, 0] = j
+            table[i, g, 1:1 + len(plus)] = plus
+            table[i, g, 3:3 + len(minus)] = minus
+    return table
 
 
 @functools.cache
