@@ -210,6 +210,17 @@ def test_cli_bench_prints_one_json_line(capsys):
     assert rec["steps"] == 5 and rec["particles"] == 1000
 
 
+def test_cli_bench_hex3d(capsys):
+    """The hex8 benchmark: 10^3 elements (11^3 nodes), its own keys; --elements
+    is refused for a particle case."""
+    assert main(["bench", "hex3d", "--elements", "1000", "--steps", "5"]) == 0
+    rec = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert rec["elements"] == 1000 and rec["nodes"] == 1331 and rec["steps"] == 5
+    assert rec["element_steps_per_s"] > 0 and rec["bytes_per_element"] > 0
+    assert main(["bench", "block3d", "--elements", "1000"]) == 2
+    assert "--elements" in capsys.readouterr().err
+
+
 EXAMPLES = sorted(Path(__file__).parent.parent.glob("examples/*.toml"))
 
 
