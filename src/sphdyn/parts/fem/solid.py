@@ -70,6 +70,8 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from .hex_gradient import hex_volume_gradient
+
 HG_VISCOUS = 0
 HG_STIFFNESS = 1
 
@@ -93,36 +95,20 @@ def local_coordinates(x, v, s, conn, e, xl):
 def volume_gradient(xl, dim, tab, g):
     r"""Volume derivatives :math:`\partial V/\partial x_{iI}` (nen, 3) into ``g``; returns V.
 
-    ``xl`` (nen + 1, 3) node coordinates and a last row of zeros (the
-    table's padding); ``tab`` the table of :func:`.shapes.volume_table`. 3D:
+    ``xl`` (nen, 3) node coordinates (rows beyond nen are ignored); ``tab``
+    the table of :func:`.shapes.volume_table`. 3D:
     :math:`\partial V/\partial x_I = \tfrac1{12}\sum_J y_J (z_{P1} + z_{P2} -
-    z_{M1} - z_{M2})` (cyclic), :math:`V = \tfrac13\sum_I \mathbf x_I
+    z_{M1} - z_{M2})` (cyclic), unrolled in :mod:`.hex_gradient` (generated
+    from the table by ``tools/gen_hex_gradient.py``), :math:`V = \tfrac13\sum_I \mathbf x_I
     \cdot \partial V/\partial \mathbf x_I`; 2D: :math:`\partial A/\partial x_I =
     \tfrac12 \sum s\, y_J`, :math:`\partial A/\partial y_I = -\tfrac12\sum s\, x_J`,
     :math:`A = \tfrac12 \sum_I \mathbf x_I\cdot\partial A/\partial\mathbf x_I`
     (area per unit depth; ``g[:, 2] = 0``).
     """
+    if dim == 3:
+        return hex_volume_gradient(xl, g)  # the table's expressions, unrolled
     nen = tab.shape[0]
     vol = 0.0
-    if dim == 3:
-        for I in range(nen):
-            sx = 0.0
-            sy = 0.0
-            sz = 0.0
-            for k in range(6):
-                J = tab[I, k, 0]
-                p1 = tab[I, k, 1]
-                p2 = tab[I, k, 2]
-                m1 = tab[I, k, 3]
-                m2 = tab[I, k, 4]
-                sx += xl[J, 1] * (xl[p1, 2] + xl[p2, 2] - xl[m1, 2] - xl[m2, 2])
-                sy += xl[J, 2] * (xl[p1, 0] + xl[p2, 0] - xl[m1, 0] - xl[m2, 0])
-                sz += xl[J, 0] * (xl[p1, 1] + xl[p2, 1] - xl[m1, 1] - xl[m2, 1])
-            g[I, 0] = sx / 12.0
-            g[I, 1] = sy / 12.0
-            g[I, 2] = sz / 12.0
-            vol += xl[I, 0] * g[I, 0] + xl[I, 1] * g[I, 1] + xl[I, 2] * g[I, 2]
-        return vol / 3.0
     for I in range(nen):
         sx = 0.0
         sy = 0.0

@@ -107,8 +107,7 @@ class SolidPart:
         self.ngp = self.dN.shape[0] if self.reduced else 1
         self.hg_form = HOURGLASS_FORMS[settings.hourglass]
         nen = elements.nen
-        # xl: node coordinates plus a row of zeros (the volume table's padding)
-        for name_, tail in (("xl", (nen + 1, 3)), ("g", (nen, 3)), ("fe", (nen, 3))):
+        for name_, tail in (("xl", (nen, 3)), ("g", (nen, 3)), ("fe", (nen, 3))):
             elements.add(name_, tail)
         ne = elements.n
         n_hist = max([len(m.history_names) for m, _ in materials.values()] + [0])
