@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from fem_models import block, material, part
-from sphdyn.parts.fem.shapes import (corner_signs, gauss_derivatives, hourglass_vectors,
+from sphdyn.geometry.shapes import (corner_signs, gauss_derivatives, hourglass_vectors,
                                      volume_table)
 from sphdyn.parts.fem.solid import volume_gradient
 from sphdyn.state import BC_VELOCITY

@@ -1,6 +1,6 @@
 """Write src/sphdyn/parts/fem/hex_gradient.py: the hex8 volume derivatives unrolled.
 
-The expressions come from :func:`sphdyn.parts.fem.shapes.volume_table` (the
+The expressions come from :func:`sphdyn.geometry.shapes.volume_table` (the
 cubic volume form grouped by node pairs); the generated function reads the
 24 coordinates into scalars once, so the compiled code keeps them in
 registers. Run after changing the table::
@@ -10,7 +10,7 @@ registers. Run after changing the table::
 
 from pathlib import Path
 
-from sphdyn.parts.fem.shapes import volume_table
+from sphdyn.geometry.shapes import volume_table
 
 OUT = Path(__file__).resolve().parents[1] / "src/sphdyn/parts/fem/hex_gradient.py"
 

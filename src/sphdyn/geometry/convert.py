@@ -27,7 +27,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .mesh import _CORNERS, MESH_KINDS, _shape_gradients
+from .mesh import MESH_KINDS
+from .shapes import gauss_derivatives, gauss_points, shape_functions
 
 __all__ = ["element_centroids", "elements_to_particles"]
 
@@ -54,9 +55,8 @@ def element_centroids(points, cells, kind: str) -> tuple[np.ndarray, np.ndarray]
     if kind not in ("hex8", "quad4"):
         raise ValueError(f"elements_to_particles needs hex8 or quad4 elements, got {kind!r}")
     d = MESH_KINDS[kind][1]
-    xg = _CORNERS[kind] / np.sqrt(3.0)                      # (G, d) Gauss points
-    N = np.prod(1.0 + _CORNERS[kind][None, :, :] * xg[:, None, :], axis=2) / 2.0**d  # (G, nen)
-    dN = _shape_gradients(kind, xg)                         # (G, nen, d)
+    N = shape_functions(d, gauss_points(d))                 # (G, nen)
+    dN = gauss_derivatives(d)                               # (G, nen, d)
     x = np.asarray(points, dtype=np.float64)[np.asarray(cells, dtype=np.int64)]  # (E, nen, 3)
     jac = np.einsum("eai,gaj->egij", x[:, :, :d], dN)       # (E, G, d, d)
     det = np.linalg.det(jac)                                # (E, G)

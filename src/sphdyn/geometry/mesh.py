@@ -34,6 +34,7 @@ import meshio
 import numpy as np
 
 from .lattice import _check_dim, _point
+from .shapes import corner_signs, shape_derivatives
 
 __all__ = [
     "MESH_KINDS",
@@ -51,18 +52,12 @@ MESH_KINDS = {"hex8": (8, 3), "quad4": (4, 2), "line2": (2, 1)}
 # kinds a mesh of spatial dimension dim may hold
 _KINDS_IN = {2: ("quad4", "line2"), 3: ("hex8", "line2")}
 # meshio cell type <-> kind
-_FROM_MESHIO = {"hexahedron": "hex8", "quad": "quad4", "line": "line2"}
-_TO_MESHIO = {v: k for k, v in _FROM_MESHIO.items()}
+#: element kind <-> meshio cell type (= the VTK cell: hexahedron 12, quad 9, line 3)
+TO_MESHIO = {"hex8": "hexahedron", "quad4": "quad", "line2": "line"}
+_FROM_MESHIO = {v: k for k, v in TO_MESHIO.items()}
 # file extension -> (meshio format, label, reader)
 _FORMATS = {".msh": ("gmsh", "Gmsh", meshio.gmsh.read),
             ".inp": ("abaqus", "Abaqus", meshio.abaqus.read)}
-
-# Natural coordinates of the corner nodes, in node order.
-_CORNERS = {
-    "hex8": np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
-                      [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], dtype=np.float64),
-    "quad4": np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], dtype=np.float64),
-}
 
 # Thresholds of check_elements (relative, see its docstring).
 _DEGENERATE_RTOL = 1e-6
@@ -186,23 +181,6 @@ class MeshData:
 # --------------------------------------------------------------------------
 # Jacobians and element checks
 # --------------------------------------------------------------------------
-def _shape_gradients(kind: str, xi: np.ndarray) -> np.ndarray:
-    """Derivatives dN_a/dxi_j of the (tri/bi)linear shape functions.
-
-    ``N_a(xi) = prod_j (1 + xi_a,j xi_j) / 2**d`` with ``xi_a`` the corner
-    coordinates of node ``a`` (Hughes 2000, sec. 3.5). ``xi`` (P, d) ->
-    (P, nen, d).
-    """
-    c = _CORNERS[kind]                                  # (nen, d)
-    f = 1.0 + c[None, :, :] * xi[:, None, :]            # (P, nen, d) factors
-    d = c.shape[1]
-    out = np.empty(f.shape)
-    for j in range(d):
-        others = np.prod(np.delete(f, j, axis=2), axis=2)
-        out[:, :, j] = c[None, :, j] * others
-    return out / 2.0**d
-
-
 def element_jacobians(points, cells, kind: str) -> np.ndarray:
     """Jacobian determinant of each element at each of its corner nodes.
 
@@ -236,7 +214,7 @@ def element_jacobians(points, cells, kind: str) -> np.ndarray:
         length = np.linalg.norm(x[:, 1] - x[:, 0], axis=1)
         return np.repeat(length[:, None], 2, axis=1)
     d = MESH_KINDS[kind][1]
-    grad = _shape_gradients(kind, _CORNERS[kind])       # (corner p, node a, j)
+    grad = shape_derivatives(d, corner_signs(d))         # (corner p, node a, j)
     jac = np.einsum("eai,paj->epij", x[:, :, :d], grad)  # (E, nen, d, d)
     return np.linalg.det(jac)
 
@@ -352,7 +330,7 @@ def block_mesh(lo, hi, divisions, dim: int) -> MeshData:
     node = np.arange(points.shape[0], dtype=np.int64).reshape([m + 1 for m in n])
     kind = "hex8" if dim == 3 else "quad4"
     # grid offsets of the corners in node order = the corner natural coordinates
-    offsets = ((_CORNERS[kind] + 1) / 2).astype(np.int64)
+    offsets = ((corner_signs(dim) + 1) / 2).astype(np.int64)
     cells = np.stack([node[tuple(slice(o[a], o[a] + n[a]) for a in range(dim))].reshape(-1)
                       for o in offsets], axis=1)
     node_sets = {"all": node.reshape(-1)}
@@ -520,7 +498,7 @@ def _holdings(raw) -> str:
 
 def _choose_kind(raw, dim: int, kind, label: str) -> str:
     allowed = _KINDS_IN[dim]
-    supported = ", ".join(f"{_TO_MESHIO[k]} ({k})" for k in allowed)
+    supported = ", ".join(f"{TO_MESHIO[k]} ({k})" for k in allowed)
     present = {}
     for b in raw.cells:
         k = _FROM_MESHIO.get(b.type)
@@ -531,7 +509,7 @@ def _choose_kind(raw, dim: int, kind, label: str) -> str:
             raise ValueError(f"{label}: kind must be one of {list(allowed)} in {dim}D, "
                              f"got {kind!r}")
         if kind not in present:
-            raise ValueError(f"{label}: no {_TO_MESHIO[kind]} ({kind}) elements; the file holds "
+            raise ValueError(f"{label}: no {TO_MESHIO[kind]} ({kind}) elements; the file holds "
                              f"{_holdings(raw)}")
         return kind
     if not present:

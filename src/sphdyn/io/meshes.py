@@ -23,14 +23,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..geometry.mesh import MESH_KINDS as GEOMETRY_KINDS
+from ..geometry.mesh import TO_MESHIO
+
 __all__ = ["MeshFrame", "MESH_KINDS", "check_mesh_name"]
 
-#: Element kind -> (nodes per element, meshio cell type = VTK cell).
-MESH_KINDS: dict[str, tuple[int, str]] = {
-    "hex8": (8, "hexahedron"),  # VTK_HEXAHEDRON (12)
-    "quad4": (4, "quad"),       # VTK_QUAD (9)
-    "line2": (2, "line"),       # VTK_LINE (3)
-}
+#: Element kind -> (nodes per element, meshio cell type = VTK cell), from the
+#: mesh module's tables
+MESH_KINDS: dict[str, tuple[int, str]] = {k: (nen, TO_MESHIO[k])
+                                          for k, (nen, _) in GEOMETRY_KINDS.items()}
 
 #: Block name of the particles in a ``.pvd`` collection; no mesh may use it.
 PARTICLES_BLOCK = "particles"

@@ -14,7 +14,7 @@ zero (Belytschko, Liu & Moran 2000, sec. 6.2.2, mid-step configuration).
 
 **One-point integration** (Flanagan & Belytschko 1981, IJNME 17, 679-706):
 with the uniform gradient :math:`b_{iI} = \frac1V \partial V/\partial x_{iI}`
-(:mod:`.shapes`),
+(:mod:`sphdyn.geometry.shapes`),
 
 .. math:: L_{ij} = \sum_I v_{iI}\, b_{jI}, \qquad
           f^{int}_{iI} = -V (\sigma_{ij} - q\,\delta_{ij})\, b_{jI},
@@ -96,7 +96,7 @@ def volume_gradient(xl, dim, tab, g):
     r"""Volume derivatives :math:`\partial V/\partial x_{iI}` (nen, 3) into ``g``; returns V.
 
     ``xl`` (nen, 3) node coordinates (rows beyond nen are ignored); ``tab``
-    the table of :func:`.shapes.volume_table`. 3D:
+    the table of :func:`sphdyn.geometry.shapes.volume_table`. 3D:
     :math:`\partial V/\partial x_I = \tfrac1{12}\sum_J y_J (z_{P1} + z_{P2} -
     z_{M1} - z_{M2})` (cyclic), unrolled in :mod:`.hex_gradient` (generated
     from the table by ``tools/gen_hex_gradient.py``), :math:`V = \tfrac13\sum_I \mathbf x_I

@@ -21,11 +21,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...geometry.mesh import MESH_KINDS
+from ...geometry.shapes import gauss_derivatives, hourglass_vectors, volume_table
 from ...integrate import drift
 from ...materials.base import von_mises
 from ...state import Elements, MaterialPoints, Nodes
 from ..base import register_part
-from .shapes import SOLID_KINDS, gauss_derivatives, hourglass_vectors, volume_table
 from .solid import (HG_STIFFNESS, HG_VISCOUS, element_time_step, gather_forces,
                     node_element_list, reduced_forces, reduced_strain_rate,
                     uniform_forces, uniform_strain_rate)
@@ -96,7 +97,7 @@ class SolidPart:
         self.s = settings
         self.dim = nodes.dim
         kind = {8: "hex8", 4: "quad4"}.get(elements.nen)
-        if kind is None or SOLID_KINDS[kind][0] != self.dim:
+        if kind is None or MESH_KINDS[kind][1] != self.dim:
             raise ValueError(f"part {name!r}: {elements.nen}-node elements do not fit "
                              f"dimension {self.dim} (hex8 in 3D, quad4 in 2D)")
         self.element_kind = kind

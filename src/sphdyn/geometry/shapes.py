@@ -6,8 +6,10 @@ then the same four with :math:`\zeta = +1`; the quadrilateral is the first
 four with :math:`\zeta` dropped. Shape functions
 :math:`N_I = \prod_k (1 + \xi_k \xi_{kI}) / 2^d`.
 
-Everything here is computed once, in NumPy, from these definitions; the
-Numba kernels of :mod:`.solid` read the tables.
+Everything here is computed once, in NumPy, from these definitions: the
+mesh checks of :mod:`.mesh` and the centroids of :mod:`.convert` use the
+shape functions, the Numba kernels of :mod:`sphdyn.parts.fem.solid` read the
+tables.
 
 * :func:`volume_table`: the element volume of a trilinear hexahedron is a
   cubic form of the nodal coordinates,
@@ -46,24 +48,26 @@ HEX_SIGNS = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
                       [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], dtype=float)
 QUAD_SIGNS = HEX_SIGNS[:4, :2].copy()
 
-#: element kind -> (dimension, nodes per element)
-SOLID_KINDS = {"hex8": (3, 8), "quad4": (2, 4)}
-
-
 def corner_signs(dim: int) -> np.ndarray:
     """Corner signs (nen, dim) of the hexahedron (dim 3) or quadrilateral (dim 2)."""
     return HEX_SIGNS if dim == 3 else QUAD_SIGNS
 
 
-def shape_derivatives(dim: int, xi: np.ndarray) -> np.ndarray:
-    r""":math:`\partial N_I/\partial \xi_k` (nen, dim) at the point ``xi`` (dim,)."""
+def shape_functions(dim: int, xi: np.ndarray) -> np.ndarray:
+    r""":math:`N_I = \prod_k (1 + \xi_k \xi_{kI}) / 2^d` (P, nen) at the points ``xi`` (P, dim)."""
     s = corner_signs(dim)
-    f = 1.0 + s * xi  # (nen, dim)
-    out = np.empty_like(s)
+    return np.prod(1.0 + s[None, :, :] * np.atleast_2d(xi)[:, None, :], axis=2) / 2 ** dim
+
+
+def shape_derivatives(dim: int, xi: np.ndarray) -> np.ndarray:
+    r""":math:`\partial N_I/\partial \xi_k` (P, nen, dim) at the points ``xi`` (P, dim)
+    (Hughes, *The Finite Element Method*, 2000, sec. 3.5)."""
+    s = corner_signs(dim)
+    f = 1.0 + s[None, :, :] * np.atleast_2d(xi)[:, None, :]  # (P, nen, dim) factors
+    out = np.empty(f.shape)
     for k in range(dim):
-        others = np.prod(np.delete(f, k, axis=1), axis=1)
-        out[:, k] = s[:, k] * others / 2 ** dim
-    return out
+        out[:, :, k] = s[None, :, k] * np.prod(np.delete(f, k, axis=2), axis=2)
+    return out / 2 ** dim
 
 
 def gauss_points(dim: int) -> np.ndarray:
@@ -75,7 +79,7 @@ def gauss_points(dim: int) -> np.ndarray:
 @functools.cache
 def gauss_derivatives(dim: int) -> np.ndarray:
     r""":math:`\partial N_I/\partial \boldsymbol\xi` (ngp, nen, dim) at the Gauss points."""
-    return np.array([shape_derivatives(dim, p) for p in gauss_points(dim)])
+    return shape_derivatives(dim, gauss_points(dim))
 
 
 @functools.cache
