@@ -20,24 +20,9 @@ from .heterogeneity.variation import factor_of, quantise, standard_normal_field,
 from .initial import initial_fields
 from .interactions.wall import STIFFNESS, WallSpec
 from .preflight import checked_lattices
-from .materials import get_model
+from .materials import MaterialGroup, get_model
 from .probes import Probe, quantity
 from .state import BC_FIXED, BC_VELOCITY, Particles
-
-
-@dataclass
-class MaterialGroup:
-    """Particles sharing one material: the model's group kernel runs over ``idx``.
-
-    ``material`` is the index in the deck's ``[[material]]`` list (a material
-    with ``[material.variation]`` has one group per class).
-    """
-
-    name: str
-    model: object  # materials.base.MaterialModel
-    params: np.ndarray
-    idx: np.ndarray  # int64 particle indices
-    material: int = 0
 
 
 @dataclass

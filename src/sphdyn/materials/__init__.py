@@ -12,6 +12,7 @@ register through entry points (:mod:`sphdyn.materials.registry`).
 from .base import (
     KERNEL_SIGNATURE_DOC,
     REGISTRY,
+    MaterialGroup,
     MaterialModel,
     available_models,
     deviatoric_split,
@@ -30,6 +31,7 @@ __all__ = [
     "ENTRY_POINT_GROUP",
     "KERNEL_SIGNATURE_DOC",
     "REGISTRY",
+    "MaterialGroup",
     "MaterialModel",
     "available_models",
     "get_model",

@@ -35,7 +35,7 @@ import numpy as np
 from numba import njit
 
 from .registry import (N_COMMON, P_DENSITY, P_G, P_K, REGISTRY,  # noqa: F401
-                       MaterialModel, available_models, get_model, register)
+                       MaterialGroup, MaterialModel, available_models, get_model, register)
 
 KERNEL_SIGNATURE_DOC = """\
 update(idx, L, dt, rho, sig, e, c, damage, hist, params, size) -> None

@@ -40,6 +40,23 @@ N_COMMON = 3
 ENTRY_POINT_GROUP = "sphdyn.materials"
 
 
+@dataclass
+class MaterialGroup:
+    """Items sharing one material: the model's group kernel runs over ``idx``.
+
+    The items are particles (of an SPH part) or integration points (of a
+    finite-element part). ``material`` is the index in the deck's
+    ``[[material]]`` list (a material with ``[material.variation]`` has one
+    group per class).
+    """
+
+    name: str
+    model: "MaterialModel"
+    params: np.ndarray
+    idx: np.ndarray  # int64 item indices
+    material: int = 0
+
+
 @dataclass(frozen=True)
 class MaterialModel:
     """A registered constitutive model.

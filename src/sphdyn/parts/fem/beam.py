@@ -445,38 +445,18 @@ def truss_stable_dt(x, conn, c, scale):
 
 # ------------------------------------------------------------------- gather
 @njit(cache=True, error_model="numpy", parallel=True)
-def gather_loads(ptr, ent, fe, col, m, v, damping, a, power):
-    r"""Nodal accelerations from the element loads (gather, no races).
-
-    :math:`a_i = \sum_{e\ni i} f_{e,i}/m_i - c\,v_i` for the three columns
-    ``col:col+3`` of ``fe`` (E, 2, 6): 0 for the forces [N] with the masses
-    ``m`` [kg] and velocities ``v`` [m/s], 3 for the moments [N m] with the
-    rotary inertias [kg m^2] and angular velocities [rad/s] (isotropic
-    inertia: Euler's equations have no gyroscopic term). ``c`` is the
-    mass-proportional damping coefficient [1/s] (0: none) acting on the
-    half-step velocity; ``power`` (N,) in/out adds the damping power
-    :math:`c\, m_i |v_i|^2` [W]. ``ptr`` (N+1,), ``ent`` (2E,) the node ->
-    (2 element + end) CSR list; ``a`` (N, 3) out (zero where m = 0).
-    """
+def mass_damping(v, m, damping, a, power):
+    r"""Mass-proportional damping :math:`\mathbf a_i \mathrel{-}= c\,\mathbf v_i`
+    on the half-step velocities ``v`` (N, 3) and its power
+    :math:`c\, m_i |\mathbf v_i|^2` [W] added to ``power`` (N,); ``m`` (N,)
+    masses (or rotary inertias with angular velocities), ``c`` [1/s]; nothing
+    for a massless node (its ``a`` is zero)."""
     for i in prange(m.shape[0]):
-        f0 = 0.0
-        f1 = 0.0
-        f2 = 0.0
-        for k in range(ptr[i], ptr[i + 1]):
-            e = ent[k] // 2
-            s = ent[k] % 2
-            f0 += fe[e, s, col]
-            f1 += fe[e, s, col + 1]
-            f2 += fe[e, s, col + 2]
         if m[i] > 0.0:
-            a[i, 0] = f0 / m[i] - damping * v[i, 0]
-            a[i, 1] = f1 / m[i] - damping * v[i, 1]
-            a[i, 2] = f2 / m[i] - damping * v[i, 2]
-        else:
-            a[i, 0] = 0.0
-            a[i, 1] = 0.0
-            a[i, 2] = 0.0
-        power[i] += damping * m[i] * (v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2)
+            a[i, 0] -= damping * v[i, 0]
+            a[i, 1] -= damping * v[i, 1]
+            a[i, 2] -= damping * v[i, 2]
+            power[i] += damping * m[i] * (v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2)
 
 
 @njit(cache=True, error_model="numpy")

@@ -73,8 +73,9 @@ from ...state.store import STATE
 from ..base import register_part
 from .beam import (N_RES, RES_L, RES_MY_A, RES_MY_B, RES_MZ_A, RES_MZ_B, RES_N, RES_T,
                    RES_VY, RES_VZ, beam_forces, beam_stable_dt, drift_rotations,
-                   gather_loads, lateral_ratio, lateral_secant, ordered_sum,
+                   lateral_ratio, lateral_secant, mass_damping, ordered_sum,
                    truss_forces, truss_gradient, truss_kinematics, truss_stable_dt)
+from .gather import gather_loads, node_element_list
 
 
 @dataclass(frozen=True)
@@ -147,16 +148,6 @@ def element_frames(x: np.ndarray, conn: np.ndarray, orientation) -> np.ndarray:
     e2 /= n2[:, None]
     e3 = np.cross(e1, e2)
     return np.ascontiguousarray(np.stack([e1, e2, e3], axis=2))
-
-
-def node_element_csr(conn: np.ndarray, n_nodes: int) -> tuple[np.ndarray, np.ndarray]:
-    """Node -> element CSR list: ``ptr`` (N+1,), ``ent`` (2E,) holding
-    ``2 element + end`` (end 0: node a, 1: node b), in element order."""
-    flat = conn.reshape(-1)
-    order = np.argsort(flat, kind="stable")
-    ptr = np.zeros(n_nodes + 1, np.int64)
-    np.add.at(ptr, flat + 1, 1)
-    return np.cumsum(ptr), order.astype(np.int64)
 
 
 @register_part("line")
@@ -240,7 +231,7 @@ class LinePart:
         el.m = rho * A * L0
         np.add.at(kin.m, conn[:, 0], 0.5 * el.m)
         np.add.at(kin.m, conn[:, 1], 0.5 * el.m)
-        self.ptr, self.ent = node_element_csr(conn, n)
+        self.ptr, self.ent = node_element_list(conn, n)
         kin.add("damp_power", ())
         self.e_damp = 0.0  # energy dissipated by the damping [J]
         if self.beam:
@@ -393,12 +384,14 @@ class LinePart:
                 self._uniaxial_update(dt)
                 el.l_prev = self.points.l_now
             truss_forces(kin.x, el.conn, self.points.sig, self.section.area, el.fe, el.res)
-        kin.damp_power[:] = 0.0
-        gather_loads(self.ptr, self.ent, el.fe, 0, kin.m, kin.v, self.damping, kin.a,
-                     kin.damp_power)
+        gather_loads(el.fe, 0, self.ptr, self.ent, kin.m, kin.a)
         if self.beam:
-            gather_loads(self.ptr, self.ent, el.fe, 3, kin.rot.m, kin.rot.v, self.damping,
-                         kin.rot.a, kin.damp_power)
+            gather_loads(el.fe, 3, self.ptr, self.ent, kin.rot.m, kin.rot.a)
+        if self.damping > 0.0:
+            kin.damp_power[:] = 0.0
+            mass_damping(kin.v, kin.m, self.damping, kin.a, kin.damp_power)
+            if self.beam:
+                mass_damping(kin.rot.v, kin.rot.m, self.damping, kin.rot.a, kin.damp_power)
 
     def _uniaxial_update(self, dt: float) -> None:
         """Material update of the truss points under uniaxial stress (module docstring)."""

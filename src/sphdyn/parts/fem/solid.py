@@ -2,8 +2,8 @@ r"""Numba kernels of the solid elements: hex8 (3D) and quad4 (2D plane strain).
 
 One code path for both (``dim`` 3 or 2, ``nen`` 8 or 4). Element loops run in
 ``prange`` and write only their own element's rows (the element nodal forces
-``fe`` (E, nen, 3)); :func:`gather_forces` then sums them per node from the
-node-to-element list, so no two threads write the same memory.
+``fe`` (E, nen, 3)); :func:`.gather.gather_loads` then sums them per node
+from the node-to-element list, so no two threads write the same memory.
 
 **Kinematics.** Velocities are at :math:`n+\tfrac12`, positions at
 :math:`n+1`. The velocity gradient is evaluated on the mid-step geometry
@@ -398,32 +398,6 @@ def reduced_forces(conn, active, sig, L, rho, c, e_spec, e_av, g, vol, Bg, wg, q
                 fe[e, I, i] += q * g[e, I, i]
 
 
-@njit(cache=True, error_model="numpy", parallel=True)
-def gather_forces(fe, offsets, slots, m, a):
-    r"""Node accelerations :math:`\mathbf a_n = \sum_{(e, I)\ni n} \mathbf f_{eI} / m_n`.
-
-    ``fe`` (E, nen, 3) element nodal forces [N]; ``offsets`` (N+1,) and
-    ``slots`` (E*nen,) the node-to-element list (slot = e * nen + I);
-    ``m`` (N,) nodal mass [kg]; ``a`` (N, 3) out [m/s^2] (0 where m = 0).
-    """
-    nen = fe.shape[1]
-    for n in prange(a.shape[0]):
-        f0 = 0.0
-        f1 = 0.0
-        f2 = 0.0
-        for k in range(offsets[n], offsets[n + 1]):
-            s = slots[k]
-            e = s // nen
-            I = s - e * nen
-            f0 += fe[e, I, 0]
-            f1 += fe[e, I, 1]
-            f2 += fe[e, I, 2]
-        inv = 1.0 / m[n] if m[n] > 0.0 else 0.0
-        a[n, 0] = f0 * inv
-        a[n, 1] = f1 * inv
-        a[n, 2] = f2 * inv
-
-
 @njit(cache=True, error_model="numpy")
 def element_time_step(g, vol, c, L, ngp, active, q1, q2, cfl):
     r"""Stable step :math:`C\,\ell/(Q + \sqrt{Q^2 + c^2})` of the elements and the
@@ -446,13 +420,3 @@ def element_time_step(g, vol, c, L, ngp, active, q1, q2, cfl):
             best = t
             k = e
     return cfl * best, k
-
-
-def node_element_list(conn: np.ndarray, n_nodes: int) -> tuple[np.ndarray, np.ndarray]:
-    """CSR list (offsets (N+1,), slots) of the element slots ``e * nen + I`` of each node."""
-    flat = conn.ravel()
-    order = np.argsort(flat, kind="stable")
-    counts = np.bincount(flat, minlength=n_nodes)
-    offsets = np.zeros(n_nodes + 1, np.int64)
-    np.cumsum(counts, out=offsets[1:])
-    return offsets, order.astype(np.int64)

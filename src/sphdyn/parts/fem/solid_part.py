@@ -24,12 +24,13 @@ import numpy as np
 from ...geometry.mesh import MESH_KINDS
 from ...geometry.shapes import gauss_derivatives, hourglass_vectors, volume_table
 from ...integrate import drift
+from ...materials import MaterialGroup
 from ...materials.base import von_mises
 from ...state import Elements, MaterialPoints, Nodes
 from ..base import register_part
-from .solid import (HG_STIFFNESS, HG_VISCOUS, element_time_step, gather_forces,
-                    node_element_list, reduced_forces, reduced_strain_rate,
-                    uniform_forces, uniform_strain_rate)
+from .gather import gather_loads, node_element_list
+from .solid import (HG_STIFFNESS, HG_VISCOUS, element_time_step, reduced_forces,
+                    reduced_strain_rate, uniform_forces, uniform_strain_rate)
 
 INTEGRATIONS = ("one_point", "selective_reduced")
 HOURGLASS_FORMS = {"viscous": HG_VISCOUS, "stiffness": HG_STIFFNESS}
@@ -61,17 +62,6 @@ class SolidSettings:
         if self.hourglass not in HOURGLASS_FORMS:
             raise ValueError(f"hourglass must be one of {tuple(HOURGLASS_FORMS)}, "
                              f"got {self.hourglass!r}")
-
-
-@dataclass
-class PointGroup:
-    """Integration points sharing one material: ``model.update`` runs over ``idx``."""
-
-    name: str
-    model: object
-    params: np.ndarray
-    idx: np.ndarray
-    material: int = 0
 
 
 @register_part("solid")
@@ -122,7 +112,7 @@ class SolidPart:
         for k, (model, params) in sorted(materials.items()):
             idx = np.flatnonzero(pts.mat == k).astype(np.int64)
             if idx.size:
-                self.groups.append(PointGroup(f"{name}:{k}", model, params, idx, k))
+                self.groups.append(MaterialGroup(f"{name}:{k}", model, params, idx, k))
         layouts = {g.model.history_names for g in self.groups} - {()}
         if len(layouts) > 1:
             raise ValueError(f"part {name!r}: materials with different history variables "
@@ -186,7 +176,7 @@ class SolidPart:
                            el.xl, el.g, el.vol, self.gam, self.hg_form,
                            s.hourglass_coefficient, el.hg, el.e_hg, s.q1, s.q2, dt,
                            self.dim, el.fe)
-        gather_forces(el.fe, self.offsets, self.slots, q.m, q.a)
+        gather_loads(el.fe, 0, self.offsets, self.slots, q.m, q.a)
 
     # ----------------------------------------------------------- protocol
     def stable_dt(self) -> tuple[float, int]:

@@ -76,7 +76,7 @@ class SPHPart:
     Parameters
     ----------
     particles : the particle state.
-    groups : material groups (``model.MaterialGroup``), dispatched once each.
+    groups : material groups (:class:`~sphdyn.materials.MaterialGroup`), dispatched once each.
     kernel : the kernel context.
     settings : the scheme's settings.
     phase, variation : (N,) mesostructure phase (int8, -1 outside one) and
