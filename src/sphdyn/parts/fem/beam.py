@@ -56,9 +56,9 @@ one material point per element, kept in the bar's co-rotating frame (see
 Conventions: SI units; ``x`` (N, 3) [m]; ``triad`` (N, 3, 3); ``conn``
 (E, 2); element nodal loads ``fe`` (E, 2, 6): force [N] and moment [N m]
 *on* node ``a`` (row 0) and ``b`` (row 1), in global axes; every element
-writes only its own row (no races), and :func:`gather_forces` /
-:func:`gather_moments` sum them per node through a node -> element CSR
-list (``ptr`` (N+1,), ``ent`` (2E,) = 2 element + end).
+writes only its own row (no races), and :func:`.gather.gather_loads` sums
+them per node (columns 0-2, then 3-5) through the node -> element list
+(``ptr`` (N+1,), ``ent`` (2E,) = 2 element + end).
 """
 
 from __future__ import annotations
