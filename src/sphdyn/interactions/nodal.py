@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 
 from ..state import BC_FIXED, BC_VELOCITY
 from .base import InteractionBase
@@ -38,6 +39,55 @@ def ramp(t: float, T: float, shape: str = "linear") -> float:
     if shape == "smooth":
         return s - math.sin(2.0 * math.pi * s) / (2.0 * math.pi)
     return s
+
+
+@njit(cache=True, error_model="numpy")
+def reaction(idx, m, v, v_mid, a, dt_kick):
+    r"""Force the constraint exerted on the items ``idx`` at the last kick [N]:
+    :math:`\sum m ((\mathbf v^{n+1/2} - \mathbf v^{n-1/2})/\Delta t^n -
+    \mathbf a^n)` with :math:`\mathbf v^{n-1/2} = 2\mathbf v^n - \mathbf v^{n+1/2}`
+    (``v_mid`` holds :math:`\mathbf v^n`); ``m`` (N,), ``v``, ``v_mid``, ``a`` (N, 3)."""
+    r0 = 0.0
+    r1 = 0.0
+    r2 = 0.0
+    for i in idx:
+        r0 += m[i] * (2.0 * (v[i, 0] - v_mid[i, 0]) / dt_kick - a[i, 0])
+        r1 += m[i] * (2.0 * (v[i, 1] - v_mid[i, 1]) / dt_kick - a[i, 1])
+        r2 += m[i] * (2.0 * (v[i, 2] - v_mid[i, 2]) / dt_kick - a[i, 2])
+    return r0, r1, r2
+
+
+@njit(cache=True, error_model="numpy")
+def add_load(idx, per_mass, scale, force, a_out):
+    """``a_out[idx[k]] += scale * per_mass[k] * force`` (force (3,) [N], per_mass (k,) [1/kg])."""
+    for k in range(idx.shape[0]):
+        f = scale * per_mass[k]
+        i = idx[k]
+        a_out[i, 0] += f * force[0]
+        a_out[i, 1] += f * force[1]
+        a_out[i, 2] += f * force[2]
+
+
+@njit(cache=True, error_model="numpy")
+def damp(idx, v, c, a_own, a_out):
+    """``a_own[k] = -c v[idx[k]]`` (k, 3), added to ``a_out`` (N, 3) [m/s^2]."""
+    for k in range(idx.shape[0]):
+        i = idx[k]
+        for j in range(3):
+            a_own[k, j] = -c * v[i, j]
+            a_out[i, j] += a_own[k, j]
+
+
+@njit(cache=True, error_model="numpy")
+def set_work(idx, m, a_own, v_mid, dt_kick):
+    r"""Work of the accelerations ``a_own`` (k, 3) on the items ``idx`` over a kick:
+    :math:`\sum m\, \mathbf a \cdot \mathbf v^n\, \Delta t^n` [J]."""
+    w = 0.0
+    for k in range(idx.shape[0]):
+        i = idx[k]
+        w += m[i] * (a_own[k, 0] * v_mid[i, 0] + a_own[k, 1] * v_mid[i, 1]
+                     + a_own[k, 2] * v_mid[i, 2])
+    return w * dt_kick
 
 
 class _SetInteraction(InteractionBase):
@@ -110,12 +160,9 @@ class PrescribedMotion(_SetInteraction):
         return None
 
     def after_kick(self, dt_kick: float) -> None:
-        q, i = self.part.kin, self.idx
-        if dt_kick <= 0.0:
-            return
-        v_new = q.v[i]
-        v_old = 2.0 * q.v_mid[i] - v_new
-        self.reaction = np.sum(q.m[i, None] * ((v_new - v_old) / dt_kick - q.a[i]), axis=0)
+        q = self.part.kin
+        if dt_kick > 0.0:
+            self.reaction[:] = reaction(self.idx, q.m, q.v, q.v_mid, q.a, dt_kick)
 
     def columns(self, t: float) -> dict[str, float]:
         r = self.reaction
@@ -143,7 +190,7 @@ class NodalLoad(_SetInteraction):
 
     def forces(self, t: float, dt: float, a_out: np.ndarray) -> None:
         self._now = ramp(t, self.ramp_time, self.shape)
-        a_out[self.idx] += (self._now * self._per_mass)[:, None] * self.force
+        add_load(self.idx, self._per_mass, self._now, self.force, a_out)
 
     def columns(self, t: float) -> dict[str, float]:
         return {f"{self.name}_force": float(self._now * np.linalg.norm(self.force))}
@@ -167,12 +214,11 @@ class MassDamping(_SetInteraction):
         self.removed = 0.0
 
     def forces(self, t: float, dt: float, a_out: np.ndarray) -> None:
-        self._a = -self.c * self.part.kin.v[self.idx]
-        a_out[self.idx] += self._a
+        damp(self.idx, self.part.kin.v, self.c, self._a, a_out)
 
     def after_kick(self, dt_kick: float) -> None:
-        q, i = self.part.kin, self.idx
-        self.removed -= float(np.sum(q.m[i, None] * self._a * q.v_mid[i])) * dt_kick
+        q = self.part.kin
+        self.removed -= set_work(self.idx, q.m, self._a, q.v_mid, dt_kick)
 
     def columns(self, t: float) -> dict[str, float]:
         return {f"E_damping_{self.name}": self.removed}
@@ -182,4 +228,4 @@ class MassDamping(_SetInteraction):
 
     def restore(self, scalars: dict, arrays: dict) -> None:
         self.removed = float(scalars["removed"])
-        self._a = arrays["a"].copy()
+        self._a[...] = arrays["a"]
