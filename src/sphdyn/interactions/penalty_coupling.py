@@ -116,6 +116,7 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
         normal_force[i] = 0.0
         best = np.inf
         bf = -1
+        xi, eta, cx, cy, cz, nx, ny, nz, clamped = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, False
         for k in range(offsets[i], offsets[i + 1]):
             f = cand[k]
             res = closest_point(xp[i], xn, faces[f])
@@ -126,9 +127,9 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
             if d2 < best or (d2 == best and f < bf):
                 best = d2
                 bf = f
+                xi, eta, cx, cy, cz, nx, ny, nz, clamped = res
         if bf < 0:
             continue
-        xi, eta, cx, cy, cz, nx, ny, nz, clamped = closest_point(xp[i], xn, faces[bf])
         r0 = xp[i, 0] - cx
         r1 = xp[i, 1] - cy
         r2 = xp[i, 2] - cz
