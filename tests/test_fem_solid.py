@@ -346,3 +346,22 @@ def test_gmsh_file_gives_the_same_part_as_the_generated_block(tmp_path):
     assert np.allclose(runs[0][0], runs[1][0], rtol=1e-13)
     size = float(np.max(HI - LO))
     assert np.abs(runs[0][1] - runs[1][1]).max() < 1e-12 * size
+
+
+@pytest.mark.parametrize("integration", ["one_point", "selective_reduced"])
+def test_element_fields_and_what_walls_see_of_the_nodes(integration):
+    """Cell fields: the element stress is its points' mean, von Mises of a
+    uniaxial stress is its magnitude, volumes sum to the block's; the nodes
+    carry what a wall needs of an item (as particles do): volume shares
+    summing to the block's, the material's density and bulk modulus."""
+    x, cells = block([0, 0, 0], [0.2, 0.1, 0.1], (4, 2, 2), 3)
+    p = part(x, cells, 3, integration=integration)
+    p.pts.sig[:, 0, 0] = -30e6
+    f = p.fields()
+    assert np.allclose(f["stress"]()[:, 0, 0], -30e6)
+    assert np.allclose(f["von_mises"](), 30e6)
+    assert f["volume"]().sum() == pytest.approx(0.002, rel=1e-12)
+    assert p.nodes.vol0.sum() == pytest.approx(0.002, rel=1e-12)
+    assert np.allclose(p.nodes.rho0, STEEL["density"])
+    assert np.allclose(p.nodes.bulk_modulus, 210e9 / (3 * (1 - 0.6)))
+    assert p.nodes.m.sum() == pytest.approx(STEEL["density"] * 0.002, rel=1e-12)

@@ -64,7 +64,7 @@ class Elements(ArrayStore):
     vol0 : (E,) float64
         Initial volume [m^3] (area per unit depth in 2D).
     vol : (E,) float64
-        Current volume.
+        Current volume (a work array: the part derives it from the nodes).
     e_hg : (E,) float64
         Work done against the hourglass forces [J] (part of the internal energy).
     hg : (E, 4, 3) float64
@@ -80,7 +80,7 @@ class Elements(ArrayStore):
         self.add("mat", (), np.int32, kind=STATE)
         self.add("m", (), np.float64, kind=STATE)
         self.add("vol0", (), np.float64, kind=STATE)
-        self.add("vol", (), np.float64, kind=STATE)
+        self.add("vol", (), np.float64)  # derived from the nodes' positions
         self.add("e_hg", (), np.float64, kind=STATE)
         self.add("hg", (4, 3), np.float64, kind=STATE)
         self.add("active", (), np.int8, kind=STATE, fill=1)

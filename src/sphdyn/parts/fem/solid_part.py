@@ -25,7 +25,7 @@ from ...geometry.mesh import MESH_KINDS
 from ...geometry.shapes import gauss_derivatives, hourglass_vectors, volume_table
 from ...integrate import drift
 from ...materials import MaterialGroup
-from ...materials.base import von_mises
+from ...fields import von_mises
 from ...state import Elements, MaterialPoints, Nodes
 from ..base import register_part
 from .gather import gather_loads, node_element_list
@@ -235,11 +235,8 @@ class SolidPart:
 
     def fields(self) -> dict:
         """Cell fields (per element) the part evaluates on demand."""
-        def vm():
-            s = self.element_stress()
-            return np.array([von_mises((t[0, 0], t[1, 1], t[2, 2], t[0, 1], t[1, 2],
-                                        t[0, 2])) for t in s])
-        out = {"stress": self.element_stress, "von_mises": vm,
+        out = {"stress": self.element_stress,
+               "von_mises": lambda: von_mises(self.element_stress()),
                "damage": lambda: self.element_mean(self.pts.damage),
                "density": lambda: self.element_mean(self.pts.rho),
                "hourglass_energy": lambda: self.el.e_hg.copy(),
