@@ -107,7 +107,8 @@ class MaterialPoints(ArrayStore):
     bulk-viscosity part of ``e``; c : (P,) wave speed [m/s]; damage : (P,);
     size : (P,) element size [m] (fracture-energy regularisation);
     hist : (P, nh) history; elem : (P,) element of the point; mat : (P,)
-    material index.
+    material index. A part adds its work arrays (e.g. the solid part's point
+    masses ``m``).
     """
 
     def __init__(self, n: int, n_history: int = 0):

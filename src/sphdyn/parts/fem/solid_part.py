@@ -136,6 +136,8 @@ class SolidPart:
         # element mass: the points' densities times their share of the volume
         rho_el = pts.rho0.reshape(ne, self.ngp).mean(axis=1)
         elements.m = rho_el * elements.vol0
+        pts.add("m", ())  # the point's share of its element's mass [kg] (energies)
+        pts.m = np.repeat(elements.m / self.ngp, self.ngp)
         pts.size = np.repeat(elements.vol0 ** (1.0 / self.dim), self.ngp)
         share = lambda w: np.bincount(elements.conn.ravel(),  # noqa: E731
                                       weights=np.repeat(w / nen, nen), minlength=nodes.n)
@@ -204,17 +206,12 @@ class SolidPart:
                            g.params, p.size)
         self._forces(dt)
 
-    def point_masses(self) -> np.ndarray:
-        """Mass of each integration point (P,) [kg]: its element's, shared evenly."""
-        return np.repeat(self.el.m / self.ngp, self.ngp)
-
     def energies(self) -> tuple[float, float]:
         """Internal energy (material work, bulk viscosity, hourglass) and its
-        bulk-viscosity part [J] (J/m in 2D)."""
-        mp = self.point_masses()
-        act = np.repeat(self.el.active != 0, self.ngp)
-        ie = float(np.sum(mp[act] * self.pts.e[act])) + float(np.sum(self.el.e_hg))
-        return ie, float(np.sum(mp[act] * self.pts.e_av[act]))
+        bulk-viscosity part [J] (J/m in 2D): the points' masses (``pts.m``,
+        their element's shared evenly) times their specific energies."""
+        p = self.pts
+        return float(p.m @ p.e) + self.hourglass_energy(), float(p.m @ p.e_av)
 
     def hourglass_energy(self) -> float:
         """Work done against the hourglass forces [J]."""
