@@ -254,7 +254,8 @@ def test_bulk_viscosity_pressure_and_heat_match_their_formula():
 
 
 def test_stable_step_of_a_cube_and_of_the_bound():
-    """Cube at rest: dt = 0.9 (a / sqrt 3) / (Q2 c + sqrt((Q2 c)^2 + c^2))."""
+    """Cube at rest: dt = 0.9 l / (Q + sqrt(Q^2 + c^2)), l = a / sqrt 3,
+    Q = Q2 c; compressed at the rate r: Q = Q2 c + Q1 l |r|."""
     a = 0.01
     x, cells = block([0, 0, 0], [a, a, a], (1, 1, 1), 3)
     p = part(x, cells, 3)
@@ -264,6 +265,14 @@ def test_stable_step_of_a_cube_and_of_the_bound():
     assert k == 0
     assert dt == pytest.approx(0.9 * a / math.sqrt(3) / (Q + math.sqrt(Q * Q + c * c)),
                                rel=1e-12)
+    # in compression the bulk viscosity adds Q1 l |eps_kk| to Q
+    r = -500.0
+    p.nodes.v = r / 3.0 * x
+    p._geometry(0.0)
+    ell = a / math.sqrt(3)
+    Q = 0.06 * c + 1.5 * ell * abs(r)
+    assert p.stable_dt()[0] == pytest.approx(0.9 * ell / (Q + math.sqrt(Q * Q + c * c)),
+                                             rel=1e-12)
 
 
 # ------------------------------------------------------------ wave dynamics
