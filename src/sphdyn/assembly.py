@@ -10,18 +10,23 @@ from __future__ import annotations
 import numpy as np
 
 from .interactions import ParticleContact, Wall
+from .mesh_assembly import mesh_interactions, mesh_part
 from .kernels import KernelContext
 from .model import Model, build_model
 from .parts import SPHPart, SPHSettings
 from .stepper import Stepper
 
 
-def sph_settings(deck) -> SPHSettings:
-    """The SPH scheme's settings from ``[sph]``, ``[time]`` and the bodies."""
+def sph_settings(deck, converted: int = 0) -> SPHSettings:
+    """The SPH scheme's settings from ``[sph]``, ``[time]`` and the bodies;
+    ``converted`` bodies made of mesh elements follow after the deck's, with
+    the [sph] formulation and artificial stress."""
     sph = deck.sph
     tl = tuple((b.formulation or sph.formulation) == "total_lagrangian" for b in deck.body)
     eps = tuple(sph.artificial_stress.epsilon if b.artificial_stress is None
                 else b.artificial_stress for b in deck.body)
+    tl += (sph.formulation == "total_lagrangian",) * converted
+    eps += (sph.artificial_stress.epsilon,) * converted
     return SPHSettings(
         correction=bool(sph.correction), alpha=sph.viscosity.alpha,
         beta=sph.viscosity.beta, xsph=sph.xsph,
@@ -38,21 +43,26 @@ def contact_on(deck, settings: SPHSettings) -> bool:
     is total-Lagrangian (their kernels never see the other bodies)."""
     if deck.contact.enabled is not None:
         return bool(deck.contact.enabled)
-    return len(deck.body) >= 2 and any(settings.total_lagrangian)
+    return len(settings.total_lagrangian) >= 2 and any(settings.total_lagrangian)
 
 
 def build_stepper(deck, model: Model | None = None, events=(), monitors=()) -> Stepper:
     """The stepper of a validated deck (the model is built if not given)."""
     model = build_model(deck) if model is None else model
     p = model.particles
-    kernel = KernelContext.named(deck.sph.kernel, p.dim, deck.sph.support_scale)
-    settings = sph_settings(deck)
-    part = SPHPart(p, model.groups, kernel, settings, phase=model.phase,
-                   variation=model.variation)
-    interactions = []
-    if contact_on(deck, settings) and p.n:
-        interactions.append(ParticleContact(part, deck.contact.alpha,
-                                            deck.contact.distance_factor))
-    interactions += [Wall(spec, part) for spec in model.walls]
+    parts, interactions, part = [], [], None
+    if p.n:
+        kernel = KernelContext.named(deck.sph.kernel, p.dim, deck.sph.support_scale)
+        settings = sph_settings(deck, len(model.body_names) - len(deck.body))
+        part = SPHPart(p, model.groups, kernel, settings, phase=model.phase,
+                       variation=model.variation)
+        parts.append(part)
+        if contact_on(deck, settings):
+            interactions.append(ParticleContact(part, deck.contact.alpha,
+                                                deck.contact.distance_factor))
+        interactions += [Wall(spec, part) for spec in model.walls]
+    meshes = {mm.name: mesh_part(deck, mm) for mm in model.meshes}
+    parts += meshes.values()
+    interactions += mesh_interactions(deck, model, part, meshes)
     dt_max = deck.time.dt_max if deck.time.dt_max is not None else np.inf
-    return Stepper([part], interactions, events, monitors, dt_max=dt_max)
+    return Stepper(parts, interactions, events, monitors, dt_max=dt_max)

@@ -23,16 +23,28 @@ class SimulationFailed(RuntimeError):
         self.diagnosis = diagnosis
 
 
+#: stand-ins for the stress and density of items that have none (mesh nodes)
+_NO_SIG = np.zeros((0, 3, 3))
+_NO_RHO = np.zeros(0)
+
+
 @njit(cache=True, error_model="numpy", parallel=True)
 def _flags(x, v, a, sig, rho, lo, hi, out):
+    """Flag (N,) items: non-finite x, v, a (and stress, density when ``sig``,
+    ``rho`` have N rows; mesh nodes pass empty ones) or outside [lo, hi]."""
     n = x.shape[0]
+    full = sig.shape[0] == n and rho.shape[0] == n
     bad = 0
     for i in prange(n):
         f = OK
-        s = a[i, 0] + a[i, 1] + a[i, 2] + v[i, 0] + v[i, 1] + v[i, 2] + rho[i]
-        s += sig[i, 0, 0] + sig[i, 1, 1] + sig[i, 2, 2] + sig[i, 0, 1]
-        s += sig[i, 0, 2] + sig[i, 1, 2] + x[i, 0] + x[i, 1] + x[i, 2]
-        if not np.isfinite(s) or rho[i] <= 0.0:
+        s = a[i, 0] + a[i, 1] + a[i, 2] + v[i, 0] + v[i, 1] + v[i, 2]
+        s += x[i, 0] + x[i, 1] + x[i, 2]
+        r = 1.0
+        if full:
+            r = rho[i]
+            s += r + sig[i, 0, 0] + sig[i, 1, 1] + sig[i, 2, 2] + sig[i, 0, 1]
+            s += sig[i, 0, 2] + sig[i, 1, 2]
+        if not np.isfinite(s) or r <= 0.0:
             f = NONFINITE
         else:
             for d in range(3):
@@ -44,39 +56,54 @@ def _flags(x, v, a, sig, rho, lo, hi, out):
     return bad
 
 
-def check_particles(p, lo, hi, t, step, work: np.ndarray) -> None:
+def check_particles(p, lo, hi, t, step, work: np.ndarray, label: str = "") -> None:
     """Raise :class:`SimulationFailed` if any particle is non-finite or outside.
 
-    ``work`` is an (N,) int8 scratch array (no allocation per step).
+    ``work`` is an (N,) int8 scratch array (no allocation per step). Mesh
+    nodes (no ``sig``, ``rho``) are checked for their kinematics; ``label``
+    (``"node(s) of mesh 'beam'"``) names them in the diagnosis.
     """
-    if _flags(p.x, p.v, p.a, p.sig, p.rho, lo, hi, work) == 0:
+    sig, rho = getattr(p, "sig", _NO_SIG), getattr(p, "rho", _NO_RHO)
+    if _flags(p.x, p.v, p.a, sig, rho, lo, hi, work) == 0:
         return
+    what = label or "particle(s)"
     lines = [f"run stopped at t = {t:.6e} s, step {step}:"]
     nonfinite = np.flatnonzero(work == NONFINITE)
     outside = np.flatnonzero(work == OUTSIDE)
     if nonfinite.size:
-        fields = {"position": p.x, "velocity": p.v, "acceleration": p.a,
-                  "stress": p.sig.reshape(p.n, 9), "density": p.rho[:, None]}
+        fields = {"position": p.x, "velocity": p.v, "acceleration": p.a}
+        if sig.shape[0] == p.n:
+            fields.update(stress=sig.reshape(p.n, 9), density=rho[:, None])
         which = [name for name, arr in fields.items()
                  if not np.all(np.isfinite(arr[nonfinite]))]
-        if np.any(p.rho[nonfinite] <= 0):
+        if rho.shape[0] == p.n and np.any(rho[nonfinite] <= 0):
             which.append("density <= 0")
-        lines.append(f"  {nonfinite.size} particle(s) with non-finite values in "
+        lines.append(f"  {nonfinite.size} {what} with non-finite values in "
                      f"{', '.join(which) or 'state'}; first: "
                      + _describe(p, nonfinite[:5]))
         lines.append("  Likely causes: time step too large (lower time.cfl), too "
                      "stiff contact (lower wall.alpha), or a material failing to converge.")
     if outside.size:
-        lines.append(f"  {outside.size} particle(s) left the domain box "
+        lines.append(f"  {outside.size} {what} left the domain box "
                      f"[{_fmt(lo)} .. {_fmt(hi)}]; first: " + _describe(p, outside[:5]))
         lines.append("  Enlarge [domain] (lo/hi or margin) if this motion is physical.")
     raise SimulationFailed("\n".join(lines))
 
 
-def check_time_step(dt, dt0, ratio, t, step, k, p) -> None:
-    """Raise :class:`SimulationFailed` when ``dt < ratio * dt0`` (time-step collapse)."""
+def check_time_step(dt, dt0, ratio, t, step, k, p, describe=None) -> None:
+    """Raise :class:`SimulationFailed` when ``dt < ratio * dt0`` (time-step collapse).
+
+    ``k`` is the controlling item of ``p`` (a particle), or of a part whose
+    ``describe(k)`` says what it is (an element of a mesh).
+    """
     if dt >= ratio * dt0 and np.isfinite(dt):
         return
+    if describe is not None:
+        raise SimulationFailed(
+            f"run stopped at t = {t:.6e} s, step {step}: time step collapsed to "
+            f"{dt:.3e} s (< {ratio:g} x initial {dt0:.3e} s), controlled by "
+            f"{describe(k)}.\n  Likely causes: an element being crushed or inverted; "
+            "check the loads, contact stiffness and materials, or erode the element.")
     raise SimulationFailed(
         f"run stopped at t = {t:.6e} s, step {step}: time step collapsed to "
         f"{dt:.3e} s (< {ratio:g} x initial {dt0:.3e} s), controlled by particle {k} "
@@ -91,4 +118,6 @@ def _fmt(v) -> str:
 
 
 def _describe(p, idx) -> str:
-    return "; ".join(f"#{i} (body {p.body[i]}) at {_fmt(p.x[i])}" for i in idx)
+    body = getattr(p, "body", None)
+    return "; ".join(f"#{i}" + ("" if body is None else f" (body {body[i]})")
+                     + f" at {_fmt(p.x[i])}" for i in idx)

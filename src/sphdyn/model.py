@@ -19,8 +19,11 @@ from .heterogeneity.photo import photo_targets
 from .heterogeneity.variation import factor_of, quantise, standard_normal_field, variation_rng
 from .initial import initial_fields
 from .interactions.wall import STIFFNESS, WallSpec
+from .deck import DeckError
+from .deck.errors import format_problem
 from .preflight import checked_lattices
 from .materials import MaterialGroup, get_model
+from .mesh_model import MeshModel, build_meshes, mesh_node_set
 from .probes import Probe, quantity
 from .state import BC_FIXED, BC_VELOCITY, Particles
 
@@ -44,6 +47,10 @@ class Model:
     variation: np.ndarray = field(repr=False, default=None)
     #: body name -> MassDraw of bodies with a random mass field ([body.mass])
     mass_draws: dict = field(default_factory=dict)
+    #: the [[mesh]] parts (read, checked, converted)
+    meshes: list[MeshModel] = field(default_factory=list)
+    #: set name -> (mesh name, (n,) node indices) of the [[set]]s with ``mesh``
+    mesh_sets: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -184,6 +191,7 @@ def build_model(deck) -> Model:
     """
     dim = deck.run.dimension
     _, lattices = checked_lattices(deck)
+    meshes = build_meshes(deck)
     mats = {m.name: m for m in deck.material}
     mat_index = {m.name: k for k, m in enumerate(deck.material)}
     models = {m.name: get_model(m.model) for m in deck.material}
@@ -238,7 +246,14 @@ def build_model(deck) -> Model:
         p.body[:] = b
         p.hist_names = list(models[body.material].history_names)
         parts.append(p)
-    particles = Particles.concatenate(parts)
+    body_names = [b.name for b in deck.body]
+    for mm in meshes:
+        if mm.converted is not None:
+            parts.append(_converted_particles(deck, mm, len(body_names), density_of, n_hist))
+            phase_parts.append(np.full(parts[-1].n, -1, np.int8))
+            body_names.append(_converted_name(mm, body_names))
+    particles = (Particles.concatenate(parts) if parts
+                 else Particles.allocate(0, dim, n_hist))
     particles.hist_names = list(next(iter(layouts), ()))
 
     groups, factor = _material_groups(deck, particles, models, params)
@@ -251,13 +266,20 @@ def build_model(deck) -> Model:
 
     body_index = {b.name: k for k, b in enumerate(deck.body)}
     sets: dict[str, np.ndarray] = {}
-    for s in deck.set:
+    mesh_sets: dict[str, tuple[str, np.ndarray]] = {}
+    for k, s in enumerate(deck.set):
+        if s.mesh is not None:
+            mm, idx = mesh_node_set(meshes, s, k, dim)
+            mesh_sets[s.name] = (mm.name, idx)
+            continue
         cand = np.arange(particles.n) if s.body is None else np.flatnonzero(
             particles.body == body_index[s.body])
         region = None if s.region is None else s.region.model_dump()
         sel = select(particles.x[cand], region, dim)
         sets[s.name] = cand[sel].astype(np.int64)
     for bnd in deck.boundary:
+        if bnd.set in mesh_sets or not _plain_boundary(bnd):
+            continue  # a prescribed motion (sphdyn.assembly)
         idx = sets[bnd.set]
         if bnd.type == "fixed":
             particles.bc[idx] = BC_FIXED
@@ -268,7 +290,12 @@ def build_model(deck) -> Model:
             particles.v[idx] = particles.bc_v[idx]
 
     probes = []
-    for pr in deck.probe:
+    for k, pr in enumerate(deck.probe):
+        if pr.set in mesh_sets:
+            raise DeckError([format_problem(
+                f"probe[{k}].set", f"'{pr.set}' is a set of mesh nodes; probes record "
+                "particle sets", "probe a particle set; the reactions of a mesh "
+                "set's [[boundary]] are in the history (<set>_reaction_x|y|z)")])
         probe = Probe(pr.set, sets[pr.set], tuple(pr.quantities), pr.reduce)
         for q in probe.quantities:
             try:
@@ -277,11 +304,12 @@ def build_model(deck) -> Model:
                 raise ValueError(f"probe on set {pr.set!r}: {exc}") from None
         probes.append(probe)
 
-    lo_b = particles.x.min(axis=0)
-    hi_b = particles.x.max(axis=0)
+    every = np.concatenate([particles.x] + [mm.points for mm in meshes])
+    lo_b = every.min(axis=0)
+    hi_b = every.max(axis=0)
     # the same distance on every side: a thin body (the paper's disc is 20 mm
     # deep) must not get a thin box, or debris squeezed out sideways stops it
-    size = max(float(np.max(hi_b - lo_b)), float(particles.h.max()))
+    size = max(float(np.max(hi_b - lo_b)), float(particles.h.max(initial=0.0)))
     lo = lo_b - deck.domain.margin * size if deck.domain.lo is None else np.asarray(
         deck.domain.lo, float)
     hi = hi_b + deck.domain.margin * size if deck.domain.hi is None else np.asarray(
@@ -291,6 +319,42 @@ def build_model(deck) -> Model:
 
     return Model(
         particles=particles, groups=groups, walls=wall_specs(deck), sets=sets,
-        body_names=[b.name for b in deck.body], domain_lo=lo, domain_hi=hi,
-        probes=probes, phase=np.concatenate(phase_parts),
-        photo_targets=photos, variation=factor, mass_draws=draws)
+        body_names=body_names, domain_lo=lo, domain_hi=hi,
+        probes=probes, phase=np.concatenate(phase_parts + [np.zeros(0, np.int8)]),
+        photo_targets=photos, variation=factor, mass_draws=draws, meshes=meshes,
+        mesh_sets=mesh_sets)
+
+
+def _plain_boundary(bnd) -> bool:
+    """A boundary the particles' ``bc`` flags hold alone: fixed, or a constant
+    velocity from the start (ramps and displacements are prescribed motions)."""
+    return bnd.type == "fixed" or (bnd.type == "velocity" and bnd.ramp_time == 0.0)
+
+
+def _converted_name(mm: MeshModel, taken: list[str]) -> str:
+    """The body name of a mesh's converted particles: the mesh's name."""
+    if mm.name in taken:
+        raise DeckError([format_problem(
+            f"mesh[{mm.index}] '{mm.name}'.convert", f"its particles form a body named "
+            f"'{mm.name}', and a [[body]] has that name", "rename the mesh or the body")])
+    return mm.name
+
+
+def _converted_particles(deck, mm: MeshModel, b: int, density_of, n_hist: int) -> Particles:
+    """Particles of a mesh's converted elements: one per element at its centroid,
+    with its volume and mass :math:`\rho V_e` (thesis ch. 4), smoothing length
+    ``sph.h_factor`` times :math:`V_e^{1/d}`, body index ``b``."""
+    c, dim = mm.converted, deck.run.dimension
+    p = Particles.allocate(c.x.shape[0], dim, n_hist)
+    p.x[:] = c.x
+    p.x0[:] = c.x
+    p.v[:] = np.asarray(mm.spec.velocity, dtype=float)
+    p.vol0[:] = c.vol
+    p.mat[:] = c.mat
+    p.rho[:] = density_of[c.mat]
+    p.rho0[:] = p.rho
+    p.m[:] = p.rho0 * c.vol
+    p.h[:] = deck.sph.h_factor * c.vol ** (1.0 / dim)
+    p.h0[:] = p.h
+    p.body[:] = b
+    return p

@@ -30,12 +30,14 @@ class Guards:
             part.kin.add("guard_work", (), np.int8)
 
     def before_step(self, s, dt, k, part) -> None:
-        check_time_step(dt, s.dt0, self.collapse_ratio, s.t, s.step_count, k, part.kin)
+        check_time_step(dt, s.dt0, self.collapse_ratio, s.t, s.step_count, k, part.kin,
+                        getattr(part, "describe_limit", None))
 
     def after_step(self, s) -> None:
         for part in s.parts:
             q = part.kin
-            check_particles(q, self.lo, self.hi, s.t, s.step_count, q.guard_work)
+            label = "" if part.kind == "sph" else f"node(s) of mesh '{part.name}'"
+            check_particles(q, self.lo, self.hi, s.t, s.step_count, q.guard_work, label)
 
 
 class HistoryRecorder:

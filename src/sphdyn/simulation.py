@@ -25,7 +25,7 @@ import numpy as np
 from . import __version__
 from .deck import dump_resolved, load_deck
 from .guards import SimulationFailed
-from .io import (FrameWriter, History, atomic_write_text, particle_fields,
+from .io import (FrameWriter, History, MeshFrame, atomic_write_text, particle_fields,
                  plot_history, read_checkpoint, write_checkpoint)
 from .analysis import window_mean_force
 from .io.plots import energy_columns, relative_drift
@@ -73,8 +73,8 @@ class Simulation:
 
     @property
     def particles(self):
-        """The particles of the SPH part."""
-        return self.stepper.particles
+        """The particles of the SPH part (none in a deck of meshes only)."""
+        return self.model.particles
 
     # ---------------------------------------------------------------- set-up
     @classmethod
@@ -222,9 +222,10 @@ class Simulation:
         s = self.stepper
         computed = {}
         for part in s.parts:
-            computed.update(part.fields())
-        fields = particle_fields(s.particles, self.fields, computed)
-        self.frames.write(s.t, s.step_count, fields)
+            if part.kind == "sph":  # mesh parts' fields go to their own blocks
+                computed.update(part.fields())
+        fields = particle_fields(self.particles, self.fields, computed)
+        self.frames.write(s.t, s.step_count, fields, meshes=mesh_frames(s.parts))
         self.output.written(s.t)
 
     def _checkpoint(self):
@@ -241,7 +242,7 @@ class Simulation:
         s, deck = self.stepper, self.deck
         steps = s.step_count - start_step
         n = sum(part.kin.n for part in s.parts)
-        sph = s.part("sph")
+        sph = next((p for p in s.parts if p.kind == "sph"), None)
         h = self.history.as_arrays() if len(self.history.columns) else {}
         if failure is not None:
             status = "failed"
@@ -253,13 +254,20 @@ class Simulation:
             "sphdyn": __version__, "title": deck.run.title, "status": status,
             "signal": interrupted if status == "interrupted" else None,
             "diagnosis": None if failure is None else failure.diagnosis,
-            "particles": n, "dimension": s.particles.dim, "time": s.t,
+            "particles": n, "dimension": deck.run.dimension, "time": s.t,
             "steps": s.step_count, "steps_this_run": steps,
             "wall_seconds": self.wall_seconds,
             "particle_steps_per_s": n * steps / max(self.wall_seconds, 1e-12),
-            "initial_dt": s.dt0, "neighbours_mean": mean_neighbours(sph.nl),
-            "neighbours_max": max_neighbours(sph.nl), "neighbour_builds": sph.nl.n_builds,
+            "initial_dt": s.dt0,
         }
+        if sph is not None:
+            summary.update(neighbours_mean=mean_neighbours(sph.nl),
+                           neighbours_max=max_neighbours(sph.nl),
+                           neighbour_builds=sph.nl.n_builds)
+        for part in s.parts:
+            if part.kind != "sph":
+                summary.setdefault("meshes", {})[part.name] = {
+                    "nodes": part.kin.n, "elements": _element_count(part)}
         if "E_total" in h and h["E_total"].size:
             # the drift drawn in plots/energies.png: relative to the largest
             # energy term, not to E_kinetic (tiny in a quasi-static test)
@@ -277,6 +285,33 @@ class Simulation:
         if self.model.walls:
             summary["force_window"] = window
         return summary
+
+
+def _elements(part):
+    """The element table of a mesh part (solid: ``el``, line: ``elements``)."""
+    return getattr(part, "el", None) or part.elements
+
+
+def _element_count(part) -> int:
+    return int(_elements(part).n)
+
+
+def mesh_frames(parts) -> dict[str, MeshFrame]:
+    """One :class:`~sphdyn.io.MeshFrame` per mesh part: nodes at their current
+    positions with ``displacement`` and ``velocity`` [m, m/s], and every cell
+    field of the part (``stress``, ``von_mises``, ``damage``, plastic strain
+    and the other history columns, ``hourglass_energy``; beams: forces)."""
+    out = {}
+    for part in parts:
+        if part.kind == "sph":
+            continue
+        q, el = part.kin, _elements(part)
+        kind = getattr(part, "element_kind", "line2")
+        out[part.name] = MeshFrame(
+            points=q.x.copy(), cells=el.conn.copy(), kind=kind,
+            point_data={"displacement": q.x - q.x0, "velocity": q.v.copy()},
+            cell_data={name: np.asarray(fn()) for name, fn in part.fields().items()})
+    return out
 
 
 def _output_failure(exc: OSError, s) -> str:

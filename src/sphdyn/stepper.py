@@ -91,8 +91,8 @@ class Stepper:
 
     @property
     def particles(self):
-        """The particles of the first SPH part (the common case)."""
-        return next(p.p for p in self.parts if p.kind == "sph")
+        """The particles of the first SPH part (the common case); None without one."""
+        return next((p.p for p in self.parts if p.kind == "sph"), None)
 
     def add_monitor(self, monitor) -> None:
         self.monitors.append(monitor)

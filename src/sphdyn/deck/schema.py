@@ -29,19 +29,33 @@ from .messages import problem
 from .sections.material import MaterialSection, parameter_clashes
 from .sections.output import Output, Probe
 from .sections.run import Domain, Run, Time
-from .sections.sets import Boundary, ParticleSet
+from .sections.meshes import BeamSection, BlockMesh, Convert, LineMesh, Mesh, MeshGroup
+from .sections.sets import Boundary, Load, ParticleSet
 from .sections.shapes import Geometry, Region
 from .sections.sph import Contact, Sph
 from .sections.walls import Wall
 from .values import ExistingFile, NonEmpty, Section
 
 __all__ = [
-    "Body", "Boundary", "Contact", "Crack", "Deck", "DeckSections", "Domain",
+    "BeamSection", "BlockMesh", "Body", "Boundary", "Convert", "LineMesh", "Load", "Mesh",
+    "MeshGroup", "Contact", "Crack", "Deck", "DeckSections", "Domain",
     "ExistingFile", "Geometry", "MassField", "MaterialSection", "Mesostructure",
     "Output", "ParticleSet", "Probe", "Region", "Run", "Section", "Sph", "Time",
     "Variation", "Wall", "deck_model", "field_annotation", "metadata",
     "strip_optional", "variants",
 ]
+
+
+def _bodies_or_meshes(value):
+    """Before-validator of ``body``: no body is fine when the deck has meshes."""
+    scope = SCOPE.get()
+    if scope is not None and scope.names.get("mesh"):
+        return value
+    if isinstance(value, (list, tuple)) and not value:
+        raise problem("there is no [[body]] table (and no [[mesh]])",
+                      "add at least one [[body]] (particles) or [[mesh]] "
+                      "(finite elements)")
+    return value
 
 
 class DeckSections(Section):
@@ -57,14 +71,17 @@ class DeckSections(Section):
     domain: Domain = Field(default_factory=Domain, description="Guard box.")
     material: tuple[MaterialSection, ...] = Field(
         description="Materials (at least one).")
-    body: Annotated[tuple[Body, ...], BeforeValidator(NonEmpty("body"))] = Field(
-        description="Bodies (at least one).")
+    body: Annotated[tuple[Body, ...], BeforeValidator(_bodies_or_meshes)] = Field(
+        (), validate_default=True,
+        description="Bodies of particles (at least one body or mesh).")
+    mesh: tuple[Mesh, ...] = Field((), description="Finite-element parts.")
     contact: Contact = Field(default_factory=Contact,
                              description="Contact between bodies.")
     wall: tuple[Wall, ...] = Field((), description="Rigid walls.")
     set: tuple[ParticleSet, ...] = Field((), description="Particle sets.")
     boundary: tuple[Boundary, ...] = Field((), description="Boundary "
                                                            "conditions.")
+    load: tuple[Load, ...] = Field((), description="Forces on sets.")
     probe: tuple[Probe, ...] = Field((), description="Time histories of "
                                                      "particle sets.")
     output: Output = Field(default_factory=Output, description="Output.")

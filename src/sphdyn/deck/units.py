@@ -69,6 +69,8 @@ PRESSURE = Dimension("pressure", "Pa", "43.1 MPa", 4.31e7, "pascals")
 DENSITY = Dimension("mass density", "kg/m^3", "2400 kg/m^3", 2400.0,
                     "kilograms per cubic metre")
 VELOCITY = Dimension("velocity", "m/s", "15 m/s", 15.0, "metres per second")
+FORCE = Dimension("force", "N", "10 kN", 1e4, "newtons")
+RATE = Dimension("rate", "1/s", "100 1/s", 100.0, "per second")
 
 
 @cache

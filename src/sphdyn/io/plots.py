@@ -168,13 +168,16 @@ def _finish_axes(ax, title: str) -> None:
 def history_figures(data: dict[str, np.ndarray], title: str = "",
                     force_window: float | None = None, dimension: int | None = None,
                     t_end: float | None = None) -> dict:
-    """The history figures of a run, unsaved, by name (``energies``, ``forces``, ``dt``).
+    """The history figures of a run, unsaved, by name (``energies``, ``forces``,
+    ``reactions``, ``dt``).
 
     * ``energies``: every ``E_*``/``W_*`` column against time, and the
       relative drift of ``E_total`` in a second panel;
     * ``forces``: every ``F_*`` column against time, and for each wall with
       an impulse column ``I_wall_<name>`` its force averaged over
       ``force_window`` (:func:`sphdyn.analysis.window_mean_force`, dashed);
+    * ``reactions``: the reaction force components ``<set>_reaction_x|y|z``
+      of prescribed motions (components that stay zero left out);
     * ``dt``: ``dt`` against ``step`` (or time if there is no step). When
       the last row lies at ``t_end``, its step was shortened to land exactly
       there: it is drawn as a separate, labelled marker, not as part of the
@@ -224,6 +227,20 @@ def history_figures(data: dict[str, np.ndarray], title: str = "",
         ax.set_ylabel(f"force [{per_depth('N', dimension)}]")
         _finish_axes(ax, f"Forces ({title})")
         figures["forces"] = fig
+
+    reaction_cols = [c for c in columns if c.rsplit("_", 1)[0].endswith("_reaction")]
+    largest = max((np.max(np.abs(data[c]), initial=0.0) for c in reaction_cols),
+                  default=0.0)
+    reaction_cols = [c for c in reaction_cols  # round-off of a free component left out
+                     if np.max(np.abs(data[c]), initial=0.0) > 1e-9 * largest]
+    if time is not None and reaction_cols:
+        fig, (ax,) = _figure()
+        for c in reaction_cols:
+            ax.plot(shown, data[c], label=c)
+        ax.set_xlabel(f"time [{tu}]")
+        ax.set_ylabel(f"reaction force [{per_depth('N', dimension)}]")
+        _finish_axes(ax, f"Reactions of prescribed node sets ({title})")
+        figures["reactions"] = fig
 
     xkey = "step" if "step" in data else "time" if time is not None else None
     if "dt" in data and xkey is not None:

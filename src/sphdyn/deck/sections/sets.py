@@ -1,45 +1,107 @@
-"""Deck sections [[set]] and [[boundary]]: named particle selections and their conditions."""
+"""Deck sections [[set]], [[boundary]] and [[load]]: named selections and their conditions.
+
+A set holds particles (of one [[body]] or all bodies) or the nodes of one
+[[mesh]] (by region, by a group of the mesh file, or both).
+"""
 
 from typing import Literal, Optional
 
-from pydantic import Field, ValidationInfo, field_validator
+from pydantic import Field, ValidationInfo, field_validator, model_validator
 
 from ..messages import problem
-from ..values import Section, VelocityVector, name_of, reference_to
+from ..units import FORCE, TIME
+from ..values import (Section, VelocityVector, Position, name_of, quantity, reference_to,
+                      vector)
 from .shapes import Region
+
+#: A force vector [N] (N/m in 2D); z must be 0 in 2D decks.
+ForceVector = vector(quantity(FORCE))
 
 
 class ParticleSet(Section):
-    """[[set]]: a named selection of particles."""
+    """[[set]]: a named selection of particles or of mesh nodes."""
 
     name: name_of("set") = Field(description="Name of the set.")
     body: Optional[reference_to("body")] = Field(
-        None, description="Restrict the set to this [[body]] (absent: all "
-                          "bodies).")
+        None, description="Restrict the set to this [[body]] (absent, and no mesh: "
+                          "all bodies).")
+    mesh: Optional[reference_to("mesh")] = Field(
+        None, description="A set of this [[mesh]]'s nodes instead of particles.")
+    group: Optional[str] = Field(
+        None, description="With mesh: the nodes of this group of the mesh file "
+                          "(Gmsh physical group, Abaqus NSET or ELSET).")
     region: Optional[Region] = Field(
-        None, description="Region selecting particles by initial position "
-                          "(absent: all particles of the body or model).")
+        None, description="Region selecting particles (or nodes) by initial position "
+                          "(absent: all of the body, mesh or model).")
+
+    @model_validator(mode="after")
+    def _one_owner(self):
+        if self.body is not None and self.mesh is not None:
+            raise problem("a set holds particles of a body or nodes of a mesh, not both",
+                          "remove body or mesh")
+        if self.group is not None and self.mesh is None:
+            raise problem("group names a group of a mesh file",
+                          "add mesh = \"<name>\" or remove group")
+        return self
 
 
 class Boundary(Section):
     """[[boundary]]: kinematic condition on a set."""
 
     set: reference_to("set") = Field(description="Name of a [[set]].")
-    type: Literal["fixed", "velocity"] = Field(
-        description="fixed: zero velocity; velocity: prescribed velocity.")
+    type: Literal["fixed", "velocity", "displacement"] = Field(
+        description="fixed: zero velocity; velocity: prescribed velocity; "
+                    "displacement: prescribed displacement reached over ramp_time, "
+                    "then held (a support moved, e.g. a beam end moved down).")
     velocity: Optional[VelocityVector] = Field(
         None, validate_default=True,
         description="Prescribed velocity; required for type = \"velocity\", "
-                    "not allowed for \"fixed\".")
+                    "not allowed otherwise.")
+    displacement: Optional[Position] = Field(
+        None, validate_default=True,
+        description="Prescribed displacement; required for type = \"displacement\", "
+                    "not allowed otherwise.")
+    ramp_time: quantity(TIME, "ramp time", lo=0) = Field(
+        0.0, description="The velocity (or displacement) grows from 0 to its value "
+                         "over this time (0: at once). A displacement with "
+                         "ramp_time = 0 is refused (an infinite velocity).")
+    ramp: Literal["linear", "smooth"] = Field(
+        "linear", description="Ramp shape: linear, or smooth (3s^2 - 2s^3: no jump "
+                              "of acceleration, less ringing).")
+    rotations: Literal["free", "fixed"] = Field(
+        "free", description="Beam nodes: also fix their rotations (a clamped or "
+                            "rotation-free moved end).")
 
-    @field_validator("velocity")
+    @field_validator("velocity", "displacement")
     @classmethod
-    def _matches_type(cls, velocity, info: ValidationInfo):
+    def _matches_type(cls, value, info: ValidationInfo):
         kind = info.data.get("type")
-        if kind == "fixed" and velocity is not None:
-            raise problem("a fixed boundary takes no velocity",
-                          "remove velocity or set type = \"velocity\"")
-        if kind == "velocity" and velocity is None:
-            raise problem("a velocity boundary needs a velocity",
-                          "add velocity = [\"1 m/s\", 0, 0]")
-        return velocity
+        key = info.field_name
+        if kind == key and value is None:
+            example = "[\"1 m/s\", 0, 0]" if key == "velocity" else "[0, \"-5 mm\", 0]"
+            raise problem(f"a {kind} boundary needs a {key}", f"add {key} = {example}")
+        if kind is not None and kind != key and value is not None:
+            raise problem(f"a {kind} boundary takes no {key}",
+                          f"remove {key} or set type = \"{key}\"")
+        return value
+
+    @model_validator(mode="after")
+    def _ramped_displacement(self):
+        if self.type == "displacement" and self.ramp_time == 0.0:
+            raise problem("a displacement boundary needs a ramp_time > 0",
+                          "add ramp_time = \"10 ms\" (the time to reach the "
+                          "displacement)")
+        if self.type == "fixed" and self.ramp_time != 0.0:
+            raise problem("a fixed boundary has no ramp", "remove ramp_time")
+        return self
+
+
+class Load(Section):
+    """[[load]]: a force on a set, shared evenly by its nodes or particles."""
+
+    set: reference_to("set") = Field(description="Name of a [[set]].")
+    force: ForceVector = Field(description="Total force on the set [N] (N/m in 2D), "
+                                           "split evenly among its members.")
+    ramp_time: quantity(TIME, "ramp time", lo=0) = Field(
+        0.0, description="The force grows from 0 over this time (0: at once).")
+    ramp: Literal["linear", "smooth"] = Field("linear", description="Ramp shape.")

@@ -278,6 +278,12 @@ class LinePart:
                                   self.dt_scale)
         return truss_stable_dt(self.kin.x, el.conn, self.c_bar, self.dt_scale)
 
+    def describe_limit(self, k: int) -> str:
+        """What element ``k`` of :meth:`stable_dt` is, for a diagnosis."""
+        centre = self.kin.x[self.elements.conn[k]].mean(axis=0)
+        return (f"element {k} of line mesh '{self.name}' at "
+                f"({', '.join(f'{c:.4g}' for c in centre)})")
+
     def start(self, dt: float) -> None:
         """Accelerations of the initial state (no material update)."""
         self._loads(update=False, dt=dt)

@@ -187,6 +187,13 @@ class SolidPart:
         return element_time_step(el.g, el.vol, p.c, p.L, self.ngp, el.active, s.q1, s.q2,
                                  s.cfl)
 
+    def describe_limit(self, k: int) -> str:
+        """What element ``k`` of :meth:`stable_dt` is, for a diagnosis."""
+        el = self.el
+        centre = self.nodes.x[el.conn[k]].mean(axis=0)
+        return (f"element {k} of mesh '{self.name}' at ({', '.join(f'{c:.4g}' for c in centre)})"
+                f", volume {el.vol[k] / el.vol0[k]:.3g} of its initial")
+
     def start(self, dt: float) -> None:
         """Accelerations of the initial state (no material update)."""
         self._geometry(0.0)

@@ -1,0 +1,215 @@
+"""Deck section [[mesh]]: finite-element parts and the regions turned into particles.
+
+A mesh is a generated block of hexahedra (3D) or plane-strain quadrilaterals
+(2D) ([mesh.block]), a generated line of beams or trusses ([mesh.line]), or a
+Gmsh / Abaqus file (``file``). Its elements use the deck's materials through
+the same point functions as particles (docs/theory.md, "Solid elements").
+[mesh.convert] replaces the elements of a region by SPH particles (one per
+element, at its centroid, with its volume and mass; thesis ch. 4) and couples
+them to the remaining mesh.
+"""
+
+from typing import Literal, Optional
+
+from pydantic import Field, model_validator
+
+from ..messages import problem
+from ..units import LENGTH, RATE
+from ..values import (Direction, ExistingFile, Position, PositiveLength, Section,
+                      UpperPosition, VelocityVector, integer, name_of, quantity, real,
+                      reference_to)
+from ..scope import dimension
+from .shapes import Region
+
+#: Elements of a generated block or a file, by dimension.
+SOLID_ELEMENTS = {3: "hex8", 2: "quad4"}
+LINE_ELEMENTS = ("beam", "truss")
+
+
+class BlockMesh(Section):
+    """[mesh.block]: a structured block of hexahedra (3D) or quadrilaterals (2D)."""
+
+    lo: Position = Field(description="Lower corner.")
+    hi: UpperPosition = Field(description="Upper corner, above lo in every used "
+                                          "component.")
+    divisions: tuple[integer("element count", lo=1), ...] = Field(
+        description="Elements along x, y (and z in 3D), e.g. [40, 4, 4].")
+
+    @model_validator(mode="after")
+    def _one_per_axis(self):
+        dim = dimension()
+        if dim is not None and len(self.divisions) != dim:
+            raise problem(f"divisions has {len(self.divisions)} entries in a {dim}D deck",
+                          f"give {dim} element counts, one per axis")
+        return self
+
+
+class LineMesh(Section):
+    """[mesh.line]: a straight line of beam or truss elements."""
+
+    start: Position = Field(description="First node.")
+    end: Position = Field(description="Last node.")
+    divisions: integer("element count", lo=1) = Field(description="Number of elements.")
+
+    @model_validator(mode="after")
+    def _has_length(self):
+        if self.start == self.end:
+            raise problem("start and end are the same point",
+                          "give two different end points of the line")
+        return self
+
+
+class BeamSection(Section):
+    """[mesh.section]: the cross-section of beams and trusses."""
+
+    shape: Literal["rectangle", "circle"] = Field(description="Section shape.")
+    width: Optional[PositiveLength] = Field(
+        None, description="Rectangle: side along the section's local y (the "
+                          "orientation vector).")
+    height: Optional[PositiveLength] = Field(
+        None, description="Rectangle: side along the section's local z "
+                          "(line direction x orientation).")
+    diameter: Optional[PositiveLength] = Field(None, description="Circle: diameter.")
+    orientation: Direction = Field(
+        (0.0, 0.0, 1.0), description="The section's local y direction (beams); "
+                                     "must not be parallel to the line.")
+
+    @model_validator(mode="after")
+    def _dimensions_of_shape(self):
+        need = {"rectangle": ("width", "height"), "circle": ("diameter",)}[self.shape]
+        other = [k for k in ("width", "height", "diameter")
+                 if k not in need and getattr(self, k) is not None]
+        missing = [k for k in need if getattr(self, k) is None]
+        if missing:
+            example = " and ".join(f'{k} = "100 mm"' for k in missing)
+            raise problem(f"a {self.shape} section needs {' and '.join(missing)}",
+                          f"add {example}")
+        if other:
+            raise problem(f"{', '.join(other)} means nothing for a {self.shape} section",
+                          f"remove {', '.join(other)}")
+        return self
+
+
+class MeshGroup(Section):
+    """[[mesh.group]]: the material of a physical group / element set of the file."""
+
+    name: str = Field(description="Name of the group in the file (Gmsh physical "
+                                  "group, Abaqus ELSET).")
+    material: reference_to("material") = Field(description="Its material.")
+
+
+class Convert(Section):
+    """[mesh.convert]: elements of a region become SPH particles, coupled to the rest.
+
+    One particle per element, at its centroid, with the element's volume and
+    mass (thesis ch. 4); the particles form a body named like the mesh, with
+    the [sph] settings; h = sph.h_factor times V^(1/d).
+    """
+
+    region: Region = Field(description="Elements whose centroid lies in this region "
+                                        "become particles.")
+    coupling: Literal["penalty", "tied", "hybrid", "none"] = Field(
+        "penalty", description="How the particles meet the remaining mesh: penalty "
+        "(particles against the element faces, the wall's spring), tied (interface "
+        "particles constrained to the mesh), hybrid (a transition layer of elements "
+        "carrying particles), none.")
+    stiffness: Literal["mass", "bulk"] = Field(
+        "mass", description="Penalty stiffness: mass: k = alpha m/dt^2 (paper eq. 8); "
+                            "bulk: k = alpha K A/L (eq. 9).")
+    alpha: real("penalty factor", lo=0, lo_open=True) = Field(
+        0.1, description="Penalty factor alpha.")
+    friction: real("friction coefficient", lo=0) = Field(
+        0.0, description="Coulomb friction coefficient of the penalty coupling.")
+    thickness_factor: real("thickness factor", lo=0, lo_open=True) = Field(
+        0.5, description="Penalty contact thickness in units of the particle size "
+                         "V^(1/d).")
+
+    @model_validator(mode="after")
+    def _penalty_keys(self):
+        if self.coupling != "penalty":
+            given = [k for k in ("stiffness", "alpha", "friction", "thickness_factor")
+                     if getattr(self, k) != self.model_fields[k].default]
+            if given:
+                raise problem(f"{', '.join(given)} belong to the penalty coupling, not "
+                              f"to coupling = \"{self.coupling}\"",
+                              f"remove {', '.join(given)} or set coupling = \"penalty\"")
+        return self
+
+
+class Mesh(Section):
+    """[[mesh]]: a finite-element part."""
+
+    name: name_of("mesh") = Field(description="Name of the mesh (output block, "
+                                              "history columns).")
+    material: Optional[reference_to("material")] = Field(
+        None, description="Material of the elements (of those not in a "
+                          "[[mesh.group]]). Required unless groups cover the file.")
+    block: Optional[BlockMesh] = Field(None, description="A generated block of solid "
+                                                         "elements.")
+    line: Optional[LineMesh] = Field(None, description="A generated line of beams or "
+                                                       "trusses.")
+    file: Optional[ExistingFile] = Field(
+        None, description="A mesh file: Gmsh .msh (2.2 or 4.1) or Abaqus .inp, "
+                          "relative to the deck; hex8 in 3D, quad4 in 2D.")
+    length_unit: quantity(LENGTH, "length unit", lo=0, lo_open=True) = Field(
+        1.0, description="Length of one file coordinate unit (\"1 mm\" for a file "
+                         "in millimetres).")
+    group: tuple[MeshGroup, ...] = Field(
+        (), description="Materials of the file's element groups.")
+    element: Optional[Literal["beam", "truss"]] = Field(
+        None, description="Element of a [mesh.line]: beam (co-rotational, elastic) "
+                          "or truss (any material, uniaxial stress).")
+    section: Optional[BeamSection] = Field(None, description="Cross-section of a "
+                                                             "[mesh.line].")
+    integration: Literal["one_point", "selective_reduced"] = Field(
+        "one_point", description="Solid elements: one_point (uniform strain with "
+                                 "hourglass control, LS-DYNA's default) or "
+                                 "selective_reduced (fully integrated, B-bar).")
+    hourglass: Literal["viscous", "stiffness"] = Field(
+        "viscous", description="Flanagan-Belytschko hourglass control form "
+                               "(one_point).")
+    hourglass_coefficient: real("hourglass coefficient", lo=0, hi=0.5) = Field(
+        0.1, description="Hourglass coefficient Q_hg (LS-DYNA QH; 0 = off).")
+    q1: real("quadratic bulk viscosity", lo=0) = Field(
+        1.5, description="Quadratic bulk-viscosity coefficient.")
+    q2: real("linear bulk viscosity", lo=0) = Field(
+        0.06, description="Linear bulk-viscosity coefficient.")
+    cfl: real("element step factor", lo=0, hi=1, lo_open=True) = Field(
+        0.9, description="Factor on the element stable step (LS-DYNA TSSFAC).")
+    velocity: VelocityVector = Field((0.0, 0.0, 0.0),
+                                     description="Initial velocity of the nodes.")
+    damping: quantity(RATE, "damping coefficient", lo=0) = Field(
+        0.0, description="Mass-proportional damping c [1/s] on every node "
+                         "(a = -c v; 2 omega damps a mode of angular frequency "
+                         "omega critically): for quasi-static loading.")
+    convert: Optional[Convert] = Field(
+        None, description="A region of elements replaced by SPH particles.")
+
+    @model_validator(mode="after")
+    def _one_source(self):
+        given = [k for k in ("block", "line", "file") if getattr(self, k) is not None]
+        if len(given) != 1:
+            raise problem(
+                "a mesh needs exactly one source" + (
+                    f" (got {', '.join(given)})" if given else ""),
+                "give one of [mesh.block], [mesh.line] or file = \"part.msh\"")
+        if self.line is not None:
+            if self.element is None or self.section is None:
+                raise problem("a [mesh.line] needs element and [mesh.section]",
+                              "add element = \"beam\" (or \"truss\") and a "
+                              "[mesh.section] table")
+            if self.convert is not None:
+                raise problem("only solid elements can be converted to particles",
+                              "remove [mesh.convert] from the line mesh")
+        else:
+            extra = [k for k in ("element", "section") if getattr(self, k) is not None]
+            if extra:
+                raise problem(f"{', '.join(extra)} belong to a [mesh.line]",
+                              f"remove {', '.join(extra)} (solid elements: hex8 in 3D, "
+                              "quad4 in 2D)")
+        if self.group and self.file is None:
+            raise problem("[[mesh.group]] names groups of a mesh file",
+                          "remove [[mesh.group]] or read the mesh from a file")
+        if self.material is None and not self.group:
+            raise problem("the mesh has no material", "add material = \"<name>\"")
+        return self

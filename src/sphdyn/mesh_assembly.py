@@ -1,0 +1,138 @@
+"""Deck -> mesh parts and their interactions: boundaries, loads, damping, walls, couplings.
+
+Called by :func:`sphdyn.assembly.build_stepper` with the meshes of
+:mod:`sphdyn.mesh_model`. Names in the history: a boundary's reactions
+``<set>_reaction_x|y|z``, a load's ``<set>_force``, a mesh's damping
+``E_damping_<mesh>``, a wall on a mesh ``F_wall_<wall>_<mesh>``, a coupling
+``F_<mesh>_coupling``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from .deck import DeckError
+from .deck.errors import format_problem
+from .interactions import PenaltyCoupling, Wall
+from .interactions.nodal import MassDamping, NodalLoad, PrescribedMotion
+from .materials import get_model
+from .mesh_model import MeshModel
+from .parts import SolidSettings
+from .parts.fem import BeamSection, LinePart, solid_part
+from .state import BC_FIXED
+
+
+def _material(deck, k: int):
+    """``(model, packed params)`` of the deck's material ``k``."""
+    m = deck.material[k]
+    model = get_model(m.model)
+    return model, model.pack(m.values())
+
+
+def mesh_part(deck, mm: MeshModel):
+    """The solid or line part of one mesh (initial velocity set)."""
+    spec = mm.spec
+    if mm.element == "solid":
+        materials = {int(k): _material(deck, int(k)) for k in np.unique(mm.mat)}
+        settings = SolidSettings(
+            integration=spec.integration, hourglass=spec.hourglass,
+            hourglass_coefficient=spec.hourglass_coefficient, q1=spec.q1, q2=spec.q2,
+            cfl=spec.cfl)
+        part = solid_part(mm.name, mm.points, mm.cells, deck.run.dimension, materials,
+                          mat=mm.mat, settings=settings)
+    else:
+        sec = spec.section
+        section = (BeamSection.rectangle(sec.width, sec.height) if sec.shape == "rectangle"
+                   else BeamSection.circle(sec.diameter))
+        model, params = _material(deck, int(mm.mat[0]))
+        if mm.element == "beam" and model.name != "elastic":
+            raise DeckError([format_problem(
+                f"mesh[{mm.index}] '{mm.name}'.material", f"beams are elastic resultant "
+                f"beams; material model '{model.name}' is not elastic",
+                "use an elastic material, or element = \"truss\" for an inelastic bar")])
+        part = LinePart(mm.name, mm.points, mm.cells, element=mm.element, section=section,
+                        material=(model, params), orientation=sec.orientation,
+                        damping=spec.damping, dt_scale=spec.cfl)
+    part.kin.v[:] = np.asarray(spec.velocity, dtype=float)
+    return part
+
+
+def _unique(name: str, taken: set) -> str:
+    """``name``, or ``name_2``, ``name_3``... if taken (two conditions on one set)."""
+    out, k = name, 1
+    while out in taken:
+        k += 1
+        out = f"{name}_{k}"
+    taken.add(out)
+    return out
+
+
+def _target(model, sph_part, meshes: dict, set_name: str):
+    """The part and the indices (n,) of a [[set]]."""
+    if set_name in model.mesh_sets:
+        mesh, idx = model.mesh_sets[set_name]
+        return meshes[mesh], idx
+    return sph_part, model.sets[set_name]
+
+
+def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
+    """Prescribed motions, loads, damping, walls on meshes and the couplings."""
+    from .model import _plain_boundary
+
+    out, taken = [], set()
+    for k, bnd in enumerate(deck.boundary):
+        on_mesh = bnd.set in model.mesh_sets
+        if not on_mesh and _plain_boundary(bnd):
+            continue  # the particles' bc flags (sphdyn.model)
+        part, idx = _target(model, sph_part, meshes, bnd.set)
+        value = {"fixed": (0.0, 0.0, 0.0), "velocity": bnd.velocity,
+                 "displacement": bnd.displacement}[bnd.type]
+        out.append(PrescribedMotion(_unique(bnd.set, taken), part, idx, kind=bnd.type,
+                                    value=value, ramp_time=bnd.ramp_time, shape=bnd.ramp))
+        if bnd.rotations == "fixed":
+            rot = getattr(part.kin, "rot", None)
+            if rot is None:
+                raise DeckError([format_problem(
+                    f"boundary[{k}].rotations", f"set '{bnd.set}' has no rotational "
+                    "degrees of freedom (only beam nodes have)",
+                    "remove rotations (solid nodes and particles only translate)")])
+            rot.bc[idx] = BC_FIXED
+            rot.v[idx] = 0.0
+    for k, load in enumerate(deck.load):
+        part, idx = _target(model, sph_part, meshes, load.set)
+        out.append(NodalLoad(_unique(load.set, taken), part, idx, load.force,
+                             ramp_time=load.ramp_time, shape=load.ramp))
+    for mm in model.meshes:
+        part = meshes[mm.name]
+        if mm.element == "solid":
+            if mm.spec.damping > 0.0:
+                out.append(MassDamping(mm.name, part, np.arange(part.kin.n),
+                                       mm.spec.damping))
+            out += [Wall(replace(spec, name=f"{spec.name}_{mm.name}"), part)
+                    for spec in model.walls]
+        if mm.converted is not None:
+            out += _coupling(mm, sph_part, part)
+    return out
+
+
+def _coupling(mm: MeshModel, sph_part, part) -> list:
+    """The coupling of a mesh's converted particles with its remaining elements."""
+    conv = mm.converted.spec
+    where = f"mesh[{mm.index}] '{mm.name}'.convert.coupling"
+    if conv.coupling == "none":
+        return []
+    if conv.coupling != "penalty":
+        raise DeckError([format_problem(
+            where, f"coupling = \"{conv.coupling}\" is not available yet",
+            "use coupling = \"penalty\"")])
+    coupling = PenaltyCoupling(f"{mm.name}_coupling", sph_part, part,
+                               stiffness=conv.stiffness, alpha=conv.alpha,
+                               thickness_factor=conv.thickness_factor,
+                               friction=conv.friction)
+    if coupling.cand.size == 0:
+        raise DeckError([format_problem(
+            where, "the coupling finds no particle near the remaining elements' faces",
+            "make the converted region touch the rest of the mesh")])
+    return [coupling]

@@ -1,0 +1,185 @@
+"""Deck -> meshes: the [[mesh]] tables as node coordinates, connectivity and sets.
+
+With :mod:`sphdyn.model` (particles) and :mod:`sphdyn.assembly` (parts and
+interactions) the only place that reads the deck's meshes. Every problem is
+found here, before a part is made or a file written, and reported as a
+:class:`~sphdyn.deck.DeckError` line ``mesh[k]...: <what>. Fix: <what>``
+(exit status 2 on the command line): an unreadable file, an unknown group,
+inverted or degenerate elements (named by element id), a conversion region
+without elements, an empty node set.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .deck import DeckError
+from .deck.errors import format_problem
+from .geometry import select
+from .geometry.convert import element_centroids, elements_to_particles
+from .geometry.mesh import MeshData, block_mesh, check_elements, line_mesh, read_mesh
+
+#: Element kind of a solid mesh by dimension.
+SOLID_KIND = {3: "hex8", 2: "quad4"}
+
+
+@dataclass
+class Converted:
+    """Particles made of a mesh's converted elements (one per element).
+
+    ``x`` (k, 3) centroids [m], ``vol`` (k,) volumes [m^d], ``mat`` (k,)
+    deck material indices; ``coupling`` and its settings as in the deck.
+    """
+
+    x: np.ndarray
+    vol: np.ndarray
+    mat: np.ndarray
+    spec: object
+
+
+@dataclass
+class MeshModel:
+    """One [[mesh]] after reading, checking and conversion.
+
+    Attributes
+    ----------
+    name, index : the deck's name and table index.
+    element : ``"solid"``, ``"beam"`` or ``"truss"``.
+    kind : ``"hex8"``, ``"quad4"`` or ``"line2"``.
+    points : (N, 3) [m] the nodes (of the remaining mesh after a conversion).
+    cells : (E, nen) int64 connectivity.
+    mat : (E,) int32 deck material index of every element.
+    node_sets : dict name -> (n,) int64, the mesh file's node sets (renumbered).
+    spec : the deck's Mesh table.
+    converted : the particles made of a [mesh.convert] region, or None.
+    """
+
+    name: str
+    index: int
+    element: str
+    kind: str
+    points: np.ndarray
+    cells: np.ndarray
+    mat: np.ndarray
+    spec: object
+    node_sets: dict = field(default_factory=dict)
+    element_ids: np.ndarray | None = None
+    converted: Converted | None = None
+
+
+def _read(spec, where: str, dim: int) -> MeshData:
+    """The mesh of one [[mesh]] table (generated or read); DeckError if unreadable."""
+    if spec.block is not None:
+        b = spec.block
+        return block_mesh(b.lo, b.hi, b.divisions, dim)
+    if spec.line is not None:
+        return line_mesh(spec.line.start, spec.line.end, spec.line.divisions)
+    try:
+        mesh = read_mesh(spec.file, dim, kind=SOLID_KIND[dim])
+    except (ValueError, OSError, KeyError, IndexError) as exc:
+        raise DeckError([format_problem(
+            f"{where}.file", f"the mesh file cannot be used ({exc})",
+            f"give a Gmsh .msh (2.2 or 4.1) or Abaqus .inp file with "
+            f"{SOLID_KIND[dim]} elements")]) from None
+    if spec.length_unit != 1.0:
+        mesh.points *= spec.length_unit
+    return mesh
+
+
+def _materials(spec, mesh: MeshData, where: str, mat_index: dict) -> np.ndarray:
+    """(E,) deck material index of every element: groups first, then the mesh's."""
+    mat = np.full(mesh.n_elements, -1, np.int32)
+    for j, g in enumerate(spec.group):
+        if g.name not in mesh.element_sets:
+            known = ", ".join(sorted(mesh.element_sets)) or "none"
+            raise DeckError([format_problem(
+                f"{where}.group[{j}].name", f"the file has no element group '{g.name}'",
+                f"use one of its groups: {known} (names are case-sensitive)")])
+        mat[mesh.element_sets[g.name]] = mat_index[g.material]
+    if spec.material is not None:
+        mat[mat < 0] = mat_index[spec.material]
+    missing = np.flatnonzero(mat < 0)
+    if missing.size:
+        raise DeckError([format_problem(
+            f"{where}.material", f"{missing.size} element(s) are in no [[mesh.group]] "
+            f"(ids {mesh.element_ids[missing[:10]].tolist()})",
+            "add material = \"<name>\" for the elements outside the groups")])
+    return mat
+
+
+def _convert(spec, mesh: MeshData, mat: np.ndarray, where: str, dim: int):
+    """Split a mesh by [mesh.convert]: (the remaining mesh, its materials, Converted)."""
+    conv = spec.convert
+    centroids, _ = element_centroids(mesh.points, mesh.cells, mesh.kind)
+    chosen = select(centroids, conv.region.model_dump(), dim)
+    if chosen.size == 0:
+        raise DeckError([format_problem(
+            f"{where}.convert.region", "no element centroid lies in the region",
+            "enlarge the region so that it holds the elements to convert")])
+    if chosen.size == mesh.n_elements and conv.coupling != "none":
+        raise DeckError([format_problem(
+            f"{where}.convert.region", "every element lies in the region, so nothing "
+            f"is left to couple to (coupling = \"{conv.coupling}\")",
+            "shrink the region, or set coupling = \"none\"")])
+    mask = np.zeros(mesh.n_elements, bool)
+    mask[chosen] = True
+    x, vol, rest, kept = elements_to_particles(mesh.points, mesh.cells, mesh.kind, mask)
+    renumber = np.full(mesh.n_nodes, -1, np.int64)
+    renumber[kept] = np.arange(kept.size)
+    sets = {k: renumber[v][renumber[v] >= 0] for k, v in mesh.node_sets.items()}
+    remaining = MeshData(mesh.points[kept], rest, mesh.kind, node_sets=sets,
+                         element_ids=mesh.element_ids[~mask], node_ids=mesh.node_ids[kept],
+                         source=mesh.source)
+    return remaining, mat[~mask], Converted(x, vol, mat[mask].astype(np.int32), conv)
+
+
+def build_meshes(deck) -> list[MeshModel]:
+    """Every [[mesh]] of a validated deck, read, checked and converted.
+
+    Raises :class:`~sphdyn.deck.DeckError` naming the table and the fix.
+    """
+    dim = deck.run.dimension
+    mat_index = {m.name: k for k, m in enumerate(deck.material)}
+    out = []
+    for k, spec in enumerate(deck.mesh):
+        where = f"mesh[{k}] '{spec.name}'"
+        mesh = _read(spec, where, dim)
+        try:
+            check_elements(mesh)
+        except ValueError as exc:
+            raise DeckError([format_problem(
+                where, str(exc), "fix the mesh (the ids are the file's element "
+                "numbers, 1-based positions for generated meshes)")]) from None
+        mat = _materials(spec, mesh, where, mat_index)
+        converted = None
+        if spec.convert is not None:
+            mesh, mat, converted = _convert(spec, mesh, mat, where, dim)
+        element = "solid" if spec.line is None else spec.element
+        out.append(MeshModel(
+            name=spec.name, index=k, element=element, kind=mesh.kind,
+            points=mesh.points, cells=mesh.cells, mat=mat, spec=spec,
+            node_sets=mesh.node_sets, element_ids=mesh.element_ids, converted=converted))
+    return out
+
+
+def mesh_node_set(meshes: list[MeshModel], s, k: int, dim: int) -> tuple[MeshModel, np.ndarray]:
+    """The mesh and node indices (n,) of a [[set]] with ``mesh``; DeckError if empty."""
+    mm = next(m for m in meshes if m.name == s.mesh)
+    idx = np.arange(mm.points.shape[0], dtype=np.int64)
+    if s.group is not None:
+        if s.group not in mm.node_sets:
+            known = ", ".join(sorted(mm.node_sets)) or "none"
+            raise DeckError([format_problem(
+                f"set[{k}] '{s.name}'.group", f"mesh '{mm.name}' has no group '{s.group}'",
+                f"use one of its groups: {known} (names are case-sensitive)")])
+        idx = mm.node_sets[s.group]
+    if s.region is not None:
+        idx = idx[select(mm.points[idx], s.region.model_dump(), dim)]
+    if idx.size == 0:
+        raise DeckError([format_problem(
+            f"set[{k}] '{s.name}'", f"the set holds no node of mesh '{mm.name}'",
+            "enlarge the region (nodes are selected by their initial position; "
+            "a box must contain them, edges included) or check the group")])
+    return mm, idx.astype(np.int64)
