@@ -87,10 +87,21 @@ def cmd_run(args) -> int:
     out = Path(args.out) if args.out else Path("out") / Path(args.deck).stem
     _writable_dir(out, "--out")
     sim = Simulation.from_deck(deck, out)
-    print(f"sphdyn: {sim.particles.n} particles, {deck.run.dimension}D, "
+    print(f"sphdyn: {sim.particles.n} particles{_mesh_counts(sim.model)}, "
+          f"{deck.run.dimension}D, "
           f"t_end = {deck.run.t_end:g} s, initial dt = {sim.stepper.dt0:.3e} s -> {out}")
     return _finish(sim.run(max_steps=args.max_steps, progress=not args.quiet and None,
                            threads=args.threads), out)
+
+
+def _mesh_counts(model) -> str:
+    """``", 2 meshes (1200 elements, 1500 nodes)"``, or nothing without meshes."""
+    if not model.meshes:
+        return ""
+    ne = sum(m.cells.shape[0] for m in model.meshes)
+    nn = sum(m.points.shape[0] for m in model.meshes)
+    k = len(model.meshes)
+    return f", {k} mesh{'es' if k > 1 else ''} ({ne} elements, {nn} nodes)"
 
 
 def cmd_restart(args) -> int:
@@ -157,8 +168,9 @@ def cmd_check(args) -> int:
     limit, source = memory_limit(deck)
     print(f"{args.deck}: OK")
     print(f"  {deck.run.dimension}D, t_end = {deck.run.t_end:g} s, {p.n} particles in "
-          f"{len(model.body_names)} bodies, {len(deck.material)} materials, "
-          f"{len(model.walls)} walls, sets {sorted(model.sets) or '-'}")
+          f"{len(model.body_names)} bodies{_mesh_counts(model)}, "
+          f"{len(deck.material)} materials, "
+          f"{len(model.walls)} walls, sets {sorted(model.sets) + sorted(model.mesh_sets) or '-'}")
     print(f"  estimate: {estimate.summary()}; memory limit {show_bytes(limit)} "
           f"({source})")
     if args.resolved:

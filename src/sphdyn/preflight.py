@@ -31,6 +31,9 @@ PARTICLE_BYTES = 1000
 #: Bytes per neighbour pair: index and two float32 factors (12), rounded up
 #: for the lists being rebuilt beside the old ones.
 PAIR_BYTES = 16
+#: Bytes per hex8 element of a generated mesh, node and point arrays included:
+#: 1.50 kB marginal peak RSS measured for hex3d (BENCHMARKS.md), rounded up.
+ELEMENT_BYTES = 1600
 #: Share of the machine's memory a deck may use without ``run.memory_limit``.
 DEFAULT_MEMORY_SHARE = 0.5
 #: A particle of one body closer than this many of its spacings inside another
@@ -142,18 +145,26 @@ class SizeEstimate:
     pairs_per_particle: float
     bytes_particles: float
     bytes_neighbours: float
+    #: mesh name -> element count of the generated meshes (files: not counted)
+    meshes: dict = None
+
+    @property
+    def bytes_meshes(self) -> float:
+        return ELEMENT_BYTES * float(sum((self.meshes or {}).values()))
 
     @property
     def bytes(self) -> float:
         """Estimated memory of the model [bytes]."""
-        return self.bytes_particles + self.bytes_neighbours
+        return self.bytes_particles + self.bytes_neighbours + self.bytes_meshes
 
     def summary(self) -> str:
         """One line: particles, neighbours and memory."""
+        meshes = (f" + {show_count(sum(self.meshes.values()))} elements "
+                  f"{show_bytes(self.bytes_meshes)}" if self.meshes else "")
         return (f"about {show_count(self.particles)} particles, {self.pairs_per_particle:.0f} "
                 f"neighbours each, {show_bytes(self.bytes)} (particles "
                 f"{show_bytes(self.bytes_particles)} + neighbour lists "
-                f"{show_bytes(self.bytes_neighbours)})")
+                f"{show_bytes(self.bytes_neighbours)}{meshes})")
 
 
 def _history_width(deck) -> int:
@@ -182,8 +193,10 @@ def estimate_size(deck) -> SizeEstimate:
               * (1.0 + sph.neighbours.skin_factor))
     pairs = ball_volume(radius, dim)
     per_particle = PARTICLE_BYTES + 8 * _history_width(deck)
+    meshes = {m.name: float(np.prod(m.block.divisions)) if m.block is not None
+              else float(m.line.divisions) for m in deck.mesh if m.file is None}
     return SizeEstimate(bodies, n, pairs, n * per_particle,
-                        n * pairs * PAIR_BYTES if n and pairs else 0.0)
+                        n * pairs * PAIR_BYTES if n and pairs else 0.0, meshes)
 
 
 def check_size(deck) -> SizeEstimate:
@@ -191,6 +204,16 @@ def check_size(deck) -> SizeEstimate:
     est = estimate_size(deck)
     limit, source = memory_limit(deck)
     if not est.bytes <= limit:  # nan (inf * 0) counts as too large
+        if est.meshes and est.bytes_meshes >= est.bytes_particles:
+            k = max(range(len(deck.mesh)), key=lambda j: est.meshes.get(deck.mesh[j].name, 0))
+            m = deck.mesh[k]
+            raise DeckError([format_problem(
+                f"mesh[{k}].{'block' if m.block is not None else 'line'}.divisions",
+                f"the model needs {est.summary()}, over the memory limit of "
+                f"{show_bytes(limit)} ({source}); mesh '{m.name}' alone has "
+                f"{show_count(est.meshes[m.name])} elements",
+                "use fewer divisions, or raise run.memory_limit above "
+                f"{show_bytes(est.bytes)} if the machine has that memory")])
         b = max(range(len(deck.body)), key=lambda k: est.bodies[deck.body[k].name])
         big = deck.body[b]
         raise DeckError([format_problem(

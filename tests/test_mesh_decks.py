@@ -1,0 +1,396 @@
+"""Finite-element parts from decks: [[mesh]], mesh node sets, boundaries, loads, walls.
+
+What is pinned here, with its tolerance:
+
+* a bar of hexes (nu = 0) pulled slowly by a prescribed displacement from a
+  deck: both reactions equal E A d / L within 0.5 % (uniform strain is exact
+  in one-point hexes; what is left is the ringing after the smooth ramp,
+  damped by the deck's mass damping);
+* a cantilever of beams from [mesh.line] with a [[load]] at its tip and a
+  clamped root (rotations fixed): the tip deflection P L^3 / (3 E I) within
+  2 % with I of the section's local z side (width along the orientation
+  vector, height across): swapping the two would be 4x off;
+* a mesh read from an Abaqus file with two element groups of two materials
+  gives the nodal masses of the groups' densities (1e-12) and the same
+  motion as the generated block (bitwise, same node order);
+* [mesh.convert]: one particle per converted element, the total mass of
+  particles and remaining elements equals the whole mesh's (1e-12);
+* a wall on mesh nodes: the momentum change of the mesh equals the wall's
+  impulse column (1e-9 relative);
+* restart of a run with a mesh continues bitwise;
+* output: the mesh block in the .pvd, .vtu and .h5 frames with its cell
+  fields, the reactions in the history and plots/reactions.png;
+* bad input: a missing or unreadable mesh file, an inverted element (named
+  by id), an unknown group, an empty node set, a conversion region without
+  elements, rotations on solid nodes, a probe of mesh nodes: each a clear
+  error naming the field, exit status 2, nothing written.
+"""
+
+from __future__ import annotations
+
+import json
+
+import meshio
+import numpy as np
+import pytest
+
+from sphdyn.assembly import build_stepper
+from sphdyn.cli import main
+from sphdyn.deck import DeckError, loads_deck
+from sphdyn.geometry.mesh import block_mesh
+from sphdyn.guards import SimulationFailed
+from sphdyn.io import read_checkpoint, read_frame_meshes, read_history_csv
+from sphdyn.model import build_model
+from sphdyn.simulation import Simulation
+
+E, RHO = 210e9, 7850.0
+C_BAR = np.sqrt(E / RHO)
+
+MATERIALS = f"""
+[[material]]
+name = "steel"
+model = "elastic"
+density = {RHO}
+E = {E}
+nu = 0.0
+[[material]]
+name = "heavy"
+model = "elastic"
+density = {2 * RHO}
+E = {E}
+nu = 0.0
+"""
+
+#: a 1 m bar of 10 x 1 x 1 hexes (0.1 m square), left end fixed, right end
+#: pulled 0.1 mm along x over a smooth ramp of 2 ms, damped
+BAR = """
+[run]
+dimension = 3
+t_end = "{t_end}"
+{materials}
+[[mesh]]
+name = "bar"
+material = "steel"
+damping = "{damping}"
+{source}
+[[set]]
+name = "left"
+mesh = "bar"
+region = {{shape = "box", lo = [-0.001, -1, -1], hi = [0.001, 1, 1]}}
+[[set]]
+name = "right"
+mesh = "bar"
+region = {{shape = "box", lo = [0.999, -1, -1], hi = [1.001, 1, 1]}}
+[[boundary]]
+set = "left"
+type = "fixed"
+[[boundary]]
+set = "right"
+type = "displacement"
+displacement = ["0.1 mm", 0, 0]
+ramp_time = "2 ms"
+ramp = "smooth"
+[output]
+every = "{every}"
+progress = false
+{extra}
+"""
+BLOCK = 'block = {lo = [0, 0, 0], hi = [1, 0.1, 0.1], divisions = [10, 1, 1]}'
+
+
+def bar_deck(t_end="3 ms", every="1 ms", source=BLOCK, damping="5000 1/s", extra="",
+             base_dir="."):
+    return loads_deck(BAR.format(t_end=t_end, every=every, source=source, damping=damping,
+                                 materials=MATERIALS, extra=extra), base_dir=base_dir)
+
+
+def test_bar_reactions_from_a_deck_equal_EA_d_over_L(tmp_path):
+    sim = Simulation.from_deck(bar_deck(), tmp_path / "bar")
+    summary = sim.run()
+    assert summary["status"] == "completed"
+    h = read_history_csv(tmp_path / "bar/history.csv")
+    expected = E * 0.1 * 0.1 * 1e-4 / 1.0
+    assert h["right_reaction_x"][-1] == pytest.approx(expected, rel=5e-3)
+    assert h["left_reaction_x"][-1] == pytest.approx(-expected, rel=5e-3)
+    # quasi-static at the end: the kinetic energy is a tiny part of the internal
+    assert h["KE_IE_ratio"][-1] < 1e-3
+    # output: the mesh block beside the (empty) particle block
+    pvd = (tmp_path / "bar/particles.pvd").read_text()
+    assert 'name="bar"' in pvd
+    vtus = sorted((tmp_path / "bar/vtk/bar").glob("frame_*.vtu"))
+    m = meshio.read(vtus[-1])
+    assert m.cells[0].type == "hexahedron" and len(m.cells[0].data) == 10
+    for name in ("stress", "von_mises", "hourglass_energy", "damage"):
+        assert name in m.cell_data, name
+    assert np.allclose(m.point_data["displacement"][:, 0].max(), 1e-4, rtol=1e-9)
+    meshes = read_frame_meshes(sorted((tmp_path / "bar/frames").glob("*.h5"))[-1])
+    assert meshes["bar"].cells.shape == (10, 8)
+    assert meshes["bar"].cell_data["stress"].shape == (10, 3, 3)
+    assert (tmp_path / "bar/plots/reactions.png").is_file()
+    info = json.loads((tmp_path / "bar/summary.json").read_text())
+    assert info["meshes"] == {"bar": {"nodes": 44, "elements": 10}}
+
+
+def _abaqus(path, groups: bool):
+    """The BAR block written as an Abaqus file (same node and element order);
+    with ``groups`` the first 5 elements in ELSET LEFT, the rest in RIGHT."""
+    ref = block_mesh((0, 0, 0), (1, 0.1, 0.1), (10, 1, 1), 3)
+    lines = ["*NODE"] + [f"{i + 1}, " + ", ".join(repr(float(v)) for v in p)
+                         for i, p in enumerate(ref.points)]
+    lines += ["*ELEMENT, TYPE=C3D8R, ELSET=ALL"]
+    lines += [f"{k + 1}, " + ", ".join(str(n + 1) for n in c) for k, c in enumerate(ref.cells)]
+    if groups:
+        lines += ["*ELSET, ELSET=LEFT", "1, 2, 3, 4, 5", "*ELSET, ELSET=RIGHT",
+                  "6, 7, 8, 9, 10"]
+    path.write_text("\n".join(lines) + "\n")
+    return ref
+
+
+def test_abaqus_file_with_groups_gives_the_block_and_the_groups_materials(tmp_path):
+    ref = _abaqus(tmp_path / "bar.inp", groups=True)
+    source = ('file = "bar.inp"\n[[mesh.group]]\nname = "LEFT"\nmaterial = "steel"\n'
+              '[[mesh.group]]\nname = "RIGHT"\nmaterial = "heavy"')
+    deck = bar_deck(source=source, base_dir=tmp_path)
+    part = build_stepper(deck).part("bar")
+    vol = 0.01 * 0.1
+    share = np.zeros(ref.n_nodes)
+    for k, c in enumerate(ref.cells):
+        share[c] += (RHO if k < 5 else 2 * RHO) * vol / 8
+    assert np.allclose(part.nodes.m, share, rtol=1e-12, atol=0)
+    # a file without groups moves exactly as the generated block
+    _abaqus(tmp_path / "plain.inp", groups=False)
+    a = build_stepper(bar_deck(source='file = "plain.inp"', base_dir=tmp_path))
+    b = build_stepper(bar_deck())
+    for _ in range(30):
+        a.step()
+        b.step()
+    assert np.array_equal(a.part("bar").nodes.x, b.part("bar").nodes.x)
+
+
+CANTILEVER = """
+[run]
+dimension = 3
+t_end = "{t_end}"
+{materials}
+[[mesh]]
+name = "rod"
+material = "steel"
+element = "beam"
+line = {{start = [0, 0, 0], end = [1, 0, 0], divisions = 20}}
+section = {{shape = "rectangle", width = "40 mm", height = "80 mm", orientation = [0, 1, 0]}}
+damping = "{damping}"
+[[set]]
+name = "root"
+mesh = "rod"
+region = {{shape = "box", lo = [-0.001, -1, -1], hi = [0.001, 1, 1]}}
+[[set]]
+name = "tip"
+mesh = "rod"
+region = {{shape = "box", lo = [0.999, -1, -1], hi = [1.001, 1, 1]}}
+[[boundary]]
+set = "root"
+type = "fixed"
+rotations = "fixed"
+[[load]]
+set = "tip"
+force = [0, 0, "-1 kN"]
+ramp_time = "{ramp}"
+ramp = "smooth"
+[output]
+progress = false
+vtk = false
+"""
+
+
+def test_cantilever_of_beams_from_a_deck_deflects_as_PL3_over_3EI():
+    # I about the local y axis: the height (80 mm) runs along local z = x X y
+    # = global z, the load's direction: I = b h^3 / 12
+    i_y = 0.04 * 0.08 ** 3 / 12.0
+    m_line = RHO * 0.04 * 0.08
+    omega1 = 1.875 ** 2 * np.sqrt(E * i_y / (m_line * 1.0 ** 4))  # first bending mode
+    period = 2 * np.pi / omega1
+    deck = loads_deck(CANTILEVER.format(materials=MATERIALS, damping=f"{2 * omega1} 1/s",
+                                        ramp=f"{3 * period} s", t_end=f"{6 * period} s"))
+    s = build_stepper(deck)
+    while s.t < deck.run.t_end:
+        s.step(t_stop=deck.run.t_end)
+    rod = s.part("rod")
+    tip = np.argmax(rod.kin.x0[:, 0])
+    expected = 1000.0 * 1.0 ** 3 / (3 * E * i_y)
+    assert -rod.kin.x[tip, 2] == pytest.approx(expected, rel=0.02)
+    assert abs(rod.kin.x[tip, 1]) < 1e-6 * expected  # no sideways bending
+    assert s.record()["tip_force"] == pytest.approx(1000.0)
+
+
+def test_converted_region_keeps_the_mass_and_gives_one_particle_per_element():
+    source = BLOCK + ('\nconvert = {region = {shape = "box", lo = [0.3, -1, -1], '
+                      'hi = [0.7, 1, 1]}}')
+    deck = bar_deck(source=source)
+    model = build_model(deck)
+    s = build_stepper(deck, model)
+    assert model.particles.n == 4  # element centroids at x = 0.35 .. 0.65
+    assert model.body_names == ["bar"]
+    total = s.part("bar").nodes.m.sum() + model.particles.m.sum()
+    assert total == pytest.approx(RHO * 0.01, rel=1e-12)
+    assert np.allclose(model.particles.vol0, 1e-3, rtol=1e-12)
+    assert [i.name for i in s.interactions][-1] == "bar_coupling"
+
+
+FALLING = """
+[run]
+dimension = 3
+t_end = "{t_end}"
+{materials}
+[[mesh]]
+name = "cube"
+material = "steel"
+block = {{lo = [0, 0.001, 0], hi = [0.1, 0.101, 0.1], divisions = [2, 2, 2]}}
+velocity = [0, "-5 m/s", 0]
+[[wall]]
+name = "floor"
+point = [0, 0, 0]
+normal = [0, 1, 0]
+[output]
+progress = false
+vtk = false
+history_every = 1
+"""
+
+
+def test_wall_on_mesh_nodes_gives_the_impulse_of_the_momentum_change():
+    deck = loads_deck(FALLING.format(materials=MATERIALS, t_end="0.5 ms"))
+    s = build_stepper(deck)
+    q = s.part("cube").kin
+    p0 = (q.m[:, None] * q.v).sum(axis=0)
+    hit = 0
+    while s.t < deck.run.t_end:
+        s.step(t_stop=deck.run.t_end)
+        hit = max(hit, s.record()["contacts_floor_cube"])
+    assert hit > 0
+    # the kick's velocities are v^{n+1/2}: their momentum minus the initial
+    # one is the sum of the wall's F dt_kick, the impulse column
+    p1 = (q.m[:, None] * q.v).sum(axis=0)
+    impulse = s.record()["I_wall_floor_cube"]
+    assert impulse > 0.5 * q.m.sum() * 5.0  # the cube did bounce
+    assert p1[1] - p0[1] == pytest.approx(impulse, rel=1e-9)
+
+
+def test_restart_with_a_mesh_is_bitwise(tmp_path):
+    full = Simulation.from_deck(bar_deck(t_end="0.6 ms", every="0.2 ms"), tmp_path / "full")
+    full.run()
+    part = Simulation.from_deck(bar_deck(t_end="0.6 ms", every="0.2 ms",
+                                         extra="checkpoint_every = 10"), tmp_path / "part")
+    part.run(max_steps=25)
+    assert 0 < read_checkpoint(tmp_path / "part/checkpoint.h5")[1]["t"] < 6e-4
+    assert main(["restart", str(tmp_path / "part"), "-q"]) == 0
+    m_full = read_frame_meshes(sorted((tmp_path / "full/frames").glob("*.h5"))[-1])["bar"]
+    m_part = read_frame_meshes(sorted((tmp_path / "part/frames").glob("*.h5"))[-1])["bar"]
+    assert np.array_equal(m_full.points, m_part.points)
+    for data in ("point_data", "cell_data"):
+        for key, arr in getattr(m_full, data).items():
+            assert np.array_equal(arr, getattr(m_part, data)[key]), key
+    h_full = read_history_csv(tmp_path / "full/history.csv")
+    h_part = read_history_csv(tmp_path / "part/history.csv")
+    assert np.array_equal(h_full["right_reaction_x"], h_part["right_reaction_x"])
+    assert np.array_equal(h_full["E_total"], h_part["E_total"])
+
+
+def test_nan_on_a_node_stops_the_run_naming_the_mesh(tmp_path):
+    sim = Simulation.from_deck(bar_deck(), tmp_path / "nan")
+    nodes = sim.stepper.part("bar").nodes
+    nodes.v[np.argmin(np.abs(nodes.x0[:, 0] - 0.5)), 1] = np.nan  # a free node
+    with pytest.raises(SimulationFailed, match="node\\(s\\) of mesh 'bar'"):
+        sim.run(max_steps=5)
+    assert (tmp_path / "nan/history.csv").is_file()
+
+
+# ------------------------------------------------------------------ bad input
+def _bad(tmp_path, text: str, path: str, words: list[str], capsys):
+    deck = tmp_path / "bad.toml"
+    deck.write_text(text)
+    out = tmp_path / "out"
+    assert main(["run", str(deck), "--out", str(out), "-q"]) == 2
+    err = capsys.readouterr().err
+    line = next((ln for ln in err.splitlines() if path in ln), None)
+    assert line is not None, err
+    for w in words:
+        assert w in line, (w, line)
+    assert "Fix:" in line
+    assert not out.exists()
+
+
+def _bar_text(source=BLOCK, extra=""):
+    return BAR.format(t_end="1 ms", every="1 ms", source=source, damping="0 1/s",
+                      materials=MATERIALS, extra=extra)
+
+
+def test_missing_mesh_file_is_refused(tmp_path, capsys):
+    _bad(tmp_path, _bar_text(source='file = "nowhere.msh"'), "mesh[0].file",
+         ["does not exist"], capsys)
+
+
+def test_unreadable_mesh_file_is_refused(tmp_path, capsys):
+    (tmp_path / "junk.msh").write_text("this is not a mesh\n")
+    _bad(tmp_path, _bar_text(source='file = "junk.msh"'), "mesh[0] 'bar'.file",
+         ["cannot be used"], capsys)
+
+
+def test_inverted_element_is_named_by_id(tmp_path, capsys):
+    ref = _abaqus(tmp_path / "bar.inp", groups=False)
+    text = (tmp_path / "bar.inp").read_text().splitlines()
+    k = text.index("*ELEMENT, TYPE=C3D8R, ELSET=ALL") + 7  # element 7
+    c = ref.cells[6] + 1
+    mirrored = np.concatenate([c[4:], c[:4]])  # top and bottom faces swapped
+    text[k] = "7, " + ", ".join(map(str, mirrored))
+    (tmp_path / "bar.inp").write_text("\n".join(text) + "\n")
+    _bad(tmp_path, _bar_text(source='file = "bar.inp"'), "mesh[0] 'bar'",
+         ["inverted", "ids 7"], capsys)
+
+
+def test_unknown_group_is_refused(tmp_path, capsys):
+    _abaqus(tmp_path / "bar.inp", groups=True)
+    source = 'file = "bar.inp"\n[[mesh.group]]\nname = "MIDDLE"\nmaterial = "steel"'
+    _bad(tmp_path, _bar_text(source=source), "mesh[0] 'bar'.group[0].name",
+         ["no element group 'MIDDLE'", "LEFT"], capsys)
+
+
+def test_empty_node_set_is_refused(tmp_path, capsys):
+    text = _bar_text().replace("lo = [0.999, -1, -1], hi = [1.001, 1, 1]",
+                               "lo = [2, -1, -1], hi = [3, 1, 1]")
+    _bad(tmp_path, text, "set[1] 'right'", ["holds no node"], capsys)
+
+
+def test_conversion_region_without_elements_is_refused(tmp_path, capsys):
+    source = BLOCK + '\nconvert = {region = {shape = "box", lo = [5, 5, 5], hi = [6, 6, 6]}}'
+    _bad(tmp_path, _bar_text(source=source), "mesh[0] 'bar'.convert.region",
+         ["no element centroid"], capsys)
+
+
+def test_rotations_on_solid_nodes_are_refused(tmp_path, capsys):
+    text = _bar_text().replace('type = "fixed"\n', 'type = "fixed"\nrotations = "fixed"\n', 1)
+    _bad(tmp_path, text, "boundary[0].rotations", ["no rotational"], capsys)
+
+
+def test_probe_of_mesh_nodes_is_refused(tmp_path, capsys):
+    text = _bar_text(extra="") + '\n[[probe]]\nset = "left"\nquantities = ["velocity_x"]\n'
+    _bad(tmp_path, text, "probe[0].set", ["mesh nodes"], capsys)
+
+
+def test_huge_generated_mesh_is_refused_before_it_is_made(tmp_path, capsys):
+    source = 'block = {lo = [0, 0, 0], hi = [1, 0.1, 0.1], divisions = [100000, 1000, 1000]}'
+    _bad(tmp_path, _bar_text(source=source), "mesh[0].block.divisions",
+         ["memory limit", "1e+11 elements"], capsys)
+
+
+def test_deck_schema_refuses_inconsistent_meshes(tmp_path):
+    (tmp_path / "x.msh").write_text("")
+    with pytest.raises(DeckError, match="exactly one source"):
+        bar_deck(source=BLOCK + '\nfile = "x.msh"', base_dir=tmp_path)
+    with pytest.raises(DeckError, match="needs element and"):
+        bar_deck(source='line = {start = [0, 0, 0], end = [1, 0, 0], divisions = 4}')
+    with pytest.raises(DeckError, match="divisions has 2 entries"):
+        bar_deck(source='block = {lo = [0, 0, 0], hi = [1, 1, 1], divisions = [2, 2]}')
+    with pytest.raises(DeckError, match="displacement boundary needs a ramp_time"):
+        loads_deck(_bar_text().replace('ramp_time = "2 ms"', ""))
+    with pytest.raises(DeckError, match="no \\[\\[body\\]\\] table"):
+        loads_deck('[run]\ndimension = 3\nt_end = 1.0\n' + MATERIALS)
