@@ -79,13 +79,8 @@ def _target(model, sph_part, meshes: dict, set_name: str):
 
 def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
     """Prescribed motions, loads, damping, walls on meshes and the couplings."""
-    from .model import _plain_boundary
-
     out, taken = [], set()
     for k, bnd in enumerate(deck.boundary):
-        on_mesh = bnd.set in model.mesh_sets
-        if not on_mesh and _plain_boundary(bnd):
-            continue  # the particles' bc flags (sphdyn.model)
         part, idx = _target(model, sph_part, meshes, bnd.set)
         value = {"fixed": (0.0, 0.0, 0.0), "velocity": bnd.velocity,
                  "displacement": bnd.displacement}[bnd.type]
@@ -104,6 +99,10 @@ def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
         part, idx = _target(model, sph_part, meshes, load.set)
         out.append(NodalLoad(_unique(load.set, taken), part, idx, load.force,
                              ramp_time=load.ramp_time, shape=load.ramp))
+    for b, body in enumerate(deck.body):
+        if body.damping > 0.0:
+            out.append(MassDamping(body.name, sph_part,
+                                   np.flatnonzero(sph_part.p.body == b), body.damping))
     for mm in model.meshes:
         part = meshes[mm.name]
         if mm.element == "solid":
@@ -113,6 +112,11 @@ def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
             out += [Wall(replace(spec, name=f"{spec.name}_{mm.name}"), part)
                     for spec in model.walls]
         if mm.converted is not None:
+            if mm.spec.damping > 0.0:  # the converted particles are damped alike
+                b = model.body_names.index(mm.name)
+                out.append(MassDamping(f"{mm.name}_particles", sph_part,
+                                       np.flatnonzero(sph_part.p.body == b),
+                                       mm.spec.damping))
             out += _coupling(mm, sph_part, part)
     return out
 

@@ -25,7 +25,7 @@ from .preflight import checked_lattices
 from .materials import MaterialGroup, get_model
 from .mesh_model import MeshModel, build_meshes, mesh_node_set
 from .probes import Probe, quantity
-from .state import BC_FIXED, BC_VELOCITY, Particles
+from .state import Particles
 
 
 @dataclass
@@ -277,18 +277,6 @@ def build_model(deck) -> Model:
         region = None if s.region is None else s.region.model_dump()
         sel = select(particles.x[cand], region, dim)
         sets[s.name] = cand[sel].astype(np.int64)
-    for bnd in deck.boundary:
-        if bnd.set in mesh_sets or not _plain_boundary(bnd):
-            continue  # a prescribed motion (sphdyn.assembly)
-        idx = sets[bnd.set]
-        if bnd.type == "fixed":
-            particles.bc[idx] = BC_FIXED
-            particles.v[idx] = 0.0
-        else:
-            particles.bc[idx] = BC_VELOCITY
-            particles.bc_v[idx] = np.asarray(bnd.velocity, dtype=float)
-            particles.v[idx] = particles.bc_v[idx]
-
     probes = []
     for k, pr in enumerate(deck.probe):
         if pr.set in mesh_sets:
@@ -323,12 +311,6 @@ def build_model(deck) -> Model:
         probes=probes, phase=np.concatenate(phase_parts + [np.zeros(0, np.int8)]),
         photo_targets=photos, variation=factor, mass_draws=draws, meshes=meshes,
         mesh_sets=mesh_sets)
-
-
-def _plain_boundary(bnd) -> bool:
-    """A boundary the particles' ``bc`` flags hold alone: fixed, or a constant
-    velocity from the start (ramps and displacements are prescribed motions)."""
-    return bnd.type == "fixed" or (bnd.type == "velocity" and bnd.ramp_time == 0.0)
 
 
 def _converted_name(mm: MeshModel, taken: list[str]) -> str:

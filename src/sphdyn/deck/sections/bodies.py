@@ -11,7 +11,7 @@ from pydantic import BeforeValidator, Field, field_validator, model_validator
 
 from ..expressions import ExpressionError, check_expression
 from ..messages import problem, show, show_number
-from ..units import LENGTH
+from ..units import LENGTH, RATE
 from ..values import (Corner, Direction, ExistingFile, Position, PositiveLength, Section,
                       UpperCorner, Vector, VelocityVector, integer, name_of, quantity,
                       real, reference_to)
@@ -369,6 +369,9 @@ class Body(Section):
     initial: Optional[InitialFields] = Field(
         None, description="Initial velocity and stress varying with position "
                           "(expressions or a file).")
+    damping: quantity(RATE, "damping coefficient", lo=0) = Field(
+        0.0, description="Mass-proportional damping c [1/s] of the body's particles "
+                         "(a = -c v) for quasi-static loading, as [[mesh]] damping.")
 
     @model_validator(mode="after")
     def _mesostructure_resolved(self):

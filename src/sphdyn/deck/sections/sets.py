@@ -66,8 +66,9 @@ class Boundary(Section):
                          "over this time (0: at once). A displacement with "
                          "ramp_time = 0 is refused (an infinite velocity).")
     ramp: Literal["linear", "smooth"] = Field(
-        "linear", description="Ramp shape: linear, or smooth (3s^2 - 2s^3: no jump "
-                              "of acceleration, less ringing).")
+        "linear", description="Ramp shape: linear, or smooth (s - sin(2 pi s)/(2 pi) "
+                              "with s = t/ramp_time: a displacement starts and ends "
+                              "at rest, less ringing).")
     rotations: Literal["free", "fixed"] = Field(
         "free", description="Beam nodes: also fix their rotations (a clamped or "
                             "rotation-free moved end).")
