@@ -45,11 +45,17 @@ CASES: dict[str, tuple[int, list[str]]] = {
     "ucs_homogeneous": (40, ['body.0.dx="5 mm"']),
     "ucs_mesostructure": (40, ['body.0.dx="5 mm"',
                                'body.0.mesostructure.itz_thickness="5 mm"']),
+    "beam_fem": (40, ["mesh.beam.block.divisions=[40, 2, 2]"]),
+    "beam_penalty": (40, ["mesh.beam.block.divisions=[40, 2, 2]"]),
+    "beam_tied": (40, ["mesh.beam.block.divisions=[40, 2, 2]"]),
+    "beam_hybrid": (40, ["mesh.beam.block.divisions=[40, 2, 2]"]),
+    "beam_sph": (40, ['body.beam.dx="125 mm"']),
 }
 
 
 def run_case(name: str, outdir: Path) -> dict[str, np.ndarray]:
-    """Run one example deck; returns ``particle/<field>`` and ``history/<column>``."""
+    """Run one example deck; returns ``particle/<field>``, ``mesh/<part>/<field>``
+    (node kinematics) and ``history/<column>``."""
     import numba
 
     from sphdyn.deck import load_deck
@@ -61,6 +67,10 @@ def run_case(name: str, outdir: Path) -> dict[str, np.ndarray]:
     sim = Simulation.from_deck(deck, outdir)
     sim.run(max_steps=steps, progress=False)
     out = {f"particle/{k}": np.array(v) for k, v in sim.particles.arrays().items()}
+    for part in sim.stepper.parts:  # mesh nodes (decks with [[mesh]])
+        if part.kind != "sph":
+            out.update({f"mesh/{part.name}/{k}": np.array(v)
+                        for k, v in part.kin.arrays().items()})
     for k, v in sim.history.as_arrays().items():
         out[f"history/{k}"] = np.asarray(v, dtype=float)
     return out
