@@ -604,3 +604,72 @@ def test_pulse_passes_from_particles_into_elements_with_little_reflection():
     reflected = np.abs(v_c - np.interp(t_c, t_ref, v_ref)).max()
     assert reflected < 0.05 * incident
     assert far > 0.9 * incident
+
+
+# ------------------------------------------------------------------ ties
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("stiffness,alpha", [("mass", 0.1), ("bulk", 0.5)])
+def test_tied_particle_is_pulled_back_to_its_anchor_in_every_direction(dim, stiffness,
+                                                                       alpha):
+    # A particle 0.4 mm (0.4 of its size, under tie_factor 1) above a top face
+    # of a tilted 2x2(x2) block at (0.3, -0.6) is tied there: no force at the
+    # start; moved by u (out of the face: tension, and along it: shear) it gets
+    # F = -m kappa u with kappa = alpha / dt^2 (eq. 8) or alpha K V^((d-2)/d)
+    # / (rho0 V) (eq. 9) and the face nodes -N_a F (1e-12); when the block
+    # then moves by the same u (a rigid translation) the force is gone again
+    # (the anchor moves with the face; 1e-9 of F: the anchor is recomputed).
+    dt, dx = 1e-7, 1e-3
+    sph = sph_part(dim, [0, 0, 0], [2 * dx, dx, dx], dx)
+    sph.p.x[1] = [1.0, 1.0, 0.0]  # out of reach: not tied
+    solid = concrete_block([0, 0, 0], [0.004, 0.004, 0.004], (2, 2, 2), dim)
+    rot = np.eye(3)
+    c, s = np.cos(0.3), np.sin(0.3)
+    rot[:2, :2] = [[c, -s], [s, c]]
+    solid.nodes.x[:] = solid.nodes.x @ rot.T
+    faces = exterior_faces(solid.el.conn)
+    xf = solid.nodes.x[faces]
+    normals = (np.cross(xf[:, 1] - xf[:, 0], xf[:, 3] - xf[:, 0]) if dim == 3
+               else np.cross(xf[:, 1] - xf[:, 0], [0, 0, 1.0]))
+    top = faces[np.argmax(normals @ rot[:, 1] / np.linalg.norm(normals, axis=1)
+                          + 1e-3 * xf.mean(axis=1)[:, 0])]
+    xi, eta = 0.3, -0.6
+    if dim == 3:
+        Na = np.array([(1 - xi) * (1 - eta), (1 + xi) * (1 - eta), (1 + xi) * (1 + eta),
+                       (1 - xi) * (1 + eta)]) / 4.0
+        n = np.cross(solid.nodes.x[top[1]] - solid.nodes.x[top[0]],
+                     solid.nodes.x[top[3]] - solid.nodes.x[top[0]])
+    else:
+        Na = np.array([(1 - xi) / 2, (1 + xi) / 2])
+        t = solid.nodes.x[top[1]] - solid.nodes.x[top[0]]
+        n = np.array([t[1], -t[0], 0.0])
+    n /= np.linalg.norm(n)
+    sph.p.x[0] = Na @ solid.nodes.x[top] + 0.4 * dx * n
+    cp = PenaltyCoupling("c", sph, solid, stiffness=stiffness, alpha=alpha, tie_factor=1.0)
+    assert cp.tied.tolist() == [0] and cp.columns(0.0)["tied_c"] == 1.0
+    assert cp.tie_offset[0] == pytest.approx(0.4 * dx, rel=1e-9)
+
+    def forces():
+        sph.p.a_ext[:] = 0.0
+        solid.nodes.a_ext[:] = 0.0
+        cp.forces(0.0, dt, sph.p.a_ext)
+        return sph.p.m[0] * sph.p.a_ext[0], solid.nodes.m[:, None] * solid.nodes.a_ext
+
+    m, vol = sph.p.m[0], dx ** dim
+    kappa = (alpha / dt ** 2 if stiffness == "mass"
+             else alpha * K_BULK * vol ** ((dim - 2.0) / dim) / (RHO * vol))
+    f_p, f_n = forces()
+    assert np.abs(f_p).max() < 1e-9 * m * kappa * dx
+    tangent = np.cross([0, 0, 1.0], n)
+    u = 0.05 * dx * (n + 0.5 * tangent)
+    sph.p.x[0] += u
+    f_p, f_n = forces()
+    expect = -m * kappa * u
+    scale = np.abs(expect).max()
+    assert np.abs(f_p - expect).max() < 1e-9 * scale
+    assert np.abs(f_n[top] + Na[:, None] * expect).max() < 1e-9 * scale
+    assert np.abs(f_n.sum(axis=0) + f_p).max() < 1e-12 * scale
+    assert cp.count == 0  # the tied particle is not also a contact
+    assert cp.columns(0.0)["F_c_tie"] == pytest.approx(np.linalg.norm(expect), rel=1e-9)
+    solid.nodes.x[:] += u
+    f_p, _ = forces()
+    assert np.abs(f_p).max() < 1e-9 * scale

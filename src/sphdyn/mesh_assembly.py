@@ -134,7 +134,7 @@ def _coupling(mm: MeshModel, sph_part, part) -> list:
     coupling = PenaltyCoupling(f"{mm.name}_coupling", sph_part, part,
                                stiffness=conv.stiffness, alpha=conv.alpha,
                                thickness_factor=conv.thickness_factor,
-                               friction=conv.friction)
+                               friction=conv.friction, tie_factor=conv.tie_factor)
     if coupling.cand.size == 0:
         raise DeckError([format_problem(
             where, "the coupling finds no particle near the remaining elements' faces",

@@ -62,7 +62,8 @@ import numpy as np
 from numba import njit, prange
 
 from .base import InteractionBase
-from .penalty_geometry import candidate_pairs, closest_point, exterior_faces, face_shapes
+from .penalty_geometry import (candidate_pairs, closest_point, exterior_faces,
+                               face_point, face_shapes)
 from .wall import STIFFNESS
 from .wall_contact import STIFFNESS_BULK, contact_thickness, spring_acceleration
 
@@ -73,7 +74,7 @@ _INSIDE_RTOL = 1e-9
 @njit(cache=True, error_model="numpy", parallel=True)
 def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, faces,
                             offsets, cand, thickness_factor, method, alpha, friction, dt,
-                            a_p, a_n, face_of, shares, force, normal_force):
+                            a_p, a_n, face_of, shares, force, normal_force, skip):
     r"""Particle-face penalty forces (module docstring) into the particles' and nodes' ``a``.
 
     Parameters
@@ -96,6 +97,7 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
         (:math:`-N_a \mathbf F_p`; rows past nf unused).
     force : (N, 3) out, the force on each particle [N] (N/m in 2D).
     normal_force : (N,) out, its component along the contact direction [N].
+    skip : (N,) bool, particles left out (those tied by :func:`tie_forces`).
 
     Returns
     -------
@@ -114,6 +116,8 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
         force[i, 1] = 0.0
         force[i, 2] = 0.0
         normal_force[i] = 0.0
+        if skip[i]:
+            continue
         best = np.inf
         bf = -1
         xi, eta, cx, cy, cz, nx, ny, nz, clamped = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, False
@@ -211,6 +215,77 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
+def tie_forces(tied, tie_face, tie_xi, tie_eta, tie_offset, xp, mp, vol0, rho0, kbulk, dim,
+               xn, mn, faces, method, alpha, dt, a_p, a_n, shares, force):
+    r"""Bilateral penalty springs of tied particles to their anchor points.
+
+    A tied particle :math:`p` keeps its face, its parametric point
+    :math:`(\xi, \eta)` and its normal offset :math:`g_0` from the start
+    (the closest point then); its anchor moves with the face,
+    :math:`\mathbf x_A = \sum_a N_a(\xi,\eta)\,\mathbf x_a + g_0\,\mathbf n`,
+    and the spring of the contact law (:func:`~.wall_contact.spring_acceleration`,
+    eq. 8 or 9, linear in the stretch) pulls it back in every direction:
+    :math:`\mathbf F_p = -m_p\,\kappa\,(\mathbf x_p - \mathbf x_A)`,
+    :math:`\kappa` the acceleration per metre of the law, and the face nodes take
+    :math:`-N_a\mathbf F_p` (momentum conserved exactly; LS-DYNA's
+    TIED_NODES_TO_SURFACE_OFFSET penalty option does the same with its own
+    stiffness).
+
+    Parameters
+    ----------
+    tied : (T,) particle indices; tie_face (T,) face index; tie_xi, tie_eta,
+        tie_offset : (T,) parametric point and normal offset [m].
+    xp, mp, vol0, rho0, kbulk, dim : the particles (as
+        :func:`penalty_coupling_forces`).
+    xn, mn, faces : node positions (M, 3), masses (M,), faces (F, nf).
+    method, alpha, dt : the spring law.
+    a_p : (N, 3) in/out, the particles' accelerations are **added**.
+    a_n : (M, 3) in/out, the nodes' accelerations are **added**.
+    shares : (T, 4, 3) out, force on each node of the face [N].
+    force : (T, 3) out, force on each tied particle [N] (N/m in 2D).
+
+    Returns
+    -------
+    The total force magnitude on the tied particles [N].
+    """
+    nt = tied.shape[0]
+    nf = faces.shape[1]
+    for k in prange(nt):
+        i = tied[k]
+        f = tie_face[k]
+        cx, cy, cz, nx, ny, nz = face_point(xn, faces[f], tie_xi[k], tie_eta[k])
+        d0 = xp[i, 0] - (cx + tie_offset[k] * nx)
+        d1 = xp[i, 1] - (cy + tie_offset[k] * ny)
+        d2 = xp[i, 2] - (cz + tie_offset[k] * nz)
+        kappa = spring_acceleration(1.0, method, alpha, dt, kbulk[i], vol0[i], rho0[i], dim)
+        a_p[i, 0] -= kappa * d0
+        a_p[i, 1] -= kappa * d1
+        a_p[i, 2] -= kappa * d2
+        f0 = -mp[i] * kappa * d0
+        f1 = -mp[i] * kappa * d1
+        f2 = -mp[i] * kappa * d2
+        force[k, 0] = f0
+        force[k, 1] = f1
+        force[k, 2] = f2
+        N = face_shapes(tie_xi[k], tie_eta[k], nf)
+        for a in range(4):
+            shares[k, a, 0] = -N[a] * f0
+            shares[k, a, 1] = -N[a] * f1
+            shares[k, a, 2] = -N[a] * f2
+    total = 0.0
+    for k in range(nt):
+        f = tie_face[k]
+        total += np.sqrt(force[k, 0] ** 2 + force[k, 1] ** 2 + force[k, 2] ** 2)
+        for a in range(nf):
+            node = faces[f, a]
+            if mn[node] > 0.0:
+                a_n[node, 0] += shares[k, a, 0] / mn[node]
+                a_n[node, 1] += shares[k, a, 1] / mn[node]
+                a_n[node, 2] += shares[k, a, 2] / mn[node]
+    return total
+
+
+@njit(cache=True, error_model="numpy", parallel=True)
 def _max_shift(x, x_ref, rows):
     """Largest displacement [m] of the items ``rows`` (R,) since ``x_ref`` (N, 3)."""
     m = 0.0
@@ -247,6 +322,16 @@ class PenaltyCoupling(InteractionBase):
     friction : Coulomb coefficient.
     skin_factor : Verlet skin of the candidate list in units of the largest
         contact thickness.
+    tie_factor : 0 (default): contact only, the interface opens under
+        tension. > 0: every particle whose closest point on a face lies inside
+        the face and within ``tie_factor`` times its size :math:`V^{1/d}` at
+        the start is tied there for good by a bilateral spring
+        (:func:`tie_forces`), so the interface carries tension and shear as a
+        continuous body would (the thesis's coupled beam, sec. 4.1); 1.0 ties
+        the first layer of particles made from elements
+        (:func:`~sphdyn.geometry.convert.elements_to_particles`, half a size
+        from the face). Columns ``F_<name>_tie`` (sum of the tie forces'
+        magnitudes [N]) and ``tied_<name>``.
 
     The candidate list holds the faces whose bounding box, grown by the reach
     :math:`2 t_{max}` plus the skin, holds a particle; it is built again when
@@ -257,13 +342,15 @@ class PenaltyCoupling(InteractionBase):
 
     def __init__(self, name: str, sph_part, solid_part, faces=None, stiffness: str = "mass",
                  alpha: float = 0.1, thickness_factor: float = 0.5, friction: float = 0.0,
-                 skin_factor: float = 1.0):
+                 skin_factor: float = 1.0, tie_factor: float = 0.0):
         if stiffness not in STIFFNESS:
             raise ValueError(f"{name}: stiffness must be one of {tuple(STIFFNESS)}, "
                              f"got {stiffness!r}")
         if alpha <= 0.0 or thickness_factor <= 0.0 or friction < 0.0 or skin_factor <= 0.0:
             raise ValueError(f"{name}: alpha, thickness_factor and skin_factor must be > 0 "
                              "and friction >= 0")
+        if tie_factor < 0.0:
+            raise ValueError(f"{name}: tie_factor must be >= 0")
         self.name = name
         self.part = sph_part
         self.solid = solid_part
@@ -280,7 +367,9 @@ class PenaltyCoupling(InteractionBase):
         self.count = 0
         self.n_builds = 0
         self.total_normal = 0.0
+        self.total_tie = 0.0
         self._allocate()
+        self._tie(float(tie_factor))
         sph_part.p.on_grow(lambda n_old, n_new: self._allocate())
 
     # ------------------------------------------------------------- set-up
@@ -292,6 +381,10 @@ class PenaltyCoupling(InteractionBase):
         self.shares = np.zeros((n, 4, 3))
         self.force = np.zeros((n, 3))
         self.normal_force = np.zeros(n)
+        skip = np.zeros(n, dtype=np.bool_)
+        if hasattr(self, "tied"):
+            skip[self.tied] = True
+        self.skip = skip
         self._all = np.arange(n, dtype=np.int64)
         t_max = float(np.max(self.thickness_factor * p.vol0 ** (1.0 / p.dim))) if n else 0.0
         self.reach = 2.0 * t_max
@@ -313,6 +406,43 @@ class PenaltyCoupling(InteractionBase):
         k = self.alpha * p.bulk_modulus * p.vol0 ** ((p.dim - 2.0) / p.dim)
         w2 = k / (p.rho0 * p.vol0) * (1.0 + p.m / m_node)
         return float(1.0 / np.sqrt(w2.max()))
+
+    def _tie(self, factor: float) -> None:
+        """Tie the particles within ``factor`` sizes of a face (see the class)."""
+        p, q = self.part.p, self.solid.nodes
+        rows, faces_, xis, etas, offs = [], [], [], [], []
+        if factor > 0.0 and p.n:
+            size = p.vol0 ** (1.0 / p.dim)
+            offsets, cand = candidate_pairs(p.x, q.x, self.faces, factor * float(size.max()),
+                                            p.dim)
+            for i in range(p.n):
+                best = None
+                for f in cand[offsets[i]:offsets[i + 1]]:
+                    xi, eta, cx, cy, cz, nx, ny, nz, clamped = closest_point(
+                        p.x[i], q.x, self.faces[f])
+                    r = p.x[i] - np.array([cx, cy, cz])
+                    d2 = float(r @ r)
+                    if best is None or d2 < best[0]:
+                        best = (d2, f, xi, eta, float(r @ np.array([nx, ny, nz])), clamped)
+                if best is None:
+                    continue
+                d2, f, xi, eta, rn, clamped = best
+                lateral = np.sqrt(max(d2 - rn * rn, 0.0))
+                if (not clamped or lateral <= 1e-6 * size[i]) and abs(rn) <= factor * size[i]:
+                    rows.append(i)
+                    faces_.append(f)
+                    xis.append(xi)
+                    etas.append(eta)
+                    offs.append(rn)
+        self.tied = np.asarray(rows, dtype=np.int64)
+        self.tie_face = np.asarray(faces_, dtype=np.int64)
+        self.tie_xi = np.asarray(xis, dtype=np.float64)
+        self.tie_eta = np.asarray(etas, dtype=np.float64)
+        self.tie_offset = np.asarray(offs, dtype=np.float64)
+        self.tie_shares = np.zeros((self.tied.size, 4, 3))
+        self.tie_force = np.zeros((self.tied.size, 3))
+        self.skip[:] = False
+        self.skip[self.tied] = True
 
     def _build(self) -> None:
         p, q = self.part.p, self.solid.nodes
@@ -342,11 +472,20 @@ class PenaltyCoupling(InteractionBase):
             p.x, p.v, p.m, p.vol0, p.rho0, p.bulk_modulus, p.dim, q.x, q.v, q.m, self.faces,
             self.offsets, self.cand, self.thickness_factor, self.method, self.alpha,
             self.friction, dt, a_out, a_n, self.face_of, self.shares, self.force,
-            self.normal_force))
+            self.normal_force, self.skip))
         self.total_normal = float(self.normal_force.sum())
+        if self.tied.size:
+            self.total_tie = float(tie_forces(
+                self.tied, self.tie_face, self.tie_xi, self.tie_eta, self.tie_offset, p.x,
+                p.m, p.vol0, p.rho0, p.bulk_modulus, p.dim, q.x, q.m, self.faces,
+                self.method, self.alpha, dt, a_out, a_n, self.tie_shares, self.tie_force))
 
     def columns(self, t: float) -> dict[str, float]:
-        return {f"F_{self.name}": self.total_normal, f"contacts_{self.name}": float(self.count)}
+        out = {f"F_{self.name}": self.total_normal, f"contacts_{self.name}": float(self.count)}
+        if self.tied.size:
+            out[f"F_{self.name}_tie"] = self.total_tie
+            out[f"tied_{self.name}"] = float(self.tied.size)
+        return out
 
     def state(self) -> tuple[dict, dict[str, np.ndarray]]:
         return {}, {"offsets": self.offsets, "cand": self.cand, "xp_ref": self.xp_ref,

@@ -189,6 +189,37 @@ def closest_point(p, xn, face):
 
 
 @njit(cache=True, error_model="numpy")
+def face_point(xn, face, xi, eta):
+    r"""Point and unit outward normal of a face at its parametric point.
+
+    Quadrilateral: :math:`\mathbf x(\xi,\eta) = \sum_a N_a \mathbf x_a`,
+    :math:`\mathbf n \parallel \mathbf x_{,\xi}\times\mathbf x_{,\eta}`
+    (the normal of :func:`closest_point`); segment (2D): :math:`\mathbf n =
+    (t_y, -t_x)/|\mathbf t|` with :math:`\mathbf t = \mathbf x_1 - \mathbf x_0`.
+    ``xn`` (N, 3) [m]; ``face`` (nf,) node ids. Returns ``cx, cy, cz, nx, ny, nz``.
+    """
+    if face.shape[0] == 2:
+        a, b = face[0], face[1]
+        t0 = xn[b, 0] - xn[a, 0]
+        t1 = xn[b, 1] - xn[a, 1]
+        w = 0.5 * (1.0 + xi)
+        inv = 1.0 / np.sqrt(t0 * t0 + t1 * t1)
+        return xn[a, 0] + w * t0, xn[a, 1] + w * t1, 0.0, t1 * inv, -t0 * inv, 0.0
+    i0, i1, i2, i3 = face[0], face[1], face[2], face[3]
+    a0, b0, c0, d0 = _coefficients(xn[i0, 0], xn[i1, 0], xn[i2, 0], xn[i3, 0], 0.0)
+    a1, b1, c1, d1 = _coefficients(xn[i0, 1], xn[i1, 1], xn[i2, 1], xn[i3, 1], 0.0)
+    a2, b2, c2, d2 = _coefficients(xn[i0, 2], xn[i1, 2], xn[i2, 2], xn[i3, 2], 0.0)
+    e10, e11, e12 = b0 + d0 * eta, b1 + d1 * eta, b2 + d2 * eta
+    e20, e21, e22 = c0 + d0 * xi, c1 + d1 * xi, c2 + d2 * xi
+    nx = e11 * e22 - e12 * e21
+    ny = e12 * e20 - e10 * e22
+    nz = e10 * e21 - e11 * e20
+    inv = 1.0 / np.sqrt(nx * nx + ny * ny + nz * nz)
+    return (a0 + b0 * xi + c0 * eta + d0 * xi * eta, a1 + b1 * xi + c1 * eta + d1 * xi * eta,
+            a2 + b2 * xi + c2 * eta + d2 * xi * eta, nx * inv, ny * inv, nz * inv)
+
+
+@njit(cache=True, error_model="numpy")
 def _coefficients(x0, x1, x2, x3, pk):
     """One component of a, b, c, d of the bilinear face, ``a`` relative to ``pk``."""
     return (0.25 * (x0 + x1 + x2 + x3) - pk, 0.25 * (-x0 + x1 + x2 - x3),

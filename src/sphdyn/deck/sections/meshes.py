@@ -123,11 +123,18 @@ class Convert(Section):
     thickness_factor: real("thickness factor", lo=0, lo_open=True) = Field(
         0.5, description="Penalty contact thickness in units of the particle size "
                          "V^(1/d).")
+    tie_factor: real("tie distance factor", lo=0) = Field(
+        0.0, description="Penalty coupling: 0 = contact only (the interface opens "
+                         "under tension); > 0 ties the particles within tie_factor "
+                         "sizes V^(1/d) of a face at the start to it by bilateral "
+                         "springs (tension and shear carried, as LS-DYNA's tied "
+                         "offset contact); 1.0 ties the first particle layer.")
 
     @model_validator(mode="after")
     def _penalty_keys(self):
         if self.coupling != "penalty":
-            given = [k for k in ("stiffness", "alpha", "friction", "thickness_factor")
+            given = [k for k in ("stiffness", "alpha", "friction", "thickness_factor",
+                                 "tie_factor")
                      if getattr(self, k) != self.model_fields[k].default]
             if given:
                 raise problem(f"{', '.join(given)} belong to the penalty coupling, not "
