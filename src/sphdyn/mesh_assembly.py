@@ -127,10 +127,6 @@ def _coupling(mm: MeshModel, sph_part, part) -> list:
     where = f"mesh[{mm.index}] '{mm.name}'.convert.coupling"
     if conv.coupling == "none":
         return []
-    if conv.coupling != "penalty":
-        raise DeckError([format_problem(
-            where, f"coupling = \"{conv.coupling}\" is not available yet",
-            "use coupling = \"penalty\"")])
     coupling = PenaltyCoupling(f"{mm.name}_coupling", sph_part, part,
                                stiffness=conv.stiffness, alpha=conv.alpha,
                                thickness_factor=conv.thickness_factor,

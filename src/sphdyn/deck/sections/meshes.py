@@ -108,11 +108,11 @@ class Convert(Section):
 
     region: Region = Field(description="Elements whose centroid lies in this region "
                                         "become particles.")
-    coupling: Literal["penalty", "tied", "hybrid", "none"] = Field(
+    coupling: Literal["penalty", "none"] = Field(
         "penalty", description="How the particles meet the remaining mesh: penalty "
-        "(particles against the element faces, the wall's spring), tied (interface "
-        "particles constrained to the mesh), hybrid (a transition layer of elements "
-        "carrying particles), none.")
+        "(particles against the element faces, the wall's spring; with tie_factor "
+        "the first layer tied), none. The constraint (tied) and hybrid "
+        "transition-layer couplings are being built.")
     stiffness: Literal["mass", "bulk"] = Field(
         "mass", description="Penalty stiffness: mass: k = alpha m/dt^2 (paper eq. 8); "
                             "bulk: k = alpha K A/L (eq. 9).")
