@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...guards import SimulationFailed
 from ...integrate import add_heat, cfl_time_step, drift, internal_energies
 from ...kernels import KernelContext
 from ...neighbours import build_neighbours, mean_neighbours, update_neighbours
@@ -196,7 +197,15 @@ class SPHPart:
 
     def update_geometry(self, t: float, dt: float) -> None:
         p, s = self.p, self.s
-        self.nl = update_neighbours(self.nl, p.x, p.h, self.dim, self.ul_active)
+        try:
+            self.nl = update_neighbours(self.nl, p.x, p.h, self.dim, self.ul_active)
+        except ValueError as exc:  # positions or h went non-finite in this step
+            bad = np.flatnonzero(~np.all(np.isfinite(p.x), axis=1) | ~np.isfinite(p.h))
+            raise SimulationFailed(
+                f"run stopped at t = {t:.6e} s: {exc} ({bad.size} particle(s), first "
+                f"{bad[:5].tolist()}). Likely causes: a time step too large for the "
+                "material (lower time.cfl; check density and moduli) or too stiff "
+                "contact.") from None
         if self.tl is not None and s.reference_update_every and \
                 self.step % s.reference_update_every == 0:
             self.tl.update_reference(p)
