@@ -24,9 +24,8 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-#: the thesis's five models; "tied" (constraint) and "hybrid" (transition
-#: layer) join when their couplings exist (issue 15)
-MODELS = ("fem", "penalty", "sph")
+#: the thesis's five models
+MODELS = ("fem", "penalty", "tied", "hybrid", "sph")
 LABELS = {"fem": "pure FEM (reference)", "penalty": "FEM-SPH-FEM, penalty",
           "tied": "FEM-SPH-FEM, tied", "hybrid": "FEM-SPH-FEM, hybrid",
           "sph": "pure SPH"}

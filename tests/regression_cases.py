@@ -47,6 +47,8 @@ CASES: dict[str, tuple[int, list[str]]] = {
                                'body.0.mesostructure.itz_thickness="5 mm"']),
     "beam_fem": (40, ["mesh.beam.block.divisions=[40, 2, 2]"]),
     "beam_penalty": (40, ["mesh.beam.block.divisions=[40, 2, 2]"]),
+    "beam_tied": (40, ["mesh.beam.block.divisions=[40, 2, 2]"]),
+    "beam_hybrid": (40, ["mesh.beam.block.divisions=[40, 2, 2]"]),
     "beam_sph": (40, ['body.beam.dx="125 mm"']),
 }
 

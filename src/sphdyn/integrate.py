@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from .state import BC_FIXED
+from .state import BC_FIXED, BC_SLAVE
 
 
 #: particles per block of the kick's energy sums: the sums are taken block by
@@ -49,6 +49,9 @@ def kick(v, a, a_contact, m, bc, bc_v, dt_kick, v_out_mean, sums):
     the (blocks, 3) scratch of :func:`kick_scratch`: each block of
     :data:`KICK_BLOCK` particles is summed in order, then the blocks in order,
     so the energies are the same bits on any number of threads.
+    ``BC_SLAVE`` items (the slaves of a tied or hybrid coupling) are left as
+    they are and booked nowhere: their masters carry their mass, and the
+    coupling sets their velocity after the kick.
 
     Returns
     -------
@@ -64,6 +67,11 @@ def kick(v, a, a_contact, m, bc, bc_v, dt_kick, v_out_mean, sums):
         wc = 0.0
         we = 0.0
         for i in range(b * KICK_BLOCK, min(n, (b + 1) * KICK_BLOCK)):
+            if bc[i] == BC_SLAVE:
+                v_out_mean[i, 0] = v[i, 0]
+                v_out_mean[i, 1] = v[i, 1]
+                v_out_mean[i, 2] = v[i, 2]
+                continue
             mi = m[i]
             n0 = v[i, 0] + dt_kick * a[i, 0]
             n1 = v[i, 1] + dt_kick * a[i, 1]

@@ -4,7 +4,7 @@ Called by :func:`sphdyn.assembly.build_stepper` with the meshes of
 :mod:`sphdyn.mesh_model`. Names in the history: a boundary's reactions
 ``<set>_reaction_x|y|z``, a load's ``<set>_force``, a mesh's damping
 ``E_damping_<mesh>``, a wall on a mesh ``F_wall_<wall>_<mesh>``, a coupling
-``F_<mesh>_coupling``.
+``F_<mesh>_coupling`` (penalty) or ``F_<mesh>_coupling_x|y|z`` (tied, hybrid).
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ import numpy as np
 
 from .deck import DeckError
 from .deck.errors import format_problem
-from .interactions import PenaltyCoupling, Wall
+from .interactions import HybridCoupling, PenaltyCoupling, TiedCoupling, Wall
 from .interactions.nodal import MassDamping, NodalLoad, PrescribedMotion
 from .materials import get_model
 from .mesh_model import MeshModel
@@ -112,27 +112,48 @@ def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
             out += [Wall(replace(spec, name=f"{spec.name}_{mm.name}"), part)
                     for spec in model.walls]
         if mm.converted is not None:
+            rows = np.flatnonzero(sph_part.p.body == model.body_names.index(mm.name))
+            coupling = _coupling(mm, sph_part, part, rows)
             if mm.spec.damping > 0.0:  # the converted particles are damped alike
-                b = model.body_names.index(mm.name)
+                slaves = np.concatenate([getattr(c, "slaves", np.zeros(0, np.int64))
+                                         for c in coupling])
                 out.append(MassDamping(f"{mm.name}_particles", sph_part,
-                                       np.flatnonzero(sph_part.p.body == b),
-                                       mm.spec.damping))
-            out += _coupling(mm, sph_part, part)
+                                       np.setdiff1d(rows, slaves), mm.spec.damping))
+            out += coupling  # after every other interaction on the particles
     return out
 
 
-def _coupling(mm: MeshModel, sph_part, part) -> list:
-    """The coupling of a mesh's converted particles with its remaining elements."""
+def _coupling(mm: MeshModel, sph_part, part, rows) -> list:
+    """The coupling of a mesh's converted particles (``rows``, (k,), then the
+    hybrid layer's) with its remaining elements; its ``slaves`` (particles the
+    mesh moves) are left out of the particles' damping."""
     conv = mm.converted.spec
     where = f"mesh[{mm.index}] '{mm.name}'.convert.coupling"
+    name = f"{mm.name}_coupling"
     if conv.coupling == "none":
         return []
-    coupling = PenaltyCoupling(f"{mm.name}_coupling", sph_part, part,
-                               stiffness=conv.stiffness, alpha=conv.alpha,
-                               thickness_factor=conv.thickness_factor,
-                               friction=conv.friction, tie_factor=conv.tie_factor)
-    if coupling.cand.size == 0:
+    try:
+        if conv.coupling == "hybrid":
+            hy = mm.converted.hybrid
+            return [HybridCoupling(name, sph_part, part, rows[mm.converted.x.shape[0]:],
+                                   hy.elem, hy.xi)]
+        if conv.coupling == "tied":
+            coupling = TiedCoupling(name, sph_part, part, tie_factor=(
+                1.0 if conv.tie_factor is None else conv.tie_factor))
+    except ValueError as exc:
+        raise DeckError([format_problem(where, str(exc).split(": ", 1)[-1],
+                                        "see the coupling's section in docs/deck.md")]) from None
+    if conv.coupling == "tied":
+        found = coupling.slaves.size
+    else:
+        coupling = PenaltyCoupling(name, sph_part, part, stiffness=conv.stiffness,
+                                   alpha=conv.alpha, thickness_factor=conv.thickness_factor,
+                                   friction=conv.friction,
+                                   tie_factor=conv.tie_factor or 0.0)
+        found = coupling.cand.size
+    if found == 0:
         raise DeckError([format_problem(
             where, "the coupling finds no particle near the remaining elements' faces",
-            "make the converted region touch the rest of the mesh")])
+            "make the converted region touch the rest of the mesh"
+            + (" (or raise tie_factor)" if conv.coupling == "tied" else ""))])
     return [coupling]

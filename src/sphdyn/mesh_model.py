@@ -18,7 +18,7 @@ import numpy as np
 from .deck import DeckError
 from .deck.errors import format_problem
 from .geometry import select
-from .geometry.convert import element_centroids, elements_to_particles
+from .geometry.convert import element_centroids, elements_to_particles, hybrid_points
 from .geometry.mesh import MeshData, block_mesh, check_elements, line_mesh, read_mesh
 
 #: Element kind of a solid mesh by dimension.
@@ -30,13 +30,29 @@ class Converted:
     """Particles made of a mesh's converted elements (one per element).
 
     ``x`` (k, 3) centroids [m], ``vol`` (k,) volumes [m^d], ``mat`` (k,)
-    deck material indices; ``coupling`` and its settings as in the deck.
+    deck material indices; ``spec``: the deck's [mesh.convert]. With the
+    hybrid coupling, ``hybrid``: the particles at the hybrid layer's
+    integration points, appended to the body after the converted ones.
     """
 
     x: np.ndarray
     vol: np.ndarray
     mat: np.ndarray
     spec: object
+    hybrid: "HybridLayer | None" = None
+
+
+@dataclass
+class HybridLayer:
+    """Integration points of the hybrid elements (:func:`~sphdyn.geometry.convert.hybrid_points`):
+    ``elem`` (H,) in the remaining mesh, ``x`` (H, 3) [m], ``vol`` (H,) [m^d],
+    ``xi`` (H, d) natural coordinates, ``mat`` (H,) deck material indices."""
+
+    elem: np.ndarray
+    x: np.ndarray
+    vol: np.ndarray
+    xi: np.ndarray
+    mat: np.ndarray
 
 
 @dataclass
@@ -132,7 +148,18 @@ def _convert(spec, mesh: MeshData, mat: np.ndarray, where: str, dim: int):
     remaining = MeshData(mesh.points[kept], rest, mesh.kind, node_sets=sets,
                          element_ids=mesh.element_ids[~mask], node_ids=mesh.node_ids[kept],
                          source=mesh.source)
-    return remaining, mat[~mask], Converted(x, vol, mat[mask].astype(np.int32), conv)
+    converted = Converted(x, vol, mat[mask].astype(np.int32), conv)
+    if conv.coupling == "hybrid":
+        elem, hx, hvol, hxi = hybrid_points(mesh.points, mesh.cells, mesh.kind, mask,
+                                            spec.integration == "one_point")
+        if elem.size == 0:
+            raise DeckError([format_problem(
+                f"{where}.convert.region", "no remaining element shares a face with a "
+                "converted one, so the hybrid coupling has no transition layer",
+                "make the converted region touch the rest of the mesh")])
+        converted.hybrid = HybridLayer(elem, hx, hvol, hxi,
+                                       mat[~mask][elem].astype(np.int32))
+    return remaining, mat[~mask], converted
 
 
 def build_meshes(deck) -> list[MeshModel]:

@@ -325,18 +325,28 @@ def _converted_name(mm: MeshModel, taken: list[str]) -> str:
 def _converted_particles(deck, mm: MeshModel, b: int, density_of, n_hist: int) -> Particles:
     """Particles of a mesh's converted elements: one per element at its centroid,
     with its volume and mass :math:`\rho V_e` (thesis ch. 4), smoothing length
-    ``sph.h_factor`` times :math:`V_e^{1/d}`, body index ``b``."""
+    ``sph.h_factor`` times :math:`V_e^{1/d}`, body index ``b``; then, with the
+    hybrid coupling, one per integration point of the hybrid layer (its
+    volume and mass; the smoothing length of its element's size)."""
     c, dim = mm.converted, deck.run.dimension
-    p = Particles.allocate(c.x.shape[0], dim, n_hist)
-    p.x[:] = c.x
-    p.x0[:] = c.x
+    x, vol, mat, size = c.x, c.vol, c.mat, c.vol ** (1.0 / dim)
+    if c.hybrid is not None:
+        hy = c.hybrid
+        per = np.bincount(hy.elem)[hy.elem]  # points per element
+        x = np.concatenate([x, hy.x])
+        vol = np.concatenate([vol, hy.vol])
+        mat = np.concatenate([mat, hy.mat])
+        size = np.concatenate([size, (hy.vol * per) ** (1.0 / dim)])
+    p = Particles.allocate(x.shape[0], dim, n_hist)
+    p.x[:] = x
+    p.x0[:] = x
     p.v[:] = np.asarray(mm.spec.velocity, dtype=float)
-    p.vol0[:] = c.vol
-    p.mat[:] = c.mat
-    p.rho[:] = density_of[c.mat]
+    p.vol0[:] = vol
+    p.mat[:] = mat
+    p.rho[:] = density_of[mat]
     p.rho0[:] = p.rho
-    p.m[:] = p.rho0 * c.vol
-    p.h[:] = deck.sph.h_factor * c.vol ** (1.0 / dim)
+    p.m[:] = p.rho0 * vol
+    p.h[:] = deck.sph.h_factor * size
     p.h0[:] = p.h
     p.body[:] = b
     return p

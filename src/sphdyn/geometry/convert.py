@@ -28,9 +28,9 @@ from __future__ import annotations
 import numpy as np
 
 from .mesh import MESH_KINDS
-from .shapes import gauss_derivatives, gauss_points, shape_functions
+from .shapes import gauss_derivatives, gauss_points, shape_derivatives, shape_functions
 
-__all__ = ["element_centroids", "elements_to_particles"]
+__all__ = ["element_centroids", "elements_to_particles", "hybrid_points"]
 
 
 def element_centroids(points, cells, kind: str) -> tuple[np.ndarray, np.ndarray]:
@@ -101,3 +101,55 @@ def elements_to_particles(points, cells, kind: str, element_mask):
     new_index = np.full(np.asarray(points).shape[0], -1, dtype=np.int64)
     new_index[kept] = np.arange(kept.size)
     return centroids, volumes, new_index[rest], kept
+
+
+#: local faces (hex8) and edges (quad4) of an element, for face sharing
+_LOCAL_FACES = {"hex8": np.array([[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5],
+                                  [2, 3, 7, 6], [3, 0, 4, 7]]),
+                "quad4": np.array([[0, 1], [1, 2], [2, 3], [3, 0]])}
+
+
+def hybrid_points(points, cells, kind: str, element_mask, one_point: bool):
+    r"""Integration points of the hybrid layer: the elements next to converted ones.
+
+    The thesis's transition layer (ch. 4): "the first neighbouring FEM
+    elements were used as the hybrid ones". An element not in
+    ``element_mask`` is hybrid when it shares a face (hex8) or an edge
+    (quad4) with one that is. Its points are the centre
+    :math:`\boldsymbol\xi = 0` with the element's volume
+    (:func:`element_centroids`; ``one_point``)
+    or the :math:`2^d` Gauss points :math:`\pm 1/\sqrt 3` with
+    :math:`\det\mathsf J(\boldsymbol\xi_g)` each (unit weights; they sum
+    to the volume exactly).
+
+    Parameters
+    ----------
+    points : (N, 3) [m]; cells : (E, nen); kind : ``"hex8"`` or ``"quad4"``.
+    element_mask : (E,) bool, the converted elements.
+    one_point : one point per element, else 2^d.
+
+    Returns
+    -------
+    elements : (H,) int64, the hybrid points' elements in the numbering of
+        the **remaining** cells (``cells[~element_mask]``); x : (H, 3) [m];
+        vol : (H,) [m^d]; xi : (H, d) natural coordinates.
+    """
+    d = 3 if kind == "hex8" else 2
+    cells = np.asarray(cells, dtype=np.int64)
+    mask = np.asarray(element_mask, dtype=bool)
+    local = _LOCAL_FACES[kind]
+    keys = np.sort(cells[:, local], axis=2)                     # (E, nface, nf)
+    conv = {tuple(k) for k in keys[mask].reshape(-1, local.shape[1])}
+    rest = np.flatnonzero(~mask)
+    hyb = np.array([r for r in range(rest.size)
+                    if any(tuple(k) in conv for k in keys[rest[r]])], dtype=np.int64)
+    xi = np.zeros((1, d)) if one_point else gauss_points(d)     # (G, d)
+    G = xi.shape[0]
+    x = np.asarray(points, dtype=np.float64)[cells[rest[hyb]]]  # (H_el, nen, 3)
+    N = shape_functions(d, xi)                                  # (G, nen)
+    dN = shape_derivatives(d, xi)                               # (G, nen, d)
+    det = np.linalg.det(np.einsum("eai,gaj->egij", x[:, :, :d], dN))  # (H_el, G)
+    vol = element_centroids(points, cells[rest[hyb]], kind)[1][:, None] if one_point else det
+    xq = np.einsum("ga,eai->egi", N, x)
+    return (np.repeat(hyb, G), xq.reshape(-1, 3), vol.reshape(-1),
+            np.tile(xi, (hyb.size, 1)))

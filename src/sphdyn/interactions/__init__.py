@@ -1,12 +1,15 @@
-"""Interactions: walls, particle contact, the SPH-FEM penalty coupling, nodal ones.
+"""Interactions: walls, particle contact, the SPH-FEM couplings (penalty, tied,
+hybrid), nodal ones.
 
 See :mod:`sphdyn.interactions.base` for the protocol the stepper uses.
 """
 
 from .base import Interaction, InteractionBase
 from .contact import ParticleContact
+from .hybrid_coupling import HybridCoupling
 from .penalty_coupling import PenaltyCoupling
+from .tied_coupling import TiedCoupling
 from .wall import STIFFNESS, Wall, WallSpec
 
-__all__ = ["Interaction", "InteractionBase", "ParticleContact", "PenaltyCoupling", "STIFFNESS",
-           "Wall", "WallSpec"]
+__all__ = ["HybridCoupling", "Interaction", "InteractionBase", "ParticleContact",
+           "PenaltyCoupling", "STIFFNESS", "TiedCoupling", "Wall", "WallSpec"]

@@ -11,8 +11,9 @@ couplings, prescribed motion, loads and damping. The :class:`~sphdyn.stepper.Ste
   ``a_ext`` of the part it acts on (``dt`` is the stable step, which
   mass-based penalty springs use); it also refreshes what it reports;
 * ``after_kick(dt_kick)``: bookkeeping over the kick (impulses);
-* ``constrain(t)``: a hook after the kick where tied couplings correct
-  velocities (none of today's interactions needs it);
+* ``constrain(t, dt)``: after the kick of the step [t, t + dt], the
+  tied and hybrid couplings set their slaves' positions and velocities
+  from their masters';
 * ``columns(t)``: its history columns; ``state()`` / ``restore()``.
 """
 
@@ -31,7 +32,7 @@ class Interaction(Protocol):
     def update_geometry(self, t: float) -> None: ...
     def forces(self, t: float, dt: float, a_out: np.ndarray) -> None: ...
     def after_kick(self, dt_kick: float) -> None: ...
-    def constrain(self, t: float) -> None: ...
+    def constrain(self, t: float, dt: float) -> None: ...
     def columns(self, t: float) -> dict[str, float]: ...
     def state(self) -> tuple[dict, dict[str, np.ndarray]]: ...
     def restore(self, scalars: dict, arrays: dict[str, np.ndarray]) -> None: ...
@@ -52,7 +53,7 @@ class InteractionBase:
     def after_kick(self, dt_kick: float) -> None:
         return None
 
-    def constrain(self, t: float) -> None:
+    def constrain(self, t: float, dt: float) -> None:
         return None
 
     def state(self) -> tuple[dict, dict[str, np.ndarray]]:

@@ -63,7 +63,7 @@ from numba import njit, prange
 
 from .base import InteractionBase
 from .penalty_geometry import (candidate_pairs, closest_point, exterior_faces,
-                               face_point, face_shapes)
+                               face_anchors, face_point, face_shapes)
 from .wall import STIFFNESS
 from .wall_contact import STIFFNESS_BULK, contact_thickness, spring_acceleration
 
@@ -410,35 +410,9 @@ class PenaltyCoupling(InteractionBase):
     def _tie(self, factor: float) -> None:
         """Tie the particles within ``factor`` sizes of a face (see the class)."""
         p, q = self.part.p, self.solid.nodes
-        rows, faces_, xis, etas, offs = [], [], [], [], []
-        if factor > 0.0 and p.n:
-            size = p.vol0 ** (1.0 / p.dim)
-            offsets, cand = candidate_pairs(p.x, q.x, self.faces, factor * float(size.max()),
-                                            p.dim)
-            for i in range(p.n):
-                best = None
-                for f in cand[offsets[i]:offsets[i + 1]]:
-                    xi, eta, cx, cy, cz, nx, ny, nz, clamped = closest_point(
-                        p.x[i], q.x, self.faces[f])
-                    r = p.x[i] - np.array([cx, cy, cz])
-                    d2 = float(r @ r)
-                    if best is None or d2 < best[0]:
-                        best = (d2, f, xi, eta, float(r @ np.array([nx, ny, nz])), clamped)
-                if best is None:
-                    continue
-                d2, f, xi, eta, rn, clamped = best
-                lateral = np.sqrt(max(d2 - rn * rn, 0.0))
-                if (not clamped or lateral <= 1e-6 * size[i]) and abs(rn) <= factor * size[i]:
-                    rows.append(i)
-                    faces_.append(f)
-                    xis.append(xi)
-                    etas.append(eta)
-                    offs.append(rn)
-        self.tied = np.asarray(rows, dtype=np.int64)
-        self.tie_face = np.asarray(faces_, dtype=np.int64)
-        self.tie_xi = np.asarray(xis, dtype=np.float64)
-        self.tie_eta = np.asarray(etas, dtype=np.float64)
-        self.tie_offset = np.asarray(offs, dtype=np.float64)
+        (self.tied, self.tie_face, self.tie_xi, self.tie_eta,
+         self.tie_offset) = face_anchors(p.x, p.vol0 ** (1.0 / p.dim), q.x, self.faces,
+                                         factor, p.dim)
         self.tie_shares = np.zeros((self.tied.size, 4, 3))
         self.tie_force = np.zeros((self.tied.size, 3))
         self.skip[:] = False

@@ -336,3 +336,57 @@ def candidate_pairs(xp: np.ndarray, xn: np.ndarray, faces: np.ndarray, reach: fl
     idx = np.empty(offsets[-1], dtype=np.int64)
     _pairs(xp, blo, bhi, order, cell_start, glo, inv_cs, nc, dim, offsets, idx, True)
     return offsets, idx
+
+
+# --------------------------------------------------------------------------
+# anchors of tied particles
+# --------------------------------------------------------------------------
+def face_anchors(xp: np.ndarray, size: np.ndarray, xn: np.ndarray, faces: np.ndarray,
+                 factor: float, dim: int):
+    r"""The points of the faces that particles near them are tied to.
+
+    A particle :math:`p` is anchored when its closest point on the faces
+    (:func:`closest_point`; the nearest face, ties to the lower index) lies
+    inside a face (not clamped to its boundary, or clamped by less than
+    :math:`10^{-6}` sizes) and its normal distance is at most ``factor``
+    times its size. Its anchor is :math:`(f, \xi, \eta, g_0)`: the face, the
+    parametric point and the signed normal offset, so that
+    :math:`\mathbf x_p = \sum_a N_a(\xi,\eta)\mathbf x_a + g_0\mathbf n`
+    at the start.
+
+    Parameters
+    ----------
+    xp : (N, 3) particle positions [m]; size : (N,) particle sizes [m].
+    xn : (M, 3) node positions [m]; faces : (F, nf) faces (module docstring).
+    factor : tie distance in particle sizes (0: none tied).
+    dim : 2 or 3.
+
+    Returns
+    -------
+    rows (T,) int64 particle indices, face (T,) int64, xi, eta, offset (T,)
+    float64 (offset in m).
+    """
+    rows, faces_, xis, etas, offs = [], [], [], [], []
+    if factor > 0.0 and xp.shape[0]:
+        offsets, cand = candidate_pairs(xp, xn, faces, factor * float(size.max()), dim)
+        for i in range(xp.shape[0]):
+            best = None
+            for f in cand[offsets[i]:offsets[i + 1]]:
+                xi, eta, cx, cy, cz, nx, ny, nz, clamped = closest_point(xp[i], xn, faces[f])
+                r = xp[i] - np.array([cx, cy, cz])
+                d2 = float(r @ r)
+                if best is None or d2 < best[0]:
+                    best = (d2, f, xi, eta, float(r @ np.array([nx, ny, nz])), clamped)
+            if best is None:
+                continue
+            d2, f, xi, eta, rn, clamped = best
+            lateral = np.sqrt(max(d2 - rn * rn, 0.0))
+            if (not clamped or lateral <= 1e-6 * size[i]) and abs(rn) <= factor * size[i]:
+                rows.append(i)
+                faces_.append(f)
+                xis.append(xi)
+                etas.append(eta)
+                offs.append(rn)
+    return (np.asarray(rows, dtype=np.int64), np.asarray(faces_, dtype=np.int64),
+            np.asarray(xis, dtype=np.float64), np.asarray(etas, dtype=np.float64),
+            np.asarray(offs, dtype=np.float64))

@@ -25,6 +25,10 @@ from .store import STATE, ArrayStore
 BC_FREE = 0
 BC_FIXED = 1
 BC_VELOCITY = 2
+#: an item whose position and velocity another part's items set (a tied or
+#: hybrid coupling's slave particle): the kick leaves it alone and books
+#: neither its kinetic energy nor work (its mass is carried by its masters)
+BC_SLAVE = 3
 
 #: name -> (tail shape, dtype) of the kinematics every part has (particles now,
 #: mesh nodes later). ``a_ext`` is the part of ``a`` from interactions (walls,
@@ -59,7 +63,7 @@ class Kinematics(ArrayStore):
     m : (N,) float64
         Mass [kg] (kg/m in 2D). May be zero (initial cracks).
     bc : (N,) int8
-        ``BC_FREE``, ``BC_FIXED`` or ``BC_VELOCITY``.
+        ``BC_FREE``, ``BC_FIXED``, ``BC_VELOCITY`` or ``BC_SLAVE``.
     bc_v : (N, 3) float64
         Prescribed velocity for ``BC_VELOCITY`` items [m/s].
     active : (N,) int8

@@ -108,11 +108,14 @@ class Convert(Section):
 
     region: Region = Field(description="Elements whose centroid lies in this region "
                                         "become particles.")
-    coupling: Literal["penalty", "none"] = Field(
-        "penalty", description="How the particles meet the remaining mesh: penalty "
-        "(particles against the element faces, the wall's spring; with tie_factor "
-        "the first layer tied), none. The constraint (tied) and hybrid "
-        "transition-layer couplings are being built.")
+    coupling: Literal["penalty", "tied", "hybrid", "none"] = Field(
+        "penalty", description="How the particles meet the remaining mesh (thesis ch. 4): "
+        "penalty: particles against the element faces with the wall's spring (with "
+        "tie_factor the first layer tied by bilateral springs); tied: the particles "
+        "within tie_factor sizes of a face move with it (constraint: their mass and "
+        "force go to the face's nodes); hybrid: the first layer of remaining elements "
+        "gets particles at its integration points that move with it and meet the "
+        "other particles through the kernel; none.")
     stiffness: Literal["mass", "bulk"] = Field(
         "mass", description="Penalty stiffness: mass: k = alpha m/dt^2 (paper eq. 8); "
                             "bulk: k = alpha K A/L (eq. 9).")
@@ -123,23 +126,31 @@ class Convert(Section):
     thickness_factor: real("thickness factor", lo=0, lo_open=True) = Field(
         0.5, description="Penalty contact thickness in units of the particle size "
                          "V^(1/d).")
-    tie_factor: real("tie distance factor", lo=0) = Field(
-        0.0, description="Penalty coupling: 0 = contact only (the interface opens "
-                         "under tension); > 0 ties the particles within tie_factor "
-                         "sizes V^(1/d) of a face at the start to it by bilateral "
-                         "springs (tension and shear carried, as LS-DYNA's tied "
-                         "offset contact); 1.0 ties the first particle layer.")
+    tie_factor: real("tie distance factor", lo=0) | None = Field(
+        None, description="Particles within tie_factor sizes V^(1/d) of a face at the "
+                          "start are tied to it. Penalty coupling: default 0 = contact "
+                          "only (the interface opens under tension); > 0 ties by "
+                          "bilateral springs (tension and shear carried, as LS-DYNA's "
+                          "tied offset contact). Tied coupling: default 1.0, the first "
+                          "particle layer (half a size from the face).")
 
     @model_validator(mode="after")
-    def _penalty_keys(self):
-        if self.coupling != "penalty":
-            given = [k for k in ("stiffness", "alpha", "friction", "thickness_factor",
-                                 "tie_factor")
-                     if getattr(self, k) != self.model_fields[k].default]
-            if given:
-                raise problem(f"{', '.join(given)} belong to the penalty coupling, not "
-                              f"to coupling = \"{self.coupling}\"",
-                              f"remove {', '.join(given)} or set coupling = \"penalty\"")
+    def _coupling_keys(self):
+        own = {"penalty": ("stiffness", "alpha", "friction", "thickness_factor",
+                           "tie_factor"),
+               "tied": ("tie_factor",), "hybrid": (), "none": ()}[self.coupling]
+        given = [k for k in ("stiffness", "alpha", "friction", "thickness_factor",
+                             "tie_factor")
+                 if k not in own and getattr(self, k) != type(self).model_fields[k].default]
+        if given:
+            raise problem(f"{', '.join(given)} do not belong to coupling = "
+                          f"\"{self.coupling}\"",
+                          f"remove {', '.join(given)}, or choose the coupling they belong "
+                          "to (tie_factor: penalty or tied; the others: penalty)")
+        if self.coupling == "tied" and self.tie_factor == 0.0:
+            raise problem("tie_factor = 0 ties no particle in the tied coupling",
+                          "give tie_factor > 0 (1.0 ties the first particle layer) or "
+                          "leave it out")
         return self
 
 

@@ -113,6 +113,9 @@ class SPHPart:
         if settings.xsph > 0:
             p.add("vs", (3,))
         self.F = np.zeros(0)  # pair gradient factors of the current list
+        #: callables run after every pass of :meth:`_gradients` (before the
+        #: stress divergence): a coupling may zero pair factors ``F`` there
+        self.pair_filters: list = []
         self.swegle_unstable = 0
         self._swegle_at = None  # (t, step) the indicator was evaluated at
         self.step = 0
@@ -280,6 +283,8 @@ class SPHPart:
                               p.B)
         if self.tl is not None:
             self.tl.velocity_gradient(p)
+        for f in self.pair_filters:
+            f()
 
     def _accelerations(self) -> None:
         """Stress divergence and artificial viscosity (and stress) into ``a``.
