@@ -37,16 +37,21 @@ from sphdyn.state import BC_SLAVE
 E, RHO = 30e9, 2400.0
 C_BAR = np.sqrt(E / RHO)  # nu = 0: the bar wave speed is the dilatational one
 
-BAR2D = """
-[run]
-dimension = 2
-t_end = "1 ms"
+#: the material of the bars (elastic, E and rho of concrete)
+MATERIAL = """
 [[material]]
 name = "m"
 model = "elastic"
 density = {rho}
 E = {E}
-nu = 0.0
+nu = {nu}
+"""
+
+BAR2D = """
+[run]
+dimension = 2
+t_end = "1 ms"
+{material}
 [[mesh]]
 name = "bar"
 material = "m"
@@ -63,12 +68,7 @@ BAR3D = """
 [run]
 dimension = 3
 t_end = "1 ms"
-[[material]]
-name = "m"
-model = "elastic"
-density = {rho}
-E = {E}
-nu = 0.25
+{material}
 [[mesh]]
 name = "bar"
 material = "m"
@@ -82,13 +82,18 @@ EXTRA = {"penalty": ", tie_factor = 1.0", "tied": "", "hybrid": ""}
 
 
 def bar2d(kind: str, nx: int = 160, integration: str = "one_point"):
-    return loads_deck(BAR2D.format(rho=RHO, E=E, kind=kind, extra=EXTRA[kind], nx=nx,
-                                   ny=nx // 20, integration=integration))
+    return loads_deck(BAR2D.format(material=MATERIAL.format(rho=RHO, E=E, nu=0.0), kind=kind,
+                                   extra=EXTRA[kind], nx=nx, ny=nx // 20,
+                                   integration=integration))
+
+
+def bar3d_text(kind: str, extra: str | None = None) -> str:
+    return BAR3D.format(material=MATERIAL.format(rho=RHO, E=E, nu=0.25), kind=kind,
+                        extra=EXTRA[kind] if extra is None else extra)
 
 
 def bar3d(kind: str, extra: str | None = None):
-    return loads_deck(BAR3D.format(rho=RHO, E=E, kind=kind,
-                                   extra=EXTRA[kind] if extra is None else extra))
+    return loads_deck(bar3d_text(kind, extra))
 
 
 # --------------------------------------------------------------------- tie map
@@ -215,8 +220,7 @@ def test_hybrid_particles_ride_their_elements_and_skip_each_other():
 
 
 def test_hybrid_needs_updated_lagrangian_particles():
-    text = BAR3D.format(rho=RHO, E=E, kind="hybrid", extra="") + \
-        '[sph]\nformulation = "total_lagrangian"\n'
+    text = bar3d_text("hybrid") + '[sph]\nformulation = "total_lagrangian"\n'
     with pytest.raises(DeckError, match="updated-Lagrangian"):
         build_stepper(loads_deck(text))
 
@@ -308,7 +312,7 @@ def test_restart_of_a_coupled_run_is_bitwise(kind, tmp_path):
     from sphdyn.io import read_history_csv
     from sphdyn.simulation import Simulation
 
-    text = BAR3D.format(rho=RHO, E=E, kind=kind, extra="").replace(
+    text = bar3d_text(kind).replace(
         "progress = false", 'progress = false\nevery = "0.5 ms"\nhistory_every = 1') + PULL
     Simulation.from_deck(loads_deck(text), tmp_path / "full").run()
     part = Simulation.from_deck(loads_deck(text.replace(
