@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from sphdyn.assembly import build_stepper
@@ -73,7 +74,8 @@ def _end_forces(name: str, extra=()) -> dict:
 def test_coupled_beam_carries_the_pure_fem_force(coupling, tol, count):
     # FEM-SPH-FEM at 5 mm on 80 x 4 x 4 one-point elements: the end force of
     # each coupling against pure FEM on the same mesh. Measured: penalty with
-    # ties -0.4 %, tied -0.5 %, hybrid -3.7 % (bounds 2, 2 and the issue's 5 %:
+    # ties -0.4 %, tied (total-Lagrangian kernel) +0.3 %, hybrid -3.7 % (bounds
+    # 2, 2 and the issue's 5 %:
     # the hybrid layer's particle sits at the element centre and takes the
     # interface's pair forces there). No energy made at the interfaces
     # (|E_total| < 1e-4 E_internal), quasi-static (KE/IE < 1e-4); both
@@ -84,3 +86,41 @@ def test_coupled_beam_carries_the_pure_fem_force(coupling, tol, count):
     assert abs(cpl["E_total"]) < 1e-4 * cpl["E_internal"]
     assert cpl["KE_IE_ratio"] < 1e-4
     assert cpl[count] == 2 * 16
+
+
+def _centre_deflection(s) -> float:
+    """Mean vertical displacement [m] of the nodes or particles closest to
+    mid-span (x0 within 35 mm of 2.5 m): the S-shaped beam's inflection
+    point moves by half the end displacement."""
+    uy = []
+    for part in s.parts:
+        q = part.kin
+        near = np.abs(q.x0[:, 0] - 0.5 * L) < 0.035
+        uy.append(q.x[near, 1] - q.x0[near, 1])
+    return float(np.concatenate(uy).mean())
+
+
+@pytest.mark.slow
+def test_tied_beam_at_half_a_metre_carries_the_pure_fem_force():
+    # The thesis's case itself: end moved 0.5 m, where the beam stretches
+    # (membrane force ~10 MN) and the SPH region is in tension. 80 x 4 x 4
+    # one-point elements (the example runs 160 x 8 x 8). The tied model with
+    # the total-Lagrangian kernel (the example's choice) against pure FEM:
+    # the issue's 5 % on the end force (measured +1.5 %; the Eulerian kernel
+    # gives -3.4 % here and -22 % at 160 x 8 x 8, the tensile instability),
+    # the inflection point at mid-span (deflection there half the end's
+    # within 1 %: measured ~0.1 %), no energy made (|E_total| < 1e-3 E_int;
+    # measured 2e-5).
+    sets = ["mesh.beam.block.divisions=[80, 4, 4]"]
+    out = {}
+    for name in ("fem", "tied"):
+        s = build_stepper(load_deck(ROOT / f"examples/beam_{name}.toml", sets))
+        while s.t < 0.15:
+            s.step(t_stop=0.15)
+        out[name] = (s.record(), _centre_deflection(s))
+    (fem, fem_mid), (tied, tied_mid) = out["fem"], out["tied"]
+    assert tied["moved_reaction_y"] == pytest.approx(fem["moved_reaction_y"], rel=0.05)
+    assert fem_mid == pytest.approx(-0.25, rel=0.01)
+    assert tied_mid == pytest.approx(-0.25, rel=0.01)
+    assert abs(tied["E_total"]) < 1e-3 * tied["E_internal"]
+    assert tied["KE_IE_ratio"] < 1e-6

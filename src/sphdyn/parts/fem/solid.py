@@ -220,6 +220,7 @@ def uniform_forces(v, conn, active, sig, L, rho, c, e_spec, e_av, xl, g, vol, ga
             coef = qh * rho[e] * c[e] * V ** ((dim - 1.0) / dim) / 4.0
         else:
             coef = qh * rho[e] * c[e] * c[e] * V * bb / dim
+        inv_v = 1.0 / V  # one division per element, not one per mode and node
         power = 0.0
         for a in range(nm):
             # gamma_aI = Gamma_aI - (sum_J Gamma_aJ x_J) . b_I
@@ -234,7 +235,7 @@ def uniform_forces(v, conn, active, sig, L, rho, c, e_spec, e_av, xl, g, vol, ga
             qd1 = 0.0
             qd2 = 0.0
             for I in range(nen):
-                gI = gam[a, I] - (h0 * g[e, I, 0] + h1 * g[e, I, 1] + h2 * g[e, I, 2]) / V
+                gI = gam[a, I] - (h0 * g[e, I, 0] + h1 * g[e, I, 1] + h2 * g[e, I, 2]) * inv_v
                 n = conn[e, I]
                 qd0 += v[n, 0] * gI
                 qd1 += v[n, 1] * gI
@@ -254,7 +255,7 @@ def uniform_forces(v, conn, active, sig, L, rho, c, e_spec, e_av, xl, g, vol, ga
                 Q2 = 0.0
             power += Q0 * qd0 + Q1 * qd1 + Q2 * qd2
             for I in range(nen):
-                gI = gam[a, I] - (h0 * g[e, I, 0] + h1 * g[e, I, 1] + h2 * g[e, I, 2]) / V
+                gI = gam[a, I] - (h0 * g[e, I, 0] + h1 * g[e, I, 1] + h2 * g[e, I, 2]) * inv_v
                 fe[e, I, 0] -= Q0 * gI
                 fe[e, I, 1] -= Q1 * gI
                 fe[e, I, 2] -= Q2 * gI
@@ -398,25 +399,47 @@ def reduced_forces(conn, active, sig, L, rho, c, e_spec, e_av, g, vol, Bg, wg, q
                 fe[e, I, i] += q * g[e, I, i]
 
 
-@njit(cache=True, error_model="numpy")
-def element_time_step(g, vol, c, L, ngp, active, q1, q2, cfl):
+#: blocks of the parallel minimum in :func:`element_time_step`
+DT_BLOCKS = 64
+
+
+@njit(cache=True, error_model="numpy", parallel=True)
+def element_time_step(g, vol, c, L, ngp, active, q1, q2, cfl, blk_t, blk_k):
     r"""Stable step :math:`C\,\ell/(Q + \sqrt{Q^2 + c^2})` of the elements and the
     controlling element (module docstring); ``c`` and ``L`` per point (the
-    element's largest c, its first point's volumetric rate)."""
+    element's largest c, its first point's volumetric rate).
+
+    The minimum is taken in parallel over ``blk_t.size`` contiguous blocks
+    (scratch ``blk_t`` (B,) float, ``blk_k`` (B,) int64), then over the
+    blocks in order, so the controlling element is the first one with the
+    smallest step, as a serial loop would find it.
+    """
+    ne = g.shape[0]
+    nb = blk_t.shape[0]
+    size = (ne + nb - 1) // nb
+    for b in prange(nb):
+        best = np.inf
+        k = 0
+        for e in range(b * size, min(ne, (b + 1) * size)):
+            if active[e] == 0:
+                continue
+            ell = char_length(g[e], vol[e])
+            ce = 0.0
+            for j in range(ngp):
+                ce = max(ce, c[e * ngp + j])
+            p = e * ngp
+            dkk = L[p, 0, 0] + L[p, 1, 1] + L[p, 2, 2]
+            Q = q2 * ce + (q1 * ell * -dkk if dkk < 0.0 else 0.0)
+            t = ell / (Q + math.sqrt(Q * Q + ce * ce) + 1e-300)
+            if t < best:
+                best = t
+                k = e
+        blk_t[b] = best
+        blk_k[b] = k
     best = np.inf
     k = 0
-    for e in range(g.shape[0]):
-        if active[e] == 0:
-            continue
-        ell = char_length(g[e], vol[e])
-        ce = 0.0
-        for j in range(ngp):
-            ce = max(ce, c[e * ngp + j])
-        p = e * ngp
-        dkk = L[p, 0, 0] + L[p, 1, 1] + L[p, 2, 2]
-        Q = q2 * ce + (q1 * ell * -dkk if dkk < 0.0 else 0.0)
-        t = ell / (Q + math.sqrt(Q * Q + ce * ce) + 1e-300)
-        if t < best:
-            best = t
-            k = e
+    for b in range(nb):
+        if blk_t[b] < best:
+            best = blk_t[b]
+            k = blk_k[b]
     return cfl * best, k

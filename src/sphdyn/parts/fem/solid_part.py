@@ -29,7 +29,7 @@ from ...fields import von_mises
 from ...state import Elements, MaterialPoints, Nodes
 from ..base import register_part
 from .gather import gather_loads, node_element_list
-from .solid import (HG_STIFFNESS, HG_VISCOUS, element_time_step, reduced_forces,
+from .solid import (DT_BLOCKS, HG_STIFFNESS, HG_VISCOUS, element_time_step, reduced_forces,
                     reduced_strain_rate, uniform_forces, uniform_strain_rate)
 
 INTEGRATIONS = ("one_point", "selective_reduced")
@@ -97,6 +97,8 @@ class SolidPart:
         self.reduced = settings.integration == "selective_reduced"
         self.ngp = self.dN.shape[0] if self.reduced else 1
         self.hg_form = HOURGLASS_FORMS[settings.hourglass]
+        self._dt_t = np.empty(DT_BLOCKS)  # scratch of the parallel stable step
+        self._dt_k = np.empty(DT_BLOCKS, dtype=np.int64)
         nen = elements.nen
         for name_, tail in (("xl", (nen, 3)), ("g", (nen, 3)), ("fe", (nen, 3))):
             elements.add(name_, tail)
@@ -185,7 +187,7 @@ class SolidPart:
         """Element step and the controlling element (:func:`.solid.element_time_step`)."""
         el, p, s = self.el, self.pts, self.s
         return element_time_step(el.g, el.vol, p.c, p.L, self.ngp, el.active, s.q1, s.q2,
-                                 s.cfl)
+                                 s.cfl, self._dt_t, self._dt_k)
 
     def describe_limit(self, k: int) -> str:
         """What element ``k`` of :meth:`stable_dt` is, for a diagnosis."""
