@@ -26,9 +26,11 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 #: the thesis's five models
 MODELS = ("fem", "penalty", "tied", "hybrid", "sph")
-LABELS = {"fem": "pure FEM (reference)", "penalty": "FEM-SPH-FEM, penalty",
-          "tied": "FEM-SPH-FEM, tied", "hybrid": "FEM-SPH-FEM, hybrid",
-          "sph": "pure SPH"}
+LABELS = {"fem": "pure FEM (reference)",
+          "penalty": "FEM-SPH-FEM, penalty (Eulerian kernel)",
+          "tied": "FEM-SPH-FEM, tied (total-Lagrangian kernel)",
+          "hybrid": "FEM-SPH-FEM, hybrid (Eulerian kernel)",
+          "sph": "pure SPH (total-Lagrangian kernel)"}
 
 
 def run(model: str, reuse: bool) -> Path:

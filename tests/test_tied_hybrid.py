@@ -17,8 +17,11 @@ Pinned here:
   conserved to round-off (1e-12 of the momentum scale), a compression pulse
   from the particles into the elements reflects less than 5 % of its
   amplitude, and no energy is created at the interface;
-* bad input: the coupling's keys, an empty interface, total-Lagrangian
-  particles in the hybrid layer.
+* the hybrid layer with the total-Lagrangian kernel: hybrid pairs cut from
+  the force pass (factors, hourglass factors, own-share sums, 1e-12), kept in
+  the deformation gradient, and their share of L pinned against NumPy;
+  momentum, pulse and restart as for the others;
+* bad input: the coupling's keys, an empty interface.
 """
 
 from __future__ import annotations
@@ -79,17 +82,26 @@ progress = false
 """
 
 EXTRA = {"penalty": ", tie_factor = 1.0", "tied": "", "hybrid": ""}
+#: the [sph] line of the total-Lagrangian variants (kind "hybrid_tl")
+TL = '[sph]\nformulation = "total_lagrangian"\n'
 
 
 def bar2d(kind: str, nx: int = 160, integration: str = "one_point"):
-    return loads_deck(BAR2D.format(material=MATERIAL.format(rho=RHO, E=E, nu=0.0), kind=kind,
-                                   extra=EXTRA[kind], nx=nx, ny=nx // 20,
-                                   integration=integration))
+    """The 2D bar; kind ``hybrid_tl``: the hybrid coupling, total-Lagrangian particles."""
+    name = kind.removesuffix("_tl")
+    text = BAR2D.format(material=MATERIAL.format(rho=RHO, E=E, nu=0.0), kind=name,
+                        extra=EXTRA[name], nx=nx, ny=nx // 20, integration=integration)
+    if kind.endswith("_tl"):
+        text = text.replace("[sph]\n", TL)
+    return loads_deck(text)
 
 
 def bar3d_text(kind: str, extra: str | None = None) -> str:
-    return BAR3D.format(material=MATERIAL.format(rho=RHO, E=E, nu=0.25), kind=kind,
-                        extra=EXTRA[kind] if extra is None else extra)
+    """The 3D bar's deck; kind ``hybrid_tl`` as in :func:`bar2d`."""
+    name = kind.removesuffix("_tl")
+    text = BAR3D.format(material=MATERIAL.format(rho=RHO, E=E, nu=0.25), kind=name,
+                        extra=EXTRA[name] if extra is None else extra)
+    return text + TL if kind.endswith("_tl") else text
 
 
 def bar3d(kind: str, extra: str | None = None):
@@ -219,10 +231,43 @@ def test_hybrid_particles_ride_their_elements_and_skip_each_other():
     assert np.count_nonzero(others) > 0
 
 
-def test_hybrid_needs_updated_lagrangian_particles():
-    text = bar3d_text("hybrid") + '[sph]\nformulation = "total_lagrangian"\n'
-    with pytest.raises(DeckError, match="updated-Lagrangian"):
-        build_stepper(loads_deck(text))
+def test_total_lagrangian_hybrid_pairs_leave_the_forces_but_not_the_gradient():
+    # The hybrid layer with the total-Lagrangian kernel: the fixed pairs of two
+    # hybrid particles are cut from the force pass once (factor and hourglass
+    # factor zero, the own-share sum gsum without them, to 1e-12), the
+    # deformation gradient keeps them, and L^hh (the part of L they give, whose
+    # stress work the coupling takes off) is [sum_hybrid V_j fac (v_j - v_i) x
+    # (X_i - X_j)] B^T F^-1: pinned against a NumPy sum after steps with random
+    # velocities, together with the whole L of the scheme from all pairs (the
+    # same convention: sign, transpose and factor).
+    s = build_stepper(loads_deck(bar3d_text("hybrid") + TL))
+    sph = s.parts[0]
+    t, cpl, p = sph.tl, s.interactions[-1], s.particles
+    assert cpl.tl and cpl.rows.size == 8  # one layer of 2 x 2 elements, 2 sides
+    rows = np.repeat(np.arange(t.offsets.size - 1), np.diff(t.offsets))
+    cut = cpl.hybrid[rows] & cpl.hybrid[t.idx]
+    assert cut.any() and (t.fac[cut] != 0).any()
+    assert np.all(t.fac_f[cut] == 0) and np.all(t.hgk[cut] == 0)
+    assert np.array_equal(t.fac_f[~cut], t.fac[~cut])
+    g = (t.vol[t.idx] * t.fac_f.astype(float))[:, None] * (t.X[rows] - t.X[t.idx])
+    gsum = np.zeros_like(t.gsum)
+    np.add.at(gsum, rows, g)
+    assert np.allclose(t.gsum_f[t.rows], gsum[t.rows], rtol=0, atol=1e-12 * np.abs(gsum).max())
+    rng = np.random.default_rng(3)
+    for part in s.parts:
+        part.kin.v[:] = 0.01 * rng.normal(size=part.kin.v.shape)
+    for _ in range(5):
+        s.step()
+    for k, i in enumerate(cpl.rows):
+        j = t.idx[t.offsets[i]:t.offsets[i + 1]]
+        f = t.vol[j] * t.fac[t.offsets[i]:t.offsets[i + 1]].astype(float)
+        raw = (f[:, None, None] * (p.v[j] - p.v[i])[:, :, None]
+               * (t.X[i] - t.X[j])[:, None, :])
+        corr = t.B0[i].T @ t.Finv[i]
+        lhh = raw[cpl.hybrid[j]].sum(axis=0) @ corr
+        assert np.allclose(cpl.Lhh[k], lhh, rtol=0, atol=1e-10 * np.abs(lhh).max())
+        assert np.allclose(p.L[i], raw.sum(axis=0) @ corr, rtol=0,
+                           atol=1e-10 * np.abs(p.L[i]).max())
 
 
 # ------------------------------------------------------------ every coupling
@@ -236,7 +281,7 @@ def _momentum(s):
     return out
 
 
-@pytest.mark.parametrize("kind", ["penalty", "tied", "hybrid"])
+@pytest.mark.parametrize("kind", ["penalty", "tied", "hybrid", "hybrid_tl"])
 def test_coupling_conserves_momentum_to_round_off(kind):
     s = build_stepper(bar3d(kind))
     rng = np.random.default_rng(1)
@@ -252,7 +297,7 @@ def test_coupling_conserves_momentum_to_round_off(kind):
     assert np.abs(_momentum(s) - p0).max() < 1e-12 * scale
 
 
-@pytest.mark.parametrize("kind", ["penalty", "tied", "hybrid"])
+@pytest.mark.parametrize("kind", ["penalty", "tied", "hybrid", "hybrid_tl"])
 def test_compression_pulse_passes_from_particles_into_elements(kind):
     # A 2 m plane-strain bar (nu = 0: uniaxial waves at c = sqrt(E/rho)), 320 x 16
     # quadrilaterals of 6.25 mm; its left half is particles. A sin^2 velocity
@@ -282,8 +327,11 @@ def test_compression_pulse_passes_from_particles_into_elements(kind):
     assert reflected < 0.05 * v0 / 2
     ahead = (q.x[:, 0] > 1.05) & (q.x[:, 0] < 1.6)
     assert q.v[ahead, 0].max() > 0.85 * v0 / 2
+    # the total-Lagrangian scheme's own balance errs by +0.13 % in this pulse
+    # (the tied coupling with it: the same +0.13 %, hybrid_tl - tied_tl 5e-6),
+    # the Eulerian one by +0.06 %: the bound is on what the interface adds
     e_total = s.record(kinetic=s.kinetic_now())["E_total"]
-    assert e_total < ke0 * (1 + 1e-3)
+    assert e_total < ke0 * (1 + (2e-3 if kind.endswith("_tl") else 1e-3))
     assert e_total == pytest.approx(ke0, rel=0.01)
 
 
@@ -306,7 +354,7 @@ velocity = [0, "-2 m/s", 0]
 """
 
 
-@pytest.mark.parametrize("kind", ["tied", "hybrid"])
+@pytest.mark.parametrize("kind", ["tied", "hybrid", "hybrid_tl"])
 def test_restart_of_a_coupled_run_is_bitwise(kind, tmp_path):
     from sphdyn.cli import main
     from sphdyn.io import read_history_csv

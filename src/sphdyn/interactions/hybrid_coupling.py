@@ -25,7 +25,9 @@ material with the point's volume and mass.
   of its strain energy at the interface, against 3.7 % and 0.02 % this way.)
 * Forces: pairs of two hybrid particles are taken out of the momentum
   equation (their pair gradient factor is set to zero after the velocity
-  gradients, which keep them; the element carries its own stiffness), pairs
+  gradients, which keep them; the element carries its own stiffness; with
+  the total-Lagrangian kernel the pairs are fixed, so the scheme's force
+  pass drops them once, :meth:`~sphdyn.parts.sph.tl_scheme.TotalLagrangian.forces_off`), pairs
   of a hybrid and an SPH particle stay: the hybrid particle gets the equal
   and opposite pair force, which goes to the element's nodes, :math:`\mathbf F_a = N_a(\boldsymbol\xi_h)\,\mathbf F_h`,
   :math:`\mathbf F_h = m_h(\mathbf a_h + \mathbf a^{ext}_h)`. With
@@ -102,6 +104,49 @@ def hybrid_pair_gradient(rows, hybrid, offsets, idx, F, x, v, vol, B, Lhh):
                 Lhh[k, a, b] = s
 
 
+@njit(cache=True, error_model="numpy", parallel=True)
+def tl_hybrid_pair_gradient(rows, hybrid, offsets, idx, fac, v, X, vol, B0, Finv, Lhh):
+    r"""Total-Lagrangian form of :func:`hybrid_pair_gradient`: the hybrid-hybrid
+    pairs' part of :math:`\mathbf L_h = \dot F_h F_h^{-1}`,
+
+    .. math:: \mathbf L^{hh}_h = \Big[\sum_{j\ \mathrm{hybrid}} V_j\,
+              \mathrm{fac}_{hj} (\mathbf v_j - \mathbf v_h) \otimes
+              (\mathbf X_h - \mathbf X_j)\Big] B_h^T F_h^{-1}
+
+    (the terms of :func:`sphdyn.parts.sph.total_lagrangian.deformation_gradient`
+    that those pairs gave). ``fac`` (nnz,) the reference pair factors (all
+    pairs), ``v``, ``X`` (N, 3), ``vol`` (N,) reference volumes, ``B0`` and
+    ``Finv`` (N, 3, 3); ``Lhh`` (H, 3, 3) out [1/s]. Since
+    :math:`\sigma : \mathbf L\, V = P : \dot F\, V_0`, :func:`remove_pair_work`
+    takes these pairs' stress work off as in the updated-Lagrangian case.
+    """
+    for k in prange(rows.shape[0]):
+        i = rows[k]
+        raw = np.zeros((3, 3))
+        for q in range(offsets[i], offsets[i + 1]):
+            j = idx[q]
+            if not hybrid[j]:
+                continue
+            f = np.float64(fac[q]) * vol[j]
+            for a in range(3):
+                u = v[j, a] - v[i, a]
+                for b in range(3):
+                    raw[a, b] += u * f * (X[i, b] - X[j, b])
+        fdot = np.zeros((3, 3))
+        for a in range(3):
+            for b in range(3):
+                s = 0.0
+                for c in range(3):
+                    s += raw[a, c] * B0[i, b, c]
+                fdot[a, b] = s
+        for a in range(3):
+            for b in range(3):
+                s = 0.0
+                for c in range(3):
+                    s += fdot[a, c] * Finv[i, c, b]
+                Lhh[k, a, b] = s
+
+
 @njit(cache=True, error_model="numpy")
 def remove_pair_work(rows, sig, rho, Lhh, dt, e):
     r""":math:`e_h \mathrel{-}= \Delta t\,\sigma_h : \mathbf L^{hh}_h / \rho_h`: the
@@ -157,7 +202,8 @@ class HybridCoupling(InteractionBase):
     ----------
     name : history columns ``F_<name>_x|y|z`` (resultant force the hybrid
         particles pass to the nodes [N], N/m in 2D) and ``hybrid_<name>``.
-    sph_part : the SPH part holding the hybrid particles (updated-Lagrangian).
+    sph_part : the SPH part holding the hybrid particles (updated- or
+        total-Lagrangian).
     solid_part : the solid part of the hybrid elements.
     rows : (H,) the hybrid particles' rows in the SPH part.
     elem : (H,) their elements in the solid part.
@@ -178,10 +224,11 @@ class HybridCoupling(InteractionBase):
         if xi.shape != (self.rows.size, d) or self.elem.shape != self.rows.shape:
             raise ValueError(f"{name}: rows (H,), elem (H,) and xi (H, {d}) must agree, "
                              f"got {self.rows.shape}, {self.elem.shape}, {xi.shape}")
-        if np.any(p.tl[self.rows]):
-            raise ValueError(f"{name}: the hybrid coupling needs updated-Lagrangian "
-                             "particles (it takes the hybrid pairs out of the UL passes); "
-                             "set sph.formulation = \"updated_lagrangian\"")
+        tl = p.tl[self.rows]
+        if tl.any() and not tl.all():
+            raise ValueError(f"{name}: the hybrid particles must all be updated- or all "
+                             "total-Lagrangian")
+        self.tl = bool(tl.all())
         busy = self.rows[p.bc[self.rows] != BC_FREE]
         if busy.size:
             raise ValueError(f"{name}: particles {busy[:5].tolist()} have boundary "
@@ -195,6 +242,8 @@ class HybridCoupling(InteractionBase):
         p.on_grow(self._mask)
         p.bc[self.rows] = BC_SLAVE
         self.constrain(0.0, 0.0)
+        if self.tl:  # the pairs are fixed: out of the force pass once
+            sph_part.tl.forces_off(self.hybrid)
         sph_part.pair_filters.append(self._pairs_off)
 
     def _mask(self, n_old: int, n_new: int) -> None:
@@ -206,6 +255,11 @@ class HybridCoupling(InteractionBase):
         the velocity gradient kept aside, then the pairs out."""
         sph = self.part
         p = sph.p
+        if self.tl:
+            t = sph.tl
+            tl_hybrid_pair_gradient(self.rows, self.hybrid, t.offsets, t.idx, t.fac, p.v,
+                                    t.X, t.vol, t.B0, t.Finv, self.Lhh)
+            return
         hybrid_pair_gradient(self.rows, self.hybrid, sph.nl.offsets, sph.nl.idx, sph.F,
                              p.x, p.v, p.vol, p.B, self.Lhh)
         hybrid_pairs_off(self.rows, self.hybrid, sph.nl.offsets, sph.nl.idx, sph.F)

@@ -48,6 +48,12 @@ class TotalLagrangian:
     passes write the ``rows`` only. :meth:`update_reference` makes the current
     configuration the new reference (``X``, ``rho_ref``; the Cauchy stress
     carries over, F restarts from I).
+
+    :meth:`forces_off` takes the pairs of a set of particles among
+    themselves out of the momentum equation (viscosity and hourglass
+    control included) while the deformation gradient keeps them: the hybrid
+    transition layer (:mod:`sphdyn.interactions.hybrid_coupling`), whose
+    particles ride with their elements, which carry their stiffness.
     """
 
     def __init__(self, p, rows, kernel, young, hourglass, alpha=0.0, beta=0.0):
@@ -59,6 +65,7 @@ class TotalLagrangian:
         self.alpha = float(alpha)
         self.beta = float(beta)
         self.n_updates = 0
+        self.off = None  # (N,) bool: particles whose mutual pairs carry no force
         self.rebuild(p, p.x0.copy(), p.rho0.copy())
 
     def rebuild(self, p, X: np.ndarray, rho_ref: np.ndarray) -> None:
@@ -86,6 +93,37 @@ class TotalLagrangian:
         self.hgk = np.zeros(nnz, dtype=np.float32)
         hourglass_coefficients(self.rows, X, self.vol, self.offsets, self.idx, w,
                                self.young, self.hourglass, self.hgk)
+        self._force_pairs()
+
+    def forces_off(self, off: np.ndarray) -> None:
+        """Take the pairs of two particles of ``off`` (N,) bool out of the forces."""
+        self.off = np.asarray(off, dtype=bool)
+        self._force_pairs()
+
+    def _force_pairs(self) -> None:
+        r"""Pair factors ``fac_f`` and own-share sums ``gsum_f`` of the force pass:
+        ``fac`` and ``gsum`` with the pairs of :meth:`forces_off` removed (and
+        their hourglass factors zeroed), :math:`\mathbf{gsum}_i = \sum_j V_j
+        \mathrm{fac}_{ij}(\mathbf X_i - \mathbf X_j)` over the pairs kept."""
+        self.fac_f, self.gsum_f = self.fac, self.gsum
+        if self.off is None or not self.off.any():
+            return
+        if self.off.size != self.X.shape[0]:  # particles were added
+            off = np.zeros(self.X.shape[0], dtype=bool)
+            k = min(off.size, self.off.size)
+            off[:k] = self.off[:k]
+            self.off = off
+        rows = np.repeat(np.arange(self.offsets.size - 1), np.diff(self.offsets))
+        cut = self.off[rows] & self.off[self.idx]
+        self.fac_f = self.fac.copy()
+        self.fac_f[cut] = 0.0
+        self.hgk[cut] = 0.0
+        i, j = rows[cut], self.idx[cut]
+        share = (self.vol[j] * self.fac[cut].astype(np.float64))[:, None] * (self.X[i] - self.X[j])
+        self.gsum_f = self.gsum.copy()
+        np.subtract.at(self.gsum_f, i, share)
+        if self.dim == 2:
+            self.gsum_f[:, 2] = 0.0
 
     def update_reference(self, p) -> None:
         """Make the current positions and densities the reference configuration.
@@ -113,7 +151,8 @@ class TotalLagrangian:
         and hourglass terms."""
         piola_stress(self.rows, self.F, self.Finv, p.sig, self.vol, self.B0, self.P, self.Q)
         tl_forces(self.rows, p.x, p.v, self.X, p.m, p.rho, self.rho_ref, p.c, p.h0,
-                  self.vol, self.offsets, self.idx, self.fac, self.hgk, self.gsum, self.P,
+                  self.vol, self.offsets, self.idx, self.fac_f, self.hgk, self.gsum_f,
+                  self.P,
                   self.Q, self.B0, self.F, self.dim, self.alpha, self.beta, self.kernel.support_scale,
                   p.a, dedt_av)
 
