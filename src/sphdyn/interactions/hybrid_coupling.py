@@ -74,51 +74,28 @@ def hybrid_kinematics(rows, elem, N, conn, xn, vn, xp, vp):
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def hybrid_pair_gradient(rows, hybrid, offsets, idx, F, x, v, vol, B, Lhh):
-    r"""The hybrid-hybrid pairs' part of each hybrid particle's velocity gradient,
-    :math:`\mathbf L^{hh}_h = \sum_{j\ \mathrm{hybrid}} V_j(\mathbf v_j - \mathbf v_h)
-    \otimes F_{hj}(\mathbf x_h - \mathbf x_j)\,B_h^T` (the terms of
-    :func:`sphdyn.parts.sph.passes.velocity_gradient` that those pairs gave).
+def hybrid_pair_gradient(rows, hybrid, offsets, idx, fac, pos, v, vol, B, Finv, tl, Lhh):
+    r"""The hybrid-hybrid pairs' part of each hybrid particle's velocity gradient.
 
-    ``F`` (nnz,) the pair factors before :func:`hybrid_pairs_off`; ``x``, ``v``
-    (N, 3); ``vol`` (N,) the volumes the pass used; ``B`` (N, 3, 3);
-    ``Lhh`` (H, 3, 3) out.
-    """
-    for k in prange(rows.shape[0]):
-        i = rows[k]
-        raw = np.zeros((3, 3))
-        for q in range(offsets[i], offsets[i + 1]):
-            j = idx[q]
-            if not hybrid[j]:
-                continue
-            f = F[q] * vol[j]
-            for a in range(3):
-                u = v[j, a] - v[i, a]
-                for b in range(3):
-                    raw[a, b] += u * f * (x[i, b] - x[j, b])
-        for a in range(3):
-            for b in range(3):
-                s = 0.0
-                for c in range(3):
-                    s += raw[a, c] * B[i, b, c]
-                Lhh[k, a, b] = s
-
-
-@njit(cache=True, error_model="numpy", parallel=True)
-def tl_hybrid_pair_gradient(rows, hybrid, offsets, idx, fac, v, X, vol, B0, Finv, Lhh):
-    r"""Total-Lagrangian form of :func:`hybrid_pair_gradient`: the hybrid-hybrid
-    pairs' part of :math:`\mathbf L_h = \dot F_h F_h^{-1}`,
+    Updated-Lagrangian (``tl`` False; the terms of
+    :func:`sphdyn.parts.sph.passes.velocity_gradient` that those pairs gave):
 
     .. math:: \mathbf L^{hh}_h = \Big[\sum_{j\ \mathrm{hybrid}} V_j\,
-              \mathrm{fac}_{hj} (\mathbf v_j - \mathbf v_h) \otimes
-              (\mathbf X_h - \mathbf X_j)\Big] B_h^T F_h^{-1}
+              F_{hj} (\mathbf v_j - \mathbf v_h) \otimes
+              (\mathbf x_h - \mathbf x_j)\Big] B_h^T;
 
-    (the terms of :func:`sphdyn.parts.sph.total_lagrangian.deformation_gradient`
-    that those pairs gave). ``fac`` (nnz,) the reference pair factors (all
-    pairs), ``v``, ``X`` (N, 3), ``vol`` (N,) reference volumes, ``B0`` and
-    ``Finv`` (N, 3, 3); ``Lhh`` (H, 3, 3) out [1/s]. Since
-    :math:`\sigma : \mathbf L\, V = P : \dot F\, V_0`, :func:`remove_pair_work`
-    takes these pairs' stress work off as in the updated-Lagrangian case.
+    total-Lagrangian (``tl`` True; the terms of
+    :func:`sphdyn.parts.sph.total_lagrangian.deformation_gradient`, with
+    :math:`\mathbf L = \dot F F^{-1}`): the same sum with the reference
+    positions :math:`\mathbf X`, volumes and factors, times :math:`F_h^{-1}`.
+    Since :math:`\sigma : \mathbf L\, V = P : \dot F\, V_0`,
+    :func:`remove_pair_work` serves both.
+
+    ``fac`` (nnz,) the pair factors of all pairs (UL: before
+    :func:`hybrid_pairs_off`); ``pos``, ``v`` (N, 3) the positions of the
+    sum (current or reference) and velocities; ``vol`` (N,) the volumes the
+    pass used; ``B`` and ``Finv`` (N, 3, 3) (``Finv`` unused in UL);
+    ``Lhh`` (H, 3, 3) out [1/s].
     """
     for k in prange(rows.shape[0]):
         i = rows[k]
@@ -131,20 +108,21 @@ def tl_hybrid_pair_gradient(rows, hybrid, offsets, idx, fac, v, X, vol, B0, Finv
             for a in range(3):
                 u = v[j, a] - v[i, a]
                 for b in range(3):
-                    raw[a, b] += u * f * (X[i, b] - X[j, b])
-        fdot = np.zeros((3, 3))
+                    raw[a, b] += u * f * (pos[i, b] - pos[j, b])
+        out = np.zeros((3, 3))
         for a in range(3):
             for b in range(3):
                 s = 0.0
                 for c in range(3):
-                    s += raw[a, c] * B0[i, b, c]
-                fdot[a, b] = s
+                    s += raw[a, c] * B[i, b, c]
+                out[a, b] = s
         for a in range(3):
             for b in range(3):
-                s = 0.0
-                for c in range(3):
-                    s += fdot[a, c] * Finv[i, c, b]
-                Lhh[k, a, b] = s
+                if tl:
+                    Lhh[k, a, b] = (out[a, 0] * Finv[i, 0, b] + out[a, 1] * Finv[i, 1, b]
+                                    + out[a, 2] * Finv[i, 2, b])
+                else:
+                    Lhh[k, a, b] = out[a, b]
 
 
 @njit(cache=True, error_model="numpy")
@@ -255,13 +233,13 @@ class HybridCoupling(InteractionBase):
         the velocity gradient kept aside, then the pairs out."""
         sph = self.part
         p = sph.p
-        if self.tl:
+        if self.tl:  # the pairs are out of the TL force pass already
             t = sph.tl
-            tl_hybrid_pair_gradient(self.rows, self.hybrid, t.offsets, t.idx, t.fac, p.v,
-                                    t.X, t.vol, t.B0, t.Finv, self.Lhh)
+            hybrid_pair_gradient(self.rows, self.hybrid, t.offsets, t.idx, t.fac, t.X, p.v,
+                                 t.vol, t.B0, t.Finv, True, self.Lhh)
             return
         hybrid_pair_gradient(self.rows, self.hybrid, sph.nl.offsets, sph.nl.idx, sph.F,
-                             p.x, p.v, p.vol, p.B, self.Lhh)
+                             p.x, p.v, p.vol, p.B, p.B, False, self.Lhh)
         hybrid_pairs_off(self.rows, self.hybrid, sph.nl.offsets, sph.nl.idx, sph.F)
 
     def constrain(self, t: float, dt: float) -> None:
