@@ -12,7 +12,8 @@ Cases: ``sphdyn bench rings2d``, ``rings2d_tl``, ``block3d --particles
 100000`` (particle-steps per second of the stepping alone) and the paper's
 CSCM disc (``sphdyn run examples/disc_impact.toml --max-steps 150``,
 particle-steps per second from its summary, output of the first frame
-included in both).
+included in both), ``hex3d --elements 100000`` (element-steps per second);
+``--cases`` picks some by name (comma-separated).
 """
 
 from __future__ import annotations
@@ -28,7 +29,8 @@ from pathlib import Path
 CASES = [("rings2d", ["bench", "rings2d", "--steps", "500"]),
          ("rings2d_tl", ["bench", "rings2d_tl", "--steps", "500"]),
          ("block3d 100k", ["bench", "block3d", "--particles", "100000", "--steps", "30"]),
-         ("CSCM disc", ["run", "examples/disc_impact.toml", "-q", "--max-steps", "150"])]
+         ("CSCM disc", ["run", "examples/disc_impact.toml", "-q", "--max-steps", "150"]),
+         ("hex3d 100k", ["bench", "hex3d", "--elements", "100000", "--steps", "100"])]
 
 
 def measure(src: str, args: list[str], threads: int) -> float:
@@ -41,7 +43,8 @@ def measure(src: str, args: list[str], threads: int) -> float:
         if args[0] == "run":
             summary = json.loads((Path(tmp) / "summary.json").read_text())
             return summary["particle_steps_per_s"]
-    return json.loads(out.stdout.strip().splitlines()[-1])["particle_steps_per_s"]
+    res = json.loads(out.stdout.strip().splitlines()[-1])
+    return res.get("particle_steps_per_s", res.get("element_steps_per_s"))
 
 
 def main():
@@ -50,10 +53,12 @@ def main():
     ap.add_argument("new")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--cases", default=",".join(name for name, _ in CASES))
     a = ap.parse_args()
+    chosen = a.cases.split(",")
     print("| case | old particle-steps/s | new particle-steps/s | new / old |")
     print("|---|---|---|---|")
-    for name, args in CASES:
+    for name, args in [c for c in CASES if c[0] in chosen]:
         for src in (a.old, a.new):  # compile / fill the Numba caches first
             measure(src, args[:-1] + ["3" if args[0] == "bench" else "5"], a.threads)
         best = {a.old: 0.0, a.new: 0.0}

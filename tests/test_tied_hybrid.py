@@ -373,3 +373,17 @@ def test_restart_of_a_coupled_run_is_bitwise(kind, tmp_path):
     for col in ("right_reaction_y", "E_total", "F_bar_coupling_y"):
         assert np.array_equal(h_full[col], h_part[col]), col
     assert abs(h_full["right_reaction_y"][-1]) > 0
+
+
+def test_converted_region_without_coupling_is_damped_as_a_whole():
+    # coupling = "none" with mesh damping: every converted particle gets the
+    # mesh's mass damping (no slaves to leave out), and the model steps
+    text = bar3d_text("tied").replace('coupling = "tied"', 'coupling = "none"').replace(
+        'material = "m"\n', 'material = "m"\ndamping = "100 1/s"\n', 1)
+    s = build_stepper(loads_deck(text))
+    names = [type(i).__name__ for i in s.interactions]
+    assert "TiedCoupling" not in names
+    damp = [i for i in s.interactions if getattr(i, "name", "") == "bar_particles"]
+    assert len(damp) == 1 and damp[0].idx.size == s.particles.n
+    for _ in range(3):
+        s.step()

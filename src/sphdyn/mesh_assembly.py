@@ -115,8 +115,9 @@ def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
             rows = np.flatnonzero(sph_part.p.body == model.body_names.index(mm.name))
             coupling = _coupling(mm, sph_part, part, rows)
             if mm.spec.damping > 0.0:  # the converted particles are damped alike
-                slaves = np.concatenate([getattr(c, "slaves", np.zeros(0, np.int64))
-                                         for c in coupling])
+                slaves = np.concatenate([np.zeros(0, np.int64)]
+                                        + [getattr(c, "slaves", np.zeros(0, np.int64))
+                                           for c in coupling])
                 out.append(MassDamping(f"{mm.name}_particles", sph_part,
                                        np.setdiff1d(rows, slaves), mm.spec.damping))
             out += coupling  # after every other interaction on the particles
