@@ -5,6 +5,14 @@ One code path for both (``dim`` 3 or 2, ``nen`` 8 or 4). Element loops run in
 ``fe`` (E, nen, 3)); :func:`.gather.gather_loads` then sums them per node
 from the node-to-element list, so no two threads write the same memory.
 
+One-point elements take two passes a step, each over blocks of
+:data:`ELEMENT_BLOCK` elements with a small scratch per block (node
+coordinates, velocities, volume derivatives): :func:`uniform_strain_rate`
+(mid-step geometry, velocity gradient, density), the material update, then
+:func:`uniform_forces` (end-of-step geometry, volume, element step, forces).
+Nothing per element is stored between the passes but the point fields, so a
+hex8 costs about 1.1 kB with its node and point (BENCHMARKS.md).
+
 **Kinematics.** Velocities are at :math:`n+\tfrac12`, positions at
 :math:`n+1`. The velocity gradient is evaluated on the mid-step geometry
 :math:`\mathbf x^{n+1/2} = \mathbf x^{n+1} - \tfrac{\Delta t}2 \mathbf v^{n+1/2}`:
@@ -92,6 +100,17 @@ def local_coordinates(x, v, s, conn, e, xl):
 
 
 @njit(cache=True, error_model="numpy")
+def element_nodes(x, v, s, conn, e, xl, vl):
+    """:func:`local_coordinates` of element ``e`` into ``xl`` and its node
+    velocities into ``vl`` (nen, 3) [m/s], read once for the element's passes."""
+    local_coordinates(x, v, s, conn, e, xl)
+    for I in range(conn.shape[1]):
+        n = conn[e, I]
+        for k in range(3):
+            vl[I, k] = v[n, k]
+
+
+@njit(cache=True, error_model="numpy")
 def volume_gradient(xl, dim, tab, g):
     r"""Volume derivatives :math:`\partial V/\partial x_{iI}` (nen, 3) into ``g``; returns V.
 
@@ -135,34 +154,75 @@ def char_length(g, vol):
     return 2.0 * vol / math.sqrt(g.shape[0] * s)
 
 
+#: elements per block of the one-point loops: a block's thread keeps the
+#: element's node coordinates and volume derivatives in its own small scratch
+#: (L1-resident), so no per-element geometry is stored between the passes
+ELEMENT_BLOCK = 256
+
+
+@njit(cache=True, error_model="numpy")
+def element_step(ell, c, dkk, q1, q2):
+    r"""Stable step :math:`\ell/(Q + \sqrt{Q^2 + c^2})` of one element [s] with
+    :math:`Q = Q_2 c + Q_1\ell|\dot\varepsilon_{kk}|` in compression (module
+    docstring; the factor ``cfl`` is applied by the part)."""
+    Q = q2 * c + (q1 * ell * -dkk if dkk < 0.0 else 0.0)
+    return ell / (Q + math.sqrt(Q * Q + c * c) + 1e-300)
+
+
 @njit(cache=True, error_model="numpy", parallel=True)
-def uniform_strain_rate(x, v, conn, active, m_el, dt, dim, tab, xl, g, L, rho, vol):
-    r"""Velocity gradient, volume and density of one-point elements.
+def element_volumes(x, conn, active, dim, tab, c, L, ngp, q1, q2, vol, dt_el):
+    r"""Volumes ``vol`` (E,) [m^3] at ``x`` and the element steps ``dt_el`` (E,) [s]
+    of :func:`element_step` (the element's largest point wave speed ``c``
+    (P,), its first point's rate ``L`` (P, 3, 3)); the state a part needs
+    before its first force pass or after a restart."""
+    ne = conn.shape[0]
+    nen = conn.shape[1]
+    for b in prange((ne + ELEMENT_BLOCK - 1) // ELEMENT_BLOCK):
+        xl = np.empty((nen, 3))
+        g = np.empty((nen, 3))
+        for e in range(b * ELEMENT_BLOCK, min(ne, (b + 1) * ELEMENT_BLOCK)):
+            local_coordinates(x, x, 0.0, conn, e, xl)
+            vol[e] = volume_gradient(xl, dim, tab, g)
+            ce = 0.0
+            for j in range(ngp):
+                ce = max(ce, c[e * ngp + j])
+            p = e * ngp
+            dkk = L[p, 0, 0] + L[p, 1, 1] + L[p, 2, 2]
+            dt_el[e] = (element_step(char_length(g, vol[e]), ce, dkk, q1, q2)
+                        if active[e] else np.inf)
+
+
+@njit(cache=True, error_model="numpy", parallel=True)
+def uniform_strain_rate(x, v, conn, active, m_el, dt, dim, tab, L, rho):
+    r"""Velocity gradient and density of one-point elements (mid-step geometry).
 
     For each active element: :math:`L = \sum_I \mathbf v_I \otimes \mathbf b_I`
-    and the density ``rho = m_el / V`` (E,) on the mid-step geometry (:math:`b
-    = \partial V/\partial x / V`), so the material's energy increment
-    :math:`\Delta t\,\bar\sigma:D / \rho` is the stress power of the mid-step
-    volume (with the volume at :math:`n+1` the energy balance would err at
-    first order in dt); then the volume derivatives ``g`` (E, nen, 3) and
-    volume ``vol`` (E,) at :math:`\mathbf x^{n+1}`. ``xl`` (E, nen, 3)
-    scratch. ``L`` (E, 3, 3) out [1/s] (zz = 0 in 2D).
+    and the density ``rho = m_el / V`` (E,) on the mid-step geometry
+    :math:`\mathbf x - \tfrac{\Delta t}2\mathbf v` (:math:`b = \partial
+    V/\partial x / V`), so the material's energy increment :math:`\Delta
+    t\,\bar\sigma:D / \rho` is the stress power of the mid-step volume (with
+    the volume at :math:`n+1` the energy balance would err at first order in
+    dt). ``L`` (E, 3, 3) out [1/s] (zz = 0 in 2D).
     """
-    for e in prange(conn.shape[0]):
-        if active[e] == 0:
-            continue
-        local_coordinates(x, v, 0.5 * dt, conn, e, xl[e])
-        vm = volume_gradient(xl[e], dim, tab, g[e])
-        inv = 1.0 / vm if vm > 0.0 else 0.0
-        rho[e] = m_el[e] * inv  # mid-step: the stress power sigma:D V^(n+1/2) dt
-        for i in range(3):
-            for j in range(3):
-                s = 0.0
-                for I in range(conn.shape[1]):
-                    s += v[conn[e, I], i] * g[e, I, j]
-                L[e, i, j] = s * inv
-        local_coordinates(x, v, 0.0, conn, e, xl[e])
-        vol[e] = volume_gradient(xl[e], dim, tab, g[e])
+    ne = conn.shape[0]
+    nen = conn.shape[1]
+    for b in prange((ne + ELEMENT_BLOCK - 1) // ELEMENT_BLOCK):
+        xl = np.empty((nen, 3))
+        vl = np.empty((nen, 3))
+        g = np.empty((nen, 3))
+        for e in range(b * ELEMENT_BLOCK, min(ne, (b + 1) * ELEMENT_BLOCK)):
+            if active[e] == 0:
+                continue
+            element_nodes(x, v, 0.5 * dt, conn, e, xl, vl)
+            vm = volume_gradient(xl, dim, tab, g)
+            inv = 1.0 / vm if vm > 0.0 else 0.0
+            rho[e] = m_el[e] * inv  # mid-step: the stress power sigma:D V^(n+1/2) dt
+            for i in range(3):
+                for j in range(3):
+                    s = 0.0
+                    for I in range(nen):
+                        s += vl[I, i] * g[I, j]
+                    L[e, i, j] = s * inv
 
 
 @njit(cache=True, error_model="numpy")
@@ -174,92 +234,167 @@ def bulk_viscosity(rho, c, ell, dkk, q1, q2):
     return rho * ell * (q1 * ell * dkk * dkk - q2 * c * dkk)
 
 
+@njit(cache=True, error_model="numpy")
+def hourglass_resultants(e, vl, xl, g, V, gam, hg_form, coef, hg, dt, dim, Q, M):
+    r"""Hourglass generalised forces ``Q`` (modes, 3) [N] of element ``e`` and
+    their share ``M`` (3, 3) [N m] of the force pass; returns their power [W].
+
+    With :math:`\mathbf h_\alpha = \sum_J \Gamma_{\alpha J}\mathbf x_J` the
+    shape vectors are :math:`\gamma_{\alpha I} = \Gamma_{\alpha I} - \mathbf
+    h_\alpha\cdot\mathbf b_I`, so the rates need no per-node shape vector:
+    :math:`\dot q_{i\alpha} = \sum_I v_{iI}\Gamma_{\alpha I} - \bar L_{ij}
+    h_{\alpha j}` with :math:`\bar L = \sum_I \mathbf v_I\otimes\mathbf b_I`
+    (the gradient on the end-of-step geometry), and the forces
+    :math:`-\sum_\alpha Q_{i\alpha}\gamma_{\alpha I} = -\sum_\alpha
+    Q_{i\alpha}\Gamma_{\alpha I} + (M_{ij}/V)\, \partial V/\partial x_{jI}`
+    with :math:`M_{ij} = \sum_\alpha Q_{i\alpha} h_{\alpha j}` (module
+    docstring for :math:`Q`; ``coef`` is :math:`a_h` or :math:`k_h`; the
+    stiffness form accumulates ``hg`` (E, modes, 3)). ``xl``, ``g`` (nen, 3)
+    the element's node coordinates and volume derivatives at :math:`n+1`,
+    ``vl`` (nen, 3) its node velocities at :math:`n+\tfrac12`.
+    """
+    nen = xl.shape[0]
+    inv_v = 1.0 / V
+    Lb00 = Lb01 = Lb02 = Lb10 = Lb11 = Lb12 = Lb20 = Lb21 = Lb22 = 0.0
+    for I in range(nen):
+        v0 = vl[I, 0]
+        v1 = vl[I, 1]
+        v2 = vl[I, 2]
+        Lb00 += v0 * g[I, 0]
+        Lb01 += v0 * g[I, 1]
+        Lb02 += v0 * g[I, 2]
+        Lb10 += v1 * g[I, 0]
+        Lb11 += v1 * g[I, 1]
+        Lb12 += v1 * g[I, 2]
+        Lb20 += v2 * g[I, 0]
+        Lb21 += v2 * g[I, 1]
+        Lb22 += v2 * g[I, 2]
+    for i in range(3):
+        for j in range(3):
+            M[i, j] = 0.0
+    power = 0.0
+    for a in range(gam.shape[0]):
+        h0 = h1 = h2 = 0.0
+        w0 = w1 = w2 = 0.0
+        for J in range(nen):
+            G = gam[a, J]
+            h0 += G * xl[J, 0]
+            h1 += G * xl[J, 1]
+            h2 += G * xl[J, 2]
+            w0 += G * vl[J, 0]
+            w1 += G * vl[J, 1]
+            w2 += G * vl[J, 2]
+        h0 *= inv_v
+        h1 *= inv_v
+        h2 *= inv_v
+        qd0 = w0 - (Lb00 * h0 + Lb01 * h1 + Lb02 * h2)
+        qd1 = w1 - (Lb10 * h0 + Lb11 * h1 + Lb12 * h2)
+        qd2 = w2 - (Lb20 * h0 + Lb21 * h1 + Lb22 * h2)
+        if hg_form == HG_VISCOUS:
+            Q[a, 0] = coef * qd0
+            Q[a, 1] = coef * qd1
+            Q[a, 2] = coef * qd2
+        else:
+            hg[e, a, 0] += dt * coef * qd0
+            hg[e, a, 1] += dt * coef * qd1
+            hg[e, a, 2] += dt * coef * qd2
+            Q[a, 0] = hg[e, a, 0]
+            Q[a, 1] = hg[e, a, 1]
+            Q[a, 2] = hg[e, a, 2]
+        if dim == 2:
+            Q[a, 2] = 0.0
+        power += Q[a, 0] * qd0 + Q[a, 1] * qd1 + Q[a, 2] * qd2
+        for i in range(3):  # h already carries 1/V: M / V
+            M[i, 0] += Q[a, i] * h0
+            M[i, 1] += Q[a, i] * h1
+            M[i, 2] += Q[a, i] * h2
+    return power
+
+
 @njit(cache=True, error_model="numpy", parallel=True)
-def uniform_forces(v, conn, active, sig, L, rho, c, e_spec, e_av, xl, g, vol, gam,
-                   hg_form, qh, hg, e_hg, q1, q2, dt, dim, fe):
+def uniform_forces(x, v, conn, active, sig, L, rho, c, e_spec, e_av, dim, tab, gam,
+                   hg_form, qh, hg, e_hg, q1, q2, dt, vol, dt_el, fe):
     r"""Nodal forces (E, nen, 3) of one-point elements: stress, bulk viscosity, hourglass.
 
-    Inputs at :math:`n+1`: ``xl``, ``g``, ``vol`` of :func:`uniform_strain_rate`,
-    stress ``sig`` (E, 3, 3) [Pa], density ``rho``, wave speed ``c``;
-    ``v`` (N, 3) at :math:`n+\tfrac12`; ``gam`` (modes, nen) hourglass base
-    vectors; ``hg_form`` :data:`HG_VISCOUS` or :data:`HG_STIFFNESS`, ``qh``
-    its coefficient; ``hg`` (E, 4, 3) stiffness-form generalised forces
-    [N] (updated); ``e_hg`` (E,) hourglass work [J] (updated); bulk
-    viscosity ``q1`` (quadratic), ``q2`` (linear), whose heat goes to
-    ``e_spec`` and ``e_av`` (E,) [J/kg]. Equations: module docstring.
+    The geometry at :math:`n+1` (``x`` (N, 3)) is computed here, element by
+    element: the volumes ``vol`` (E,) [m^3] and the element steps ``dt_el``
+    (E,) [s] (:func:`element_step`) are written on the way. Stress ``sig``
+    (E, 3, 3) [Pa], density ``rho``, wave speed ``c``, rate ``L`` of
+    :func:`uniform_strain_rate`; ``v`` (N, 3) at :math:`n+\tfrac12`; ``gam``
+    (modes, nen) hourglass base vectors; ``hg_form`` :data:`HG_VISCOUS` or
+    :data:`HG_STIFFNESS`, ``qh`` its coefficient; ``hg`` (E, 4, 3)
+    stiffness-form generalised forces [N] (updated); ``e_hg`` (E,) hourglass
+    work [J] (updated); bulk viscosity ``q1`` (quadratic), ``q2`` (linear),
+    whose heat goes to ``e_spec`` and ``e_av`` (E,) [J/kg]. Equations: module
+    docstring and :func:`hourglass_resultants`.
     """
+    ne = conn.shape[0]
     nen = conn.shape[1]
     nm = gam.shape[0]
-    for e in prange(conn.shape[0]):
-        if active[e] == 0:
-            for I in range(nen):
-                for k in range(3):
-                    fe[e, I, k] = 0.0
-            continue
-        V = vol[e]
-        ell = char_length(g[e], V)
-        dkk = L[e, 0, 0] + L[e, 1, 1] + L[e, 2, 2]
-        q = bulk_viscosity(rho[e], c[e], ell, dkk, q1, q2)
-        if q > 0.0 and rho[e] > 0.0:
-            heat = -dt * q * dkk / rho[e]
-            e_spec[e] += heat
-            e_av[e] += heat
-        for I in range(nen):
-            for i in range(3):
-                s = 0.0
-                for j in range(3):
-                    s += (sig[e, i, j] - (q if i == j else 0.0)) * g[e, I, j]
-                fe[e, I, i] = -s
-        if qh <= 0.0 or V <= 0.0:
-            continue
-        bb = 0.0
-        for I in range(nen):
-            bb += g[e, I, 0] ** 2 + g[e, I, 1] ** 2 + g[e, I, 2] ** 2
-        bb /= V * V
-        if hg_form == HG_VISCOUS:
-            coef = qh * rho[e] * c[e] * V ** ((dim - 1.0) / dim) / 4.0
-        else:
-            coef = qh * rho[e] * c[e] * c[e] * V * bb / dim
-        inv_v = 1.0 / V  # one division per element, not one per mode and node
-        power = 0.0
-        for a in range(nm):
-            # gamma_aI = Gamma_aI - (sum_J Gamma_aJ x_J) . b_I
-            h0 = 0.0
-            h1 = 0.0
-            h2 = 0.0
-            for J in range(nen):
-                h0 += gam[a, J] * xl[e, J, 0]
-                h1 += gam[a, J] * xl[e, J, 1]
-                h2 += gam[a, J] * xl[e, J, 2]
-            qd0 = 0.0
-            qd1 = 0.0
-            qd2 = 0.0
-            for I in range(nen):
-                gI = gam[a, I] - (h0 * g[e, I, 0] + h1 * g[e, I, 1] + h2 * g[e, I, 2]) * inv_v
-                n = conn[e, I]
-                qd0 += v[n, 0] * gI
-                qd1 += v[n, 1] * gI
-                qd2 += v[n, 2] * gI
-            if hg_form == HG_VISCOUS:
-                Q0 = coef * qd0
-                Q1 = coef * qd1
-                Q2 = coef * qd2
+    for b in prange((ne + ELEMENT_BLOCK - 1) // ELEMENT_BLOCK):
+        xl = np.empty((nen, 3))
+        vl = np.empty((nen, 3))
+        g = np.empty((nen, 3))
+        Q = np.zeros((nm, 3))
+        M = np.zeros((3, 3))
+        for e in range(b * ELEMENT_BLOCK, min(ne, (b + 1) * ELEMENT_BLOCK)):
+            if active[e] == 0:
+                for I in range(nen):
+                    for k in range(3):
+                        fe[e, I, k] = 0.0
+                dt_el[e] = np.inf
+                continue
+            element_nodes(x, v, 0.0, conn, e, xl, vl)
+            V = volume_gradient(xl, dim, tab, g)
+            vol[e] = V
+            ell = char_length(g, V)
+            dkk = L[e, 0, 0] + L[e, 1, 1] + L[e, 2, 2]
+            dt_el[e] = element_step(ell, c[e], dkk, q1, q2)
+            q = bulk_viscosity(rho[e], c[e], ell, dkk, q1, q2)
+            if q > 0.0 and rho[e] > 0.0:
+                heat = -dt * q * dkk / rho[e]
+                e_spec[e] += heat
+                e_av[e] += heat
+            hourglass = qh > 0.0 and V > 0.0
+            if hourglass:
+                if hg_form == HG_VISCOUS:  # V^((d-1)/d) without a general power
+                    face = np.cbrt(V) ** 2 if dim == 3 else math.sqrt(V)
+                    coef = qh * rho[e] * c[e] * face / 4.0
+                else:
+                    bb = 0.0
+                    for I in range(nen):
+                        bb += g[I, 0] ** 2 + g[I, 1] ** 2 + g[I, 2] ** 2
+                    coef = qh * rho[e] * c[e] * c[e] * bb / (V * dim)
+                e_hg[e] += dt * hourglass_resultants(e, vl, xl, g, V, gam, hg_form, coef,
+                                                     hg, dt, dim, Q, M)
             else:
-                hg[e, a, 0] += dt * coef * qd0
-                hg[e, a, 1] += dt * coef * qd1
-                hg[e, a, 2] += dt * coef * qd2
-                Q0 = hg[e, a, 0]
-                Q1 = hg[e, a, 1]
-                Q2 = hg[e, a, 2]
-            if dim == 2:
-                Q2 = 0.0
-            power += Q0 * qd0 + Q1 * qd1 + Q2 * qd2
+                M[:] = 0.0
+            # f_iI = -(sigma_ij - q delta_ij - M_ij / V) dV/dx_jI - sum_a Q_ai Gamma_aI
+            s00 = sig[e, 0, 0] - q - M[0, 0]
+            s01 = sig[e, 0, 1] - M[0, 1]
+            s02 = sig[e, 0, 2] - M[0, 2]
+            s10 = sig[e, 1, 0] - M[1, 0]
+            s11 = sig[e, 1, 1] - q - M[1, 1]
+            s12 = sig[e, 1, 2] - M[1, 2]
+            s20 = sig[e, 2, 0] - M[2, 0]
+            s21 = sig[e, 2, 1] - M[2, 1]
+            s22 = sig[e, 2, 2] - q - M[2, 2]
             for I in range(nen):
-                gI = gam[a, I] - (h0 * g[e, I, 0] + h1 * g[e, I, 1] + h2 * g[e, I, 2]) * inv_v
-                fe[e, I, 0] -= Q0 * gI
-                fe[e, I, 1] -= Q1 * gI
-                fe[e, I, 2] -= Q2 * gI
-        e_hg[e] += dt * power
+                g0 = g[I, 0]
+                g1 = g[I, 1]
+                g2 = g[I, 2]
+                f0 = s00 * g0 + s01 * g1 + s02 * g2
+                f1 = s10 * g0 + s11 * g1 + s12 * g2
+                f2 = s20 * g0 + s21 * g1 + s22 * g2
+                if hourglass:
+                    for a in range(nm):
+                        G = gam[a, I]
+                        f0 += Q[a, 0] * G
+                        f1 += Q[a, 1] * G
+                        f2 += Q[a, 2] * G
+                fe[e, I, 0] = -f0
+                fe[e, I, 1] = -f1
+                fe[e, I, 2] = -f2
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
@@ -353,11 +488,12 @@ def reduced_strain_rate(x, v, conn, active, m_el, dt, dim, tab, dN, xl, g, Bg, w
 
 @njit(cache=True, error_model="numpy", parallel=True)
 def reduced_forces(conn, active, sig, L, rho, c, e_spec, e_av, g, vol, Bg, wg, q1, q2,
-                   dt, dim, fe):
+                   dt, dim, dt_el, fe):
     r"""Nodal forces (E, nen, 3) of selective-reduced elements (B-bar, module docstring).
 
     Bulk viscosity from the element's mean volumetric rate (the points share
-    it), heat shared evenly by the points.
+    it), heat shared evenly by the points; ``dt_el`` (E,) out, the element
+    steps (:func:`element_step` with the element's largest wave speed).
     """
     ngp = wg.shape[0] // conn.shape[0]
     nen = conn.shape[1]
@@ -366,6 +502,7 @@ def reduced_forces(conn, active, sig, L, rho, c, e_spec, e_av, g, vol, Bg, wg, q
             for k in range(3):
                 fe[e, I, k] = 0.0
         if active[e] == 0:
+            dt_el[e] = np.inf
             continue
         V = vol[e]
         p0 = e * ngp
@@ -374,6 +511,7 @@ def reduced_forces(conn, active, sig, L, rho, c, e_spec, e_av, g, vol, Bg, wg, q
         cmax = 0.0
         for k in range(ngp):
             cmax = max(cmax, c[p0 + k])
+        dt_el[e] = element_step(ell, cmax, dkk, q1, q2)
         q = bulk_viscosity(rho[p0], cmax, ell, dkk, q1, q2)
         if q > 0.0 and rho[p0] > 0.0:
             heat = -dt * q * dkk / rho[p0]
@@ -399,40 +537,30 @@ def reduced_forces(conn, active, sig, L, rho, c, e_spec, e_av, g, vol, Bg, wg, q
                 fe[e, I, i] += q * g[e, I, i]
 
 
-#: blocks of the parallel minimum in :func:`element_time_step`
+#: blocks of the parallel minimum in :func:`min_time_step`
 DT_BLOCKS = 64
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def element_time_step(g, vol, c, L, ngp, active, q1, q2, cfl, blk_t, blk_k):
-    r"""Stable step :math:`C\,\ell/(Q + \sqrt{Q^2 + c^2})` of the elements and the
-    controlling element (module docstring); ``c`` and ``L`` per point (the
-    element's largest c, its first point's volumetric rate).
+def min_time_step(dt_el, cfl, blk_t, blk_k):
+    r"""The part's stable step ``cfl * min(dt_el)`` and the controlling element.
 
-    The minimum is taken in parallel over ``blk_t.size`` contiguous blocks
-    (scratch ``blk_t`` (B,) float, ``blk_k`` (B,) int64), then over the
-    blocks in order, so the controlling element is the first one with the
-    smallest step, as a serial loop would find it.
+    ``dt_el`` (E,) the element steps of the last force pass
+    (:func:`element_step`, ``inf`` for inactive elements). The minimum is
+    taken in parallel over ``blk_t.size`` contiguous blocks (scratch ``blk_t``
+    (B,) float, ``blk_k`` (B,) int64), then over the blocks in order, so the
+    controlling element is the first one with the smallest step, as a serial
+    loop would find it.
     """
-    ne = g.shape[0]
+    ne = dt_el.shape[0]
     nb = blk_t.shape[0]
     size = (ne + nb - 1) // nb
     for b in prange(nb):
         best = np.inf
         k = 0
         for e in range(b * size, min(ne, (b + 1) * size)):
-            if active[e] == 0:
-                continue
-            ell = char_length(g[e], vol[e])
-            ce = 0.0
-            for j in range(ngp):
-                ce = max(ce, c[e * ngp + j])
-            p = e * ngp
-            dkk = L[p, 0, 0] + L[p, 1, 1] + L[p, 2, 2]
-            Q = q2 * ce + (q1 * ell * -dkk if dkk < 0.0 else 0.0)
-            t = ell / (Q + math.sqrt(Q * Q + ce * ce) + 1e-300)
-            if t < best:
-                best = t
+            if dt_el[e] < best:
+                best = dt_el[e]
                 k = e
         blk_t[b] = best
         blk_k[b] = k

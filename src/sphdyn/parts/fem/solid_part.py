@@ -29,8 +29,8 @@ from ...fields import von_mises
 from ...state import Elements, MaterialPoints, Nodes
 from ..base import register_part
 from .gather import gather_loads, node_element_list
-from .solid import (DT_BLOCKS, HG_STIFFNESS, HG_VISCOUS, element_time_step, reduced_forces,
-                    reduced_strain_rate, uniform_forces, uniform_strain_rate)
+from .solid import (DT_BLOCKS, HG_STIFFNESS, HG_VISCOUS, element_volumes, min_time_step,
+                    reduced_forces, reduced_strain_rate, uniform_forces, uniform_strain_rate)
 
 INTEGRATIONS = ("one_point", "selective_reduced")
 HOURGLASS_FORMS = {"viscous": HG_VISCOUS, "stiffness": HG_STIFFNESS}
@@ -100,8 +100,11 @@ class SolidPart:
         self._dt_t = np.empty(DT_BLOCKS)  # scratch of the parallel stable step
         self._dt_k = np.empty(DT_BLOCKS, dtype=np.int64)
         nen = elements.nen
-        for name_, tail in (("xl", (nen, 3)), ("g", (nen, 3)), ("fe", (nen, 3))):
-            elements.add(name_, tail)
+        elements.add("fe", (nen, 3))  # element nodal forces, gathered into the nodes
+        elements.add("dt_el", ())  # element steps of the last force pass [s]
+        if self.reduced:  # the B-bar pass keeps the end-of-step geometry per element
+            elements.add("xl", (nen, 3))
+            elements.add("g", (nen, 3))
         ne = elements.n
         n_hist = max([len(m.history_names) for m, _ in materials.values()] + [0])
         pts = self.pts = MaterialPoints(ne * self.ngp, n_hist)
@@ -121,7 +124,7 @@ class SolidPart:
                              "cannot share a part; split the mesh into parts")
         pts.hist_names = list(next(iter(layouts), ()))
         self.offsets, self.slots = node_element_list(elements.conn, nodes.n)
-        self._geometry(0.0)  # g, vol at x
+        self._element_geometry()  # vol at x
         elements.vol0 = elements.vol
         bad = np.flatnonzero(elements.vol <= 0.0)
         if bad.size:
@@ -157,6 +160,7 @@ class SolidPart:
         nodes.bulk_modulus = np.where(nodes.vol0 > 0, share(k_el * elements.vol0) /
                                       np.where(nodes.vol0 > 0, nodes.vol0, 1.0), 0.0)
         self._geometry(0.0)  # densities from the masses
+        self._element_geometry()  # element steps with the wave speeds
 
     # ------------------------------------------------------------ kernels
     def _geometry(self, dt: float) -> None:
@@ -167,27 +171,33 @@ class SolidPart:
                                 self.dN, el.xl, el.g, p.Bg, p.wg, p.L, p.rho, el.vol)
         else:
             uniform_strain_rate(q.x, q.v, el.conn, el.active, el.m, dt, self.dim, self.tab,
-                                el.xl, el.g, p.L, p.rho, el.vol)
+                                p.L, p.rho)
+
+    def _element_geometry(self) -> None:
+        """Volumes and element steps at the current positions (no forces)."""
+        q, el, p, s = self.nodes, self.el, self.pts, self.s
+        element_volumes(q.x, el.conn, el.active, self.dim, self.tab, p.c, p.L, self.ngp,
+                        s.q1, s.q2, el.vol, el.dt_el)
 
     def _forces(self, dt: float) -> None:
-        """Element nodal forces gathered into the nodes' accelerations."""
+        """Element nodal forces (and element steps) gathered into the nodes'
+        accelerations; one-point elements compute their end-of-step geometry here."""
         q, el, p, s = self.nodes, self.el, self.pts, self.s
         if self.reduced:
             reduced_forces(el.conn, el.active, p.sig, p.L, p.rho, p.c, p.e, p.e_av, el.g,
-                           el.vol, p.Bg, p.wg, s.q1, s.q2, dt, self.dim, el.fe)
+                           el.vol, p.Bg, p.wg, s.q1, s.q2, dt, self.dim, el.dt_el, el.fe)
         else:
-            uniform_forces(q.v, el.conn, el.active, p.sig, p.L, p.rho, p.c, p.e, p.e_av,
-                           el.xl, el.g, el.vol, self.gam, self.hg_form,
-                           s.hourglass_coefficient, el.hg, el.e_hg, s.q1, s.q2, dt,
-                           self.dim, el.fe)
+            uniform_forces(q.x, q.v, el.conn, el.active, p.sig, p.L, p.rho, p.c, p.e,
+                           p.e_av, self.dim, self.tab, self.gam, self.hg_form,
+                           s.hourglass_coefficient, el.hg, el.e_hg, s.q1, s.q2, dt, el.vol,
+                           el.dt_el, el.fe)
         gather_loads(el.fe, 0, self.offsets, self.slots, q.m, q.a)
 
     # ----------------------------------------------------------- protocol
     def stable_dt(self) -> tuple[float, int]:
-        """Element step and the controlling element (:func:`.solid.element_time_step`)."""
-        el, p, s = self.el, self.pts, self.s
-        return element_time_step(el.g, el.vol, p.c, p.L, self.ngp, el.active, s.q1, s.q2,
-                                 s.cfl, self._dt_t, self._dt_k)
+        """Element step and the controlling element (:func:`.solid.min_time_step` of
+        the element steps of the last force pass)."""
+        return min_time_step(self.el.dt_el, self.s.cfl, self._dt_t, self._dt_k)
 
     def describe_limit(self, k: int) -> str:
         """What element ``k`` of :meth:`stable_dt` is, for a diagnosis."""
@@ -262,9 +272,7 @@ class SolidPart:
         for k, v in arrays.items():
             store, name = (self.el, k[3:]) if k.startswith("el.") else (self.pts, k[3:])
             setattr(store, name, v)
-        L = self.pts.L.copy()  # the checkpoint's (the geometry pass rewrites it)
-        self._geometry(0.0)  # work arrays (g, xl, Bg) of the restored positions
-        self.pts.L = L
+        self._element_geometry()  # volumes and element steps of the restored state
 
 
 def solid_part(name: str, points: np.ndarray, cells: np.ndarray, dim: int, materials,
