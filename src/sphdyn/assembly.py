@@ -10,23 +10,24 @@ from __future__ import annotations
 import numpy as np
 
 from .interactions import ParticleContact, Wall
-from .mesh_assembly import mesh_interactions, mesh_part
+from .mesh_assembly import erosion_events, mesh_interactions, mesh_part
 from .kernels import KernelContext
-from .model import Model, build_model
+from .model import Model, build_model, debris_meshes
 from .parts import SPHPart, SPHSettings
 from .stepper import Stepper
 
 
-def sph_settings(deck, converted: int = 0) -> SPHSettings:
+def sph_settings(deck, converted: int = 0, debris: int = 0) -> SPHSettings:
     """The SPH scheme's settings from ``[sph]``, ``[time]`` and the bodies;
     ``converted`` bodies made of mesh elements follow after the deck's, with
-    the [sph] formulation and artificial stress."""
+    the [sph] formulation and artificial stress, then ``debris`` bodies of
+    eroded elements, updated-Lagrangian (debris has no reference shape)."""
     sph = deck.sph
     tl = tuple((b.formulation or sph.formulation) == "total_lagrangian" for b in deck.body)
     eps = tuple(sph.artificial_stress.epsilon if b.artificial_stress is None
                 else b.artificial_stress for b in deck.body)
-    tl += (sph.formulation == "total_lagrangian",) * converted
-    eps += (sph.artificial_stress.epsilon,) * converted
+    tl += (sph.formulation == "total_lagrangian",) * converted + (False,) * debris
+    eps += (sph.artificial_stress.epsilon,) * (converted + debris)
     return SPHSettings(
         correction=bool(sph.correction), alpha=sph.viscosity.alpha,
         beta=sph.viscosity.beta, xsph=sph.xsph,
@@ -51,9 +52,11 @@ def build_stepper(deck, model: Model | None = None, events=(), monitors=()) -> S
     model = build_model(deck) if model is None else model
     p = model.particles
     parts, interactions, part = [], [], None
-    if p.n:
+    debris = len(debris_meshes(model.meshes))
+    if p.n or debris:
         kernel = KernelContext.named(deck.sph.kernel, p.dim, deck.sph.support_scale)
-        settings = sph_settings(deck, len(model.body_names) - len(deck.body))
+        settings = sph_settings(deck, len(model.body_names) - len(deck.body) - debris,
+                                debris)
         part = SPHPart(p, model.groups, kernel, settings, phase=model.phase,
                        variation=model.variation)
         parts.append(part)
@@ -64,5 +67,6 @@ def build_stepper(deck, model: Model | None = None, events=(), monitors=()) -> S
     meshes = {mm.name: mesh_part(deck, mm) for mm in model.meshes}
     parts += meshes.values()
     interactions += mesh_interactions(deck, model, part, meshes)
+    events = list(events) + erosion_events(deck, model, part, meshes, interactions)
     dt_max = deck.time.dt_max if deck.time.dt_max is not None else np.inf
     return Stepper(parts, interactions, events, monitors, dt_max=dt_max)

@@ -4,7 +4,9 @@ Called by :func:`sphdyn.assembly.build_stepper` with the meshes of
 :mod:`sphdyn.mesh_model`. Names in the history: a boundary's reactions
 ``<set>_reaction_x|y|z``, a load's ``<set>_force``, a mesh's damping
 ``E_damping_<mesh>``, a wall on a mesh ``F_wall_<wall>_<mesh>``, a coupling
-``F_<mesh>_coupling`` (penalty) or ``F_<mesh>_coupling_x|y|z`` (tied, hybrid).
+``F_<mesh>_coupling`` (penalty) or ``F_<mesh>_coupling_x|y|z`` (tied, hybrid),
+the debris coupling of an eroding mesh ``F_<mesh>_debris``, its erosion
+``eroded_<mesh>`` and the rest of :meth:`sphdyn.events.ElementErosion.columns`.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ import numpy as np
 
 from .deck import DeckError
 from .deck.errors import format_problem
+from .events import ElementErosion, ErosionRules
 from .interactions import HybridCoupling, PenaltyCoupling, TiedCoupling, Wall
 from .interactions.nodal import MassDamping, NodalLoad, PrescribedMotion
 from .materials import get_model
@@ -121,6 +124,53 @@ def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
                 out.append(MassDamping(f"{mm.name}_particles", sph_part,
                                        np.setdiff1d(rows, slaves), mm.spec.damping))
             out += coupling  # after every other interaction on the particles
+        ero = mm.spec.erosion
+        if ero is not None and ero.to == "particles" and not (
+                mm.converted is not None and mm.converted.spec.coupling == "penalty"):
+            # the debris meets the remaining elements by penalty (a [mesh.convert]
+            # penalty coupling does it already: it couples every particle)
+            out.append(PenaltyCoupling(f"{mm.name}_debris", sph_part, part,
+                                       stiffness=ero.stiffness, alpha=ero.alpha,
+                                       thickness_factor=ero.thickness_factor,
+                                       friction=ero.friction))
+    return out
+
+
+def erosion_events(deck, model, sph_part, meshes: dict, interactions) -> list:
+    """The :class:`~sphdyn.events.ElementErosion` of every mesh with [mesh.erosion],
+    with its materials' [material.erosion] rules."""
+    out = []
+    for mm in model.meshes:
+        ero = mm.spec.erosion
+        if ero is None:
+            continue
+        part, rules = meshes[mm.name], {}
+        for k in np.unique(mm.mat):
+            m = deck.material[int(k)]
+            if m.erosion is None:
+                continue
+            if m.erosion.erode is not None and not get_model(m.model).has_damage:
+                raise DeckError([format_problem(
+                    f"material[{int(k)}] '{m.name}'.erosion.erode",
+                    f"model '{m.model}' has no damage variable, so the damage rule "
+                    "cannot apply", "use principal_strain or effective_strain, or a "
+                    "model with damage (cscm)")])
+            e = m.erosion
+            rules[int(k)] = ErosionRules(erode=e.erode, principal_strain=e.principal_strain,
+                                         effective_strain=e.effective_strain,
+                                         min_time_step=e.min_time_step)
+        if not rules:
+            names = ", ".join(f"'{deck.material[int(k)].name}'" for k in np.unique(mm.mat))
+            raise DeckError([format_problem(
+                f"mesh[{mm.index}] '{mm.name}'.erosion",
+                f"no material of the mesh ({names}) has erosion rules",
+                "add [material.erosion] (e.g. principal_strain = 0.1) to its material")])
+        to_particles = ero.to == "particles"
+        out.append(ElementErosion(
+            f"erosion_{mm.name}", part, rules, to=ero.to,
+            per_element=ero.particles_per_element, sph=sph_part if to_particles else None,
+            body=(model.body_names.index(f"{mm.name}_debris") if to_particles else 0),
+            h_factor=deck.sph.h_factor, every=ero.every))
     return out
 
 

@@ -252,13 +252,23 @@ def build_model(deck) -> Model:
             parts.append(_converted_particles(deck, mm, len(body_names), density_of, n_hist))
             phase_parts.append(np.full(parts[-1].n, -1, np.int8))
             body_names.append(_converted_name(mm, body_names))
+    for mm in debris_meshes(meshes):  # bodies that start empty: eroded elements
+        body_names.append(_debris_name(mm, body_names))
     particles = (Particles.concatenate(parts) if parts
                  else Particles.allocate(0, dim, n_hist))
     particles.hist_names = list(next(iter(layouts), ()))
 
     groups, factor = _material_groups(deck, particles, models, params)
+    have = {g.material for g in groups}
+    for k in sorted({int(k) for mm in debris_meshes(meshes) for k in np.unique(mm.mat)}
+                    - have):  # an empty group for the debris of each eroding material
+        m = deck.material[k]
+        groups.append(MaterialGroup(m.name, models[m.name], params[m.name],
+                                    np.zeros(0, np.int64), k))
 
     for g in groups:
+        if not g.idx.size:  # a debris group, filled during the run
+            continue
         particles.c[g.idx] = g.model.wave_speed(g.params, particles.rho0[g.idx[0]])  # one density per material
         h0 = g.model.initial_history(g.params)
         if len(h0):
@@ -311,6 +321,23 @@ def build_model(deck) -> Model:
         probes=probes, phase=np.concatenate(phase_parts + [np.zeros(0, np.int8)]),
         photo_targets=photos, variation=factor, mass_draws=draws, meshes=meshes,
         mesh_sets=mesh_sets)
+
+
+def debris_meshes(meshes) -> list[MeshModel]:
+    """The meshes whose eroded elements become particles ([mesh.erosion] to =
+    "particles"), in deck order: their debris bodies follow the converted ones."""
+    return [mm for mm in meshes
+            if mm.spec.erosion is not None and mm.spec.erosion.to == "particles"]
+
+
+def _debris_name(mm: MeshModel, taken: list[str]) -> str:
+    """The body name of a mesh's eroded-element particles: ``<mesh>_debris``."""
+    name = f"{mm.name}_debris"
+    if name in taken:
+        raise DeckError([format_problem(
+            f"mesh[{mm.index}] '{mm.name}'.erosion", f"its particles form a body named "
+            f"'{name}', and a [[body]] has that name", "rename the mesh or the body")])
+    return name
 
 
 def _converted_name(mm: MeshModel, taken: list[str]) -> str:

@@ -300,17 +300,19 @@ def mesh_frames(parts) -> dict[str, MeshFrame]:
     """One :class:`~sphdyn.io.MeshFrame` per mesh part: nodes at their current
     positions with ``displacement`` and ``velocity`` [m, m/s], and every cell
     field of the part (``stress``, ``von_mises``, ``damage``, plastic strain
-    and the other history columns, ``hourglass_energy``; beams: forces)."""
+    and the other history columns, ``hourglass_energy``; beams: forces);
+    eroded elements are left out."""
     out = {}
     for part in parts:
         if part.kind == "sph":
             continue
         q, el = part.kin, _elements(part)
         kind = getattr(part, "element_kind", "line2")
+        live = el.active == 1  # eroded elements leave the picture
         out[part.name] = MeshFrame(
-            points=q.x.copy(), cells=el.conn.copy(), kind=kind,
+            points=q.x.copy(), cells=el.conn[live], kind=kind,
             point_data={"displacement": q.x - q.x0, "velocity": q.v.copy()},
-            cell_data={name: np.asarray(fn()) for name, fn in part.fields().items()})
+            cell_data={name: np.asarray(fn())[live] for name, fn in part.fields().items()})
     return out
 
 

@@ -19,8 +19,10 @@ Central differences (leapfrog, :mod:`sphdyn.integrate`), state at
    ``after_step`` (guards, history, frames, checkpoints).
 
 The energy balance :math:`E_{total} = E_{kin} + E_{int} + E_{contact} -
-W_{ext}`, with :math:`E_{contact} = -W_{contact}` the negative work of the
-interaction forces, is recorded by :meth:`Stepper.record`.
+W_{ext} + E_{removed}`, with :math:`E_{contact} = -W_{contact}` the negative
+work of the interaction forces and :math:`E_{removed}` the energy events took
+out of the model (an event's ``energy_removed``: plain erosion), is recorded
+by :meth:`Stepper.record` with the events' ``columns(t)``.
 """
 
 from __future__ import annotations
@@ -188,19 +190,27 @@ class Stepper:
             a, b = part.energies()
             ie, iav = _add(ie, a), _add(iav, b)
         e_contact = -self.work_contact
+        # energy events took out of the model (plain erosion), still in the balance
+        removed = [ev.energy_removed for ev in self.events if hasattr(ev, "energy_removed")]
+        e_removed = float(sum(removed))
         rec = {
             "time": self.t, "step": float(self.step_count),
             "dt": self.dt_step if dt is None else dt,
             "E_kinetic": kinetic, "E_internal": ie, "E_viscous": iav,
             "E_contact": e_contact, "W_external": self.work_external,
-            "E_total": kinetic + ie + e_contact - self.work_external,
+            "E_total": kinetic + ie + e_contact - self.work_external + e_removed,
             # how quasi-static the run is: small (< 0.05 say) for a static answer
             "KE_IE_ratio": kinetic / ie if ie > 0.0 else 0.0,
         }
+        if removed:
+            rec["E_removed"] = e_removed
         for part in self.parts:
             rec.update(part.columns())
         for inter in self.interactions:
             rec.update(inter.columns(self.t))
+        for ev in self.events:
+            if hasattr(ev, "columns"):
+                rec.update(ev.columns(self.t))
         return rec
 
     def kinetic_now(self) -> float:

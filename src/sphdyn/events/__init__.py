@@ -1,6 +1,7 @@
 """Events: changes of the model between steps (see :mod:`sphdyn.events.base`)."""
 
 from .base import Event
+from .erosion import ElementErosion, ErosionRules
 from .inject import InjectParticles
 
-__all__ = ["Event", "InjectParticles"]
+__all__ = ["ElementErosion", "ErosionRules", "Event", "InjectParticles"]

@@ -7,6 +7,11 @@ lists and the material groups follow, see :mod:`sphdyn.state.store`).
 Erosion of elements into particles (the erosion issue) is an event;
 :mod:`.inject` proves the mechanism. ``state()`` / ``restore()`` keep what
 an event must remember across a restart (whether it fired).
+
+Optional: ``columns(t)``, the event's history columns, and
+``energy_removed`` [J], energy the event took out of the model, which the
+stepper's ``E_total`` counts (:mod:`.erosion`). An event that changes a mesh
+calls ``mesh_changed()`` on the interactions whose ``solid`` is that part.
 """
 
 from __future__ import annotations

@@ -52,8 +52,10 @@ Zero-mass particles (initial cracks) are pushed out with the spring's
 acceleration and exert no force, as at the wall.
 
 Limitations: one face per particle (at a concave corner of the master
-surface a particle is held out of the nearer face only); the master faces are
-those of the reference mesh (eroded elements do not expose new faces).
+surface a particle is held out of the nearer face only). With the default
+master surface (all exterior faces) the faces follow erosion: an eroded
+element exposes its neighbours' faces (:meth:`PenaltyCoupling.mesh_changed`);
+a surface given as faces keeps those of them whose elements remain.
 """
 
 from __future__ import annotations
@@ -358,6 +360,7 @@ class PenaltyCoupling(InteractionBase):
         self.alpha, self.thickness_factor = float(alpha), float(thickness_factor)
         self.friction, self.skin_factor = float(friction), float(skin_factor)
         dim = solid_part.dim
+        self.all_faces = faces is None  # the master surface follows erosion
         faces = exterior_faces(solid_part.el.conn) if faces is None else faces
         self.faces = np.ascontiguousarray(faces, dtype=np.int64)
         if self.faces.ndim != 2 or self.faces.shape[1] != (4 if dim == 3 else 2):
@@ -426,6 +429,32 @@ class PenaltyCoupling(InteractionBase):
         self.xn_ref = q.x.copy()
         self.n_builds += 1
 
+    def mesh_changed(self) -> None:
+        """Elements of the solid part eroded: the master surface is that of the
+        remaining elements (default surface), or the given faces that are
+        still exterior faces of them; lists rebuilt."""
+        el = self.solid.el
+        live = exterior_faces(el.conn[el.active == 1])
+        if self.all_faces:
+            faces = live
+        else:
+            keys = {tuple(sorted(f)) for f in live.tolist()}
+            faces = self.faces[[tuple(sorted(f)) in keys for f in self.faces.tolist()]]
+        faces = np.ascontiguousarray(faces, dtype=np.int64).reshape(-1, self.faces.shape[1])
+        if self.tied.size:  # a tie follows its face (same nodes, same order) or ends
+            index = {tuple(sorted(f)): i for i, f in enumerate(faces.tolist())}
+            old = self.faces[self.tie_face].tolist()
+            face = np.array([index.get(tuple(sorted(f)), -1) for f in old], dtype=np.int64)
+            keep = face >= 0
+            self.tied, self.tie_face = self.tied[keep], face[keep]
+            self.tie_xi, self.tie_eta = self.tie_xi[keep], self.tie_eta[keep]
+            self.tie_offset = self.tie_offset[keep]
+            self.tie_shares = np.zeros((self.tied.size, 4, 3))
+            self.tie_force = np.zeros((self.tied.size, 3))
+        self.faces = faces
+        self.master_nodes = np.unique(self.faces)
+        self._allocate()
+
     # ----------------------------------------------------------- protocol
     def stable_dt(self) -> float:
         return self._dt
@@ -466,6 +495,8 @@ class PenaltyCoupling(InteractionBase):
                     "xn_ref": self.xn_ref}
 
     def restore(self, scalars: dict, arrays: dict) -> None:
+        if np.any(self.solid.el.active == 0):  # eroded before the checkpoint
+            self.mesh_changed()
         self.offsets = arrays["offsets"].copy()
         self.cand = arrays["cand"].copy()
         self.xp_ref = arrays["xp_ref"].copy()

@@ -84,6 +84,10 @@ class MaterialModel:
         The model accepts a Cauchy stress given at t = 0 (``[body.initial]
         stress``) as its state: an incremental model with no other state tied
         to the stress. False (the default) refuses one in the deck.
+    has_damage : bool
+        The model writes a scalar damage (0 intact, 1 failed) into
+        ``damage``: only then may elements of it erode by damage
+        (:mod:`sphdyn.parts.fem.erosion_criteria`).
     """
 
     name: str
@@ -93,6 +97,7 @@ class MaterialModel:
     history_init: Callable[[np.ndarray], np.ndarray] | None = None
     schema: Any = None
     initial_stress: bool = False
+    has_damage: bool = False
 
     @property
     def n_history(self) -> int:

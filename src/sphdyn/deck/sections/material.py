@@ -12,12 +12,40 @@ from pydantic import Field, model_validator
 
 from ..introspect import strip_optional
 from ..messages import problem
-from ..units import DENSITY
-from ..values import Section, name_of, quantity
+from ..units import DENSITY, TIME
+from ..values import Section, name_of, quantity, real
 from .bodies import Variation
 
 #: Mass density of a material (required, > 0).
 Density = quantity(DENSITY, lo=0, lo_open=True)
+
+
+class MaterialErosion(Section):
+    """[material.erosion]: when elements of this material erode (docs/theory.md,
+    "Element erosion"); any rule that holds erodes the element. Used by the
+    meshes with [mesh.erosion]; particles ignore it."""
+
+    erode: Optional[real("ERODE", lo=1, lo_open=True)] = Field(
+        None, description="LS-DYNA MAT_159's ERODE: the element erodes when its "
+                          "damage exceeds 0.99 and its maximum principal strain "
+                          "exceeds erode - 1 (e.g. 1.05). Only for a model with "
+                          "damage (cscm).")
+    principal_strain: Optional[real("principal strain", lo=0, lo_open=True)] = Field(
+        None, description="Maximum principal (engineering) strain at erosion.")
+    effective_strain: Optional[real("effective strain", lo=0, lo_open=True)] = Field(
+        None, description="Effective strain at erosion: the von Mises equivalent "
+                          "of the logarithmic strain (LS-DYNA's EFFEPS).")
+    min_time_step: Optional[quantity(TIME, "time step", lo=0, lo_open=True)] = Field(
+        None, description="The element erodes when its stable step (times the "
+                          "mesh's cfl) falls below this.")
+
+    @model_validator(mode="after")
+    def _a_rule(self):
+        if all(getattr(self, k) is None for k in type(self).model_fields):
+            raise problem("[material.erosion] has no rule",
+                          "give erode, principal_strain, effective_strain or "
+                          "min_time_step")
+        return self
 
 
 class MaterialSection(Section):
@@ -38,13 +66,16 @@ class MaterialSection(Section):
     density: Density = Field(description="Initial mass density.")
     variation: Optional[Variation] = Field(
         None, description="Random scatter of one parameter ([material.variation]).")
+    erosion: Optional[MaterialErosion] = Field(
+        None, description="Erosion rules of elements of this material "
+                          "([material.erosion]).")
 
     @model_validator(mode="after")
     def _varied_parameter(self):
         var = self.variation
         if var is None:
             return self
-        fixed = {"name", "model", "density", "variation", *self.unvaried}
+        fixed = {"name", "model", "density", "variation", "erosion", *self.unvaried}
         numeric = [k for k, f in type(self).model_fields.items() if k not in fixed
                    and strip_optional(f.annotation) is float]
         if var.parameter not in numeric:
@@ -59,9 +90,9 @@ class MaterialSection(Section):
 
     def values(self) -> dict:
         """The model's parameters in SI units, as ``pack`` takes them: every key
-        but name, model and variation, absent (None) values left out."""
+        but name, model, variation and erosion, absent (None) values left out."""
         return {key: v for key, v in self.model_dump().items()
-                if key not in ("name", "model", "variation") and v is not None}
+                if key not in ("name", "model", "variation", "erosion") and v is not None}
 
 
 def parameter_clashes(materials) -> list[tuple[int, str]]:

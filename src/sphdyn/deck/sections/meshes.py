@@ -6,7 +6,9 @@ Gmsh / Abaqus file (``file``). Its elements use the deck's materials through
 the same point functions as particles (docs/theory.md, "Solid elements").
 [mesh.convert] replaces the elements of a region by SPH particles (one per
 element, at its centroid, with its volume and mass; thesis ch. 4) and couples
-them to the remaining mesh.
+them to the remaining mesh. [mesh.erosion] lets elements erode during the
+run by their material's [material.erosion] rules, deleted or turned into SPH
+particles (thesis 5.3).
 """
 
 from typing import Literal, Optional
@@ -98,7 +100,23 @@ class MeshGroup(Section):
     material: reference_to("material") = Field(description="Its material.")
 
 
-class Convert(Section):
+class PenaltyKeys(Section):
+    """The penalty coupling's keys of [mesh.convert] and [mesh.erosion]: particles
+    against the element faces with the wall's spring."""
+
+    stiffness: Literal["mass", "bulk"] = Field(
+        "mass", description="Penalty stiffness: mass: k = alpha m/dt^2 (paper eq. 8); "
+                            "bulk: k = alpha K A/L (eq. 9).")
+    alpha: real("penalty factor", lo=0, lo_open=True) = Field(
+        0.1, description="Penalty factor alpha.")
+    friction: real("friction coefficient", lo=0) = Field(
+        0.0, description="Coulomb friction coefficient of the penalty coupling.")
+    thickness_factor: real("thickness factor", lo=0, lo_open=True) = Field(
+        0.5, description="Penalty contact thickness in units of the particle size "
+                         "V^(1/d).")
+
+
+class Convert(PenaltyKeys):
     """[mesh.convert]: elements of a region become SPH particles, coupled to the rest.
 
     One particle per element, at its centroid, with the element's volume and
@@ -116,16 +134,6 @@ class Convert(Section):
         "force go to the face's nodes); hybrid: the first layer of remaining elements "
         "gets particles at its integration points that move with it and meet the "
         "other particles through the kernel; none.")
-    stiffness: Literal["mass", "bulk"] = Field(
-        "mass", description="Penalty stiffness: mass: k = alpha m/dt^2 (paper eq. 8); "
-                            "bulk: k = alpha K A/L (eq. 9).")
-    alpha: real("penalty factor", lo=0, lo_open=True) = Field(
-        0.1, description="Penalty factor alpha.")
-    friction: real("friction coefficient", lo=0) = Field(
-        0.0, description="Coulomb friction coefficient of the penalty coupling.")
-    thickness_factor: real("thickness factor", lo=0, lo_open=True) = Field(
-        0.5, description="Penalty contact thickness in units of the particle size "
-                         "V^(1/d).")
     tie_factor: real("tie distance factor", lo=0) | None = Field(
         None, description="Particles within tie_factor sizes V^(1/d) of a face at the "
                           "start are tied to it. Penalty coupling: default 0 = contact "
@@ -151,6 +159,38 @@ class Convert(Section):
             raise problem("tie_factor = 0 ties no particle in the tied coupling",
                           "give tie_factor > 0 (1.0 ties the first particle layer) or "
                           "leave it out")
+        return self
+
+
+class MeshErosion(PenaltyKeys):
+    """[mesh.erosion]: elements erode by their material's [material.erosion] rules.
+
+    ``to = "particles"``: each eroded element becomes SPH particles with its
+    mass, momentum, energy, stress and history (thesis 5.3), in a body named
+    ``<mesh>_debris`` (updated-Lagrangian, the [sph] settings), which meets the
+    remaining elements through a penalty coupling (the [mesh.convert]
+    penalty coupling if there is one). ``to = "nothing"``: LS-DYNA's plain
+    erosion; the mass and energy lost are in the history.
+    """
+
+    to: Literal["particles", "nothing"] = Field(
+        "particles", description="What an eroded element becomes: SPH particles, or "
+                                 "nothing (deleted).")
+    particles_per_element: Literal[1, 8] = Field(
+        1, description="Particles per eroded element: 1 at its centre or 8 at the "
+                       "octants' centres (4 quadrants in 2D).")
+    every: integer("step interval", lo=1) = Field(
+        1, description="Check the rules every this many steps.")
+
+    @model_validator(mode="after")
+    def _coupling_keys(self):
+        if self.to == "nothing":
+            given = [k for k in ("particles_per_element", "stiffness", "alpha", "friction",
+                                 "thickness_factor")
+                     if getattr(self, k) != type(self).model_fields[k].default]
+            if given:
+                raise problem(f"{', '.join(given)} mean nothing with to = \"nothing\"",
+                              f"remove {', '.join(given)}, or set to = \"particles\"")
         return self
 
 
@@ -202,6 +242,8 @@ class Mesh(Section):
                          "omega critically): for quasi-static loading.")
     convert: Optional[Convert] = Field(
         None, description="A region of elements replaced by SPH particles.")
+    erosion: Optional[MeshErosion] = Field(
+        None, description="Elements erode during the run ([mesh.erosion]).")
 
     @model_validator(mode="after")
     def _one_source(self):
@@ -219,6 +261,9 @@ class Mesh(Section):
             if self.convert is not None:
                 raise problem("only solid elements can be converted to particles",
                               "remove [mesh.convert] from the line mesh")
+            if self.erosion is not None:
+                raise problem("only solid elements erode",
+                              "remove [mesh.erosion] from the line mesh")
         else:
             extra = [k for k in ("element", "section") if getattr(self, k) is not None]
             if extra:
@@ -230,4 +275,10 @@ class Mesh(Section):
                           "remove [[mesh.group]] or read the mesh from a file")
         if self.material is None and not self.group:
             raise problem("the mesh has no material", "add material = \"<name>\"")
+        if (self.erosion is not None and self.erosion.to == "particles"
+                and self.convert is not None and self.convert.coupling in ("tied", "hybrid")):
+            raise problem(f"erosion into particles with coupling = "
+                          f"\"{self.convert.coupling}\" of [mesh.convert]",
+                          "use coupling = \"penalty\" (the debris meets the mesh by "
+                          "penalty), or erosion to = \"nothing\"")
         return self

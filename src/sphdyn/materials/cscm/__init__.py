@@ -66,4 +66,5 @@ CSCM = register(MaterialModel(
     update=cscm_update,
     history_init=initial_history,
     schema=CscmParams,
+    has_damage=True,
 ))

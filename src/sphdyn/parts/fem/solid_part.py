@@ -26,7 +26,7 @@ from ...geometry.shapes import gauss_derivatives, hourglass_vectors, volume_tabl
 from ...integrate import drift
 from ...materials import MaterialGroup
 from ...fields import von_mises
-from ...state import Elements, MaterialPoints, Nodes
+from ...state import BC_FIXED, STATE, Elements, MaterialPoints, Nodes
 from ..base import register_part
 from .gather import gather_loads, node_element_list
 from .solid import (DT_BLOCKS, HG_STIFFNESS, HG_VISCOUS, element_volumes, min_time_step,
@@ -141,7 +141,8 @@ class SolidPart:
         # element mass: the points' densities times their share of the volume
         rho_el = pts.rho0.reshape(ne, self.ngp).mean(axis=1)
         elements.m = rho_el * elements.vol0
-        pts.add("m", ())  # the point's share of its element's mass [kg] (energies)
+        # the point's share of its element's mass [kg] (energies; zero once eroded)
+        pts.add("m", (), kind=STATE)
         pts.m = np.repeat(elements.m / self.ngp, self.ngp)
         pts.size = np.repeat(elements.vol0 ** (1.0 / self.dim), self.ngp)
         share = lambda w: np.bincount(elements.conn.ravel(),  # noqa: E731
@@ -239,6 +240,53 @@ class SolidPart:
     def columns(self) -> dict[str, float]:
         """``<name>_E_hourglass``: the hourglass work [J]."""
         return {f"{self.name}_E_hourglass": self.hourglass_energy()}
+
+    # ------------------------------------------------------------ erosion
+    def element_points(self, elements: np.ndarray) -> np.ndarray:
+        """Point indices (k, ngp) of ``elements`` (k,)."""
+        return elements[:, None] * self.ngp + np.arange(self.ngp)[None, :]
+
+    def erode(self, elements: np.ndarray,
+              dt_half: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        r"""Take ``elements`` (k,) out of the part; returns what they carried.
+
+        Each element's mass leaves its nodes (the lumped share ``m_e / nen``
+        each; their accelerations of this step are kept); nodes left with no
+        active element get zero mass, zero velocity and ``BC_FIXED``. The element's internal energy (its points' work
+        ``m e`` plus its hourglass work) leaves the part's books: the points'
+        masses and the hourglass work are zeroed, their rates too (the
+        material update then leaves their stress alone).
+
+        Returns
+        -------
+        m : (k,) element masses [kg]; kinetic : (k,) kinetic energy of their
+        node shares, :math:`\sum_I \tfrac12 (m_e/n_{en}) |\mathbf v_I|^2` [J],
+        at :math:`\mathbf v + \Delta t_{1/2}\,\mathbf a` (``dt_half``: the
+        coming half kick, so at the time the stepper books its kinetic energy);
+        internal : (k,) internal energy [J].
+        """
+        el, q, p = self.el, self.nodes, self.pts
+        elements = np.asarray(elements, dtype=np.int64)
+        pts = self.element_points(elements)
+        nen = el.nen
+        m = el.m[elements].copy()
+        ve = q.v[el.conn[elements]] + dt_half * q.a[el.conn[elements]]  # (k, nen, 3)
+        kinetic = 0.5 * (m / nen) * np.sum(ve * ve, axis=(1, 2))
+        internal = np.sum(p.m[pts] * p.e[pts], axis=1) + el.e_hg[elements]
+        el.active[elements] = 0
+        el.dt_el[elements] = np.inf
+        el.e_hg[elements] = 0.0
+        p.m[pts] = 0.0
+        p.L[pts] = 0.0
+        np.subtract.at(q.m, el.conn[elements].ravel(), np.repeat(m / nen, nen))
+        alive = np.bincount(el.conn[el.active == 1].ravel(), minlength=q.n) > 0
+        orphan = ~alive
+        q.m[orphan] = 0.0  # exactly: the subtraction leaves round-off
+        q.v[orphan] = 0.0
+        q.a[orphan] = 0.0
+        q.a_ext[orphan] = 0.0
+        q.bc[orphan] = BC_FIXED
+        return m, kinetic, internal
 
     # ------------------------------------------------------------- fields
     def element_stress(self) -> np.ndarray:

@@ -1,0 +1,345 @@
+"""Element erosion (thesis 5.3): the strain measures and rules, and the books of
+deletion and of conversion into SPH particles (mass, momentum, energy),
+the master surface that follows erosion, and restart across a conversion."""
+
+from __future__ import annotations
+
+import copy
+import math
+
+import numpy as np
+import pytest
+
+from fem_models import block, material, part
+from sphdyn.events import ElementErosion, ErosionRules
+from sphdyn.interactions import PenaltyCoupling, Wall, WallSpec
+from sphdyn.interactions.penalty_geometry import exterior_faces
+from sphdyn.interactions.wall_contact import STIFFNESS_MASS
+from sphdyn.kernels import KernelContext
+from sphdyn.materials import MaterialGroup, get_model
+from sphdyn.parts.fem.erosion_criteria import (BY_DAMAGE, BY_EFFECTIVE, BY_PRINCIPAL,
+                                               BY_TIME_STEP, deformation_gradient,
+                                               erosion_flags, strain_measures,
+                                               sym3_eigenvalues)
+from sphdyn.parts.sph.part import SPHPart, SPHSettings
+from sphdyn.state import Particles
+from sphdyn.stepper import Stepper
+
+RHO, E, NU = 2400.0, 30e9, 0.2
+CONCRETE = dict(density=RHO, E=E, nu=NU)
+
+
+def empty_sph(dim, mat, n_hist=1):
+    """An SPH part with no particles and one (empty) group of material 0.
+
+    No gradient correction: a layer of debris particles has a near-singular
+    moment matrix (its determinant between the solver's singular threshold
+    and ~0.01), whose inverse blows the run up."""
+    model, params = mat
+    p = Particles.allocate(0, dim, n_hist)
+    g = MaterialGroup("m", model, params, np.zeros(0, np.int64), 0)
+    s = SPHSettings(correction=False, alpha=1.0, beta=2.0, xsph=0.0, benz=False,
+                    h_min_factor=0.5, h_max_factor=2.0, skin_factor=0.1, cfl=0.3,
+                    stress_exponent=4.0, epsilon=(0.0,), total_lagrangian=(False,),
+                    hourglass=0.0, reference_update_every=0)
+    return SPHPart(p, [g], KernelContext.named("cubic_spline", dim, 2.0), s)
+
+
+def moving_block(dim, div=(3, 3, 3), seed=0):
+    """A distorted, moving block of concrete-like elastic elements (random
+    node velocities, a few steps taken so it carries stress and energy)."""
+    x, cells = block([0, 0, 0], [0.03, 0.03, 0.03], div[:dim], dim)
+    mat = material(**CONCRETE)
+    solid = part(x, cells, dim, mat=mat)
+    rng = np.random.default_rng(seed)
+    solid.nodes.v[:, :dim] = rng.normal(0.0, 1.0, (solid.nodes.n, dim)) + 3.0
+    return solid, mat
+
+
+def kinetic(q, dt_half):
+    """Kinetic energy [J] at the velocities after the coming half kick,
+    v + dt_half a (where the stepper books it and the event takes it)."""
+    w = q.v + dt_half * q.a
+    return 0.5 * float(np.sum(q.m * np.sum(w * w, axis=1)))
+
+
+def books(st, solid, sph):
+    """Mass, momentum (3,) and kinetic + internal energy of both parts [SI]
+    (momentum of the mid-step velocities, energy as :func:`kinetic`)."""
+    q, p = solid.nodes, sph.p
+    mass = q.m.sum() + p.m.sum()
+    mom = (q.m[:, None] * q.v).sum(axis=0) + (p.m[:, None] * p.v).sum(axis=0)
+    dh = 0.5 * st.dt_prev
+    ie = solid.energies()[0] + float(p.m @ p.e)
+    return mass, mom, kinetic(q, dh) + kinetic(p, dh) + ie
+
+
+# ----------------------------------------------------------- strain measures
+def test_symmetric_eigenvalues_match_lapack():
+    """Closed-form eigenvalues against numpy.linalg.eigvalsh on random
+    symmetric matrices, and with repeated eigenvalues (1e-12 of the norm:
+    round-off of the cubic's trigonometric solution)."""
+    rng = np.random.default_rng(1)
+    mats = [rng.normal(size=(3, 3)) for _ in range(50)]
+    mats = [a + a.T for a in mats]
+    R = np.linalg.qr(rng.normal(size=(3, 3)))[0]
+    mats += [np.eye(3) * 2.5, R @ np.diag([1.0, 1.0, 3.0]) @ R.T,
+             R @ np.diag([2.0, 0.5, 0.5]) @ R.T]
+    for a in mats:
+        ours = np.array(sym3_eigenvalues(a[0, 0], a[0, 1], a[0, 2], a[1, 1], a[1, 2], a[2, 2]))
+        ref = np.sort(np.linalg.eigvalsh(a))[::-1]
+        assert np.allclose(ours, ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+
+
+def test_strain_measures_of_a_rotated_uniaxial_stretch():
+    """F = R diag(1.1, 1, 1): principal strain 0.1 and effective strain
+    (2/3) ln 1.1 (the log strain's von Mises equivalent), whatever R."""
+    rng = np.random.default_rng(2)
+    R = np.linalg.qr(rng.normal(size=(3, 3)))[0]
+    e1, eff = strain_measures(R @ np.diag([1.1, 1.0, 1.0]))
+    assert e1 == pytest.approx(0.1, rel=1e-12)
+    assert eff == pytest.approx(2.0 / 3.0 * math.log(1.1), rel=1e-12)
+    # pure volume change: no effective strain
+    e1, eff = strain_measures(R * 1.05)
+    assert e1 == pytest.approx(0.05, rel=1e-12)
+    assert eff < 1e-12
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_deformation_gradient_is_exact_for_a_homogeneous_deformation(dim):
+    """x = A X + c on a distorted mesh: every element's F is A (1e-12)."""
+    rng = np.random.default_rng(3)
+    x, cells = block([0, 0, 0], [1, 1, 1], (3, 3, 3)[:dim], dim)
+    inner = np.all((x[:, :dim] > 1e-9) & (x[:, :dim] < 1 - 1e-9), axis=1)
+    x[inner, :dim] += rng.uniform(-0.08, 0.08, (inner.sum(), dim))
+    solid = part(x, cells, dim)
+    ev = ElementErosion("e", solid, {0: ErosionRules(principal_strain=1.0)}, to="nothing")
+    A = np.eye(3)
+    A[:dim, :dim] += rng.normal(0, 0.1, (dim, dim))
+    xs = x @ A.T + 0.7
+    F = np.zeros((3, 3))
+    for e in range(cells.shape[0]):
+        deformation_gradient(xs, cells, e, ev.b0, dim, F)
+        assert np.abs(F - A).max() < 1e-12
+
+
+def test_each_rule_flags_what_it_should():
+    """Four elements of a bar: stretched 20 % (principal 0.2 > 0.15), damaged
+    with 5 % strain (MAT_159 ERODE 1.04: damage > 0.99 and strain > 0.04),
+    damaged without strain (kept), and one whose step is below the minimum."""
+    x, cells = block([0, 0, 0], [4, 1, 1], (4, 1, 1), 3)
+    solid = part(x, cells, 3)
+    ev = ElementErosion("e", solid, {0: ErosionRules(principal_strain=0.15)}, to="nothing")
+    xs = x.copy()
+    # element 0: the nodes at x = 1 pulled 0.2 along x: 20 % strain
+    xs[:, 0] = np.where(x[:, 0] <= 1 + 1e-9, 1.2 * x[:, 0], x[:, 0] + 0.2)
+    # element 1 (1 <= x <= 2): 5 % strain; element 2 (2 <= x <= 3): none
+    xs[:, 0] = np.where((x[:, 0] > 1 + 1e-9) & (x[:, 0] <= 2 + 1e-9),
+                        1.2 + (x[:, 0] - 1) * 1.05, xs[:, 0])
+    xs[x[:, 0] > 2 + 1e-9, 0] = x[x[:, 0] > 2 + 1e-9, 0] + 0.25
+    damage = np.array([0.0, 1.0, 1.0, 0.0])
+    dt_el = np.array([1.0, 1.0, 1.0, 1e-9])
+    table = np.tile(ErosionRules(erode=1.04, principal_strain=0.15).row(), (4, 1))
+    table[3, 3] = 1e-6  # element 3: minimum step 1 us
+    flags = np.zeros(4, np.int8)
+    n = erosion_flags(xs, cells, solid.el.active, ev.b0, 3, damage, 1, dt_el, 0.9, table,
+                      flags)
+    assert flags.tolist() == [BY_PRINCIPAL, BY_DAMAGE, 0, BY_TIME_STEP]
+    assert n == 3
+    # the effective-strain rule alone: the 20 % element (eff = 2/3 ln 1.2 = 0.122)
+    table = np.tile(ErosionRules(effective_strain=0.1).row(), (4, 1))
+    erosion_flags(xs, cells, solid.el.active, ev.b0, 3, damage, 1, dt_el, 0.9, table, flags)
+    assert flags.tolist() == [BY_EFFECTIVE, 0, 0, 0]
+
+
+def test_bad_rules_are_refused():
+    x, cells = block([0, 0, 0], [1, 1, 1], (1, 1, 1), 3)
+    solid = part(x, cells, 3)
+    with pytest.raises(ValueError, match="no damage variable"):
+        ElementErosion("e", solid, {0: ErosionRules(erode=1.05)}, to="nothing")
+    with pytest.raises(ValueError, match="erode must be > 1"):
+        ErosionRules(erode=0.9)
+    with pytest.raises(ValueError, match="principal_strain must be > 0"):
+        ErosionRules(principal_strain=-0.1)
+    with pytest.raises(ValueError, match="per_element"):
+        ElementErosion("e", solid, {0: ErosionRules(principal_strain=0.1)}, per_element=3,
+                       sph=object())
+    with pytest.raises(ValueError, match="needs an SPH part"):
+        ElementErosion("e", solid, {0: ErosionRules(principal_strain=0.1)})
+
+
+# ------------------------------------------------------------------- books
+def _erode_all_flagged(solid, sph, to, per_element, flagged):
+    """Erode the elements ``flagged`` now (a step-free call of the event)."""
+    ev = ElementErosion("e", solid, {0: ErosionRules(min_time_step=1.0)}, to=to,
+                        per_element=per_element, sph=sph)
+    ev.rules[:, 3] = 0.0
+    ev.rules[flagged, 3] = np.inf  # the time-step rule holds for these only
+    st = Stepper([solid] + ([sph] if sph is not None else []), events=[ev])
+    for _ in range(3):
+        st.step()
+    return st, ev
+
+
+@pytest.mark.parametrize("per_element", [1, 8])
+@pytest.mark.parametrize("dim", [2, 3])
+def test_conversion_keeps_mass_momentum_and_energy(dim, per_element):
+    """Elements turned into particles: total mass and momentum of nodes and
+    particles equal before and after to round-off (1e-12 relative), and the
+    kinetic plus internal energy too (the nodes' relative kinetic energy
+    becomes the particles' heat). The particles carry the element's stress."""
+    solid, mat = moving_block(dim)
+    sph = empty_sph(dim, mat)
+    st = Stepper([solid, sph])
+    for _ in range(3):
+        st.step()
+    flagged = np.array([0, 4, 13]) if dim == 3 else np.array([0, 4])
+    sig = solid.element_stress()[flagged]
+    before = books(st, solid, sph)
+    ev = ElementErosion("e", solid, {0: ErosionRules(min_time_step=1.0)}, sph=sph,
+                        per_element=per_element)
+    ev.rules[:, 3] = 0.0
+    ev.rules[flagged, 3] = np.inf
+    ev.apply(st)
+    after = books(st, solid, sph)
+    npp = 1 if per_element == 1 else 2 ** dim
+    assert sph.p.n == npp * flagged.size
+    assert solid.el.active[flagged].tolist() == [0] * flagged.size
+    assert after[0] == pytest.approx(before[0], rel=1e-12)
+    assert np.abs(after[1] - before[1]).max() < 1e-12 * np.abs(before[1]).max()
+    assert after[2] == pytest.approx(before[2], rel=1e-12)
+    assert np.allclose(sph.p.sig.reshape(flagged.size, npp, 3, 3),
+                       sig[:, None], rtol=0, atol=1e-9 * np.abs(sig).max())
+    assert ev.energy_to_heat > 0.0
+    assert ev.columns(st.t)["particles_from_mesh"] == npp * flagged.size
+    # the particles sit inside their element: centroid at the mean of the nodes
+    if per_element == 1:
+        centre = solid.nodes.x[solid.el.conn[flagged]].mean(axis=1)
+        assert np.allclose(sph.p.x, centre, atol=1e-15)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_deletion_removes_and_reports_mass_and_energy(dim):
+    """Plain erosion: the model loses the elements' mass, kinetic share and
+    internal energy, and the event reports exactly those; the balance with
+    E_removed is unchanged (1e-12 relative). Nodes left without elements
+    get no mass and stop."""
+    solid, mat = moving_block(dim)
+    st = Stepper([solid])
+    for _ in range(3):
+        st.step()
+    flagged = np.array([0, 1]) if dim == 2 else np.array([0, 1, 3, 4, 9, 10, 12, 13])
+    m0 = solid.nodes.m.sum()
+    ke = lambda: kinetic(solid.nodes, 0.5 * st.dt_prev)  # noqa: E731
+    e0 = ke() + solid.energies()[0]
+    ev = ElementErosion("e", solid, {0: ErosionRules(min_time_step=1.0)}, to="nothing")
+    ev.rules[:, 3] = 0.0
+    ev.rules[flagged, 3] = np.inf
+    st.events.append(ev)
+    ev.apply(st)
+    assert ev.mass_removed == pytest.approx(solid.el.m[flagged].sum(), rel=1e-12)
+    assert solid.nodes.m.sum() + ev.mass_removed == pytest.approx(m0, rel=1e-12)
+    assert ke() + solid.energies()[0] + ev.energy_removed == pytest.approx(e0, rel=1e-12)
+    assert ev.energy_removed > 0.0
+    corner = 0  # node 0 belongs to element 0 only
+    assert solid.nodes.m[corner] == 0.0 and np.all(solid.nodes.v[corner] == 0.0)
+    rec = st.record()
+    assert rec["E_removed"] == ev.energy_removed
+    assert rec["m_eroded_mesh"] == ev.mass_removed
+
+
+def test_master_faces_follow_erosion():
+    """A corner element of a 2 x 2 x 2 block erodes: its three exterior faces
+    go and the three faces it shared with its neighbours appear."""
+    x, cells = block([0, 0, 0], [0.02, 0.02, 0.02], (2, 2, 2), 3)
+    mat = material(**CONCRETE)
+    solid = part(x, cells, 3, mat=mat)
+    sph = empty_sph(3, mat)
+    cp = PenaltyCoupling("c", sph, solid)
+    assert cp.faces.shape[0] == 24
+    solid.erode(np.array([0]))
+    cp.mesh_changed()
+    assert cp.faces.shape[0] == 24
+    assert np.array_equal(np.sort(np.sort(cp.faces, axis=1), axis=0),
+                          np.sort(np.sort(exterior_faces(cells[1:]), axis=1), axis=0))
+
+
+# ---------------------------------------------------------------- dynamics
+def _impact(to, per_element=1):
+    """A concrete-like block of 4 x 4 x 4 hexes at 20 m/s onto a rigid wall,
+    its elements eroding at 0.2 % effective strain, the particles coupled to the
+    remaining elements by penalty and held by the same wall."""
+    x, cells = block([0, 0, 0.0055], [0.04, 0.04, 0.0455], (4, 4, 4), 3)
+    mat = material(**CONCRETE)
+    solid = part(x, cells, 3, mat=mat)
+    solid.nodes.v[:, 2] = -20.0
+    parts, inters = [solid], []
+    spec = WallSpec("floor", np.zeros(3), np.array([0, 0, 1.0]), STIFFNESS_MASS, alpha=0.1,
+                    friction=0.0, thickness_factor=0.5)
+    inters.append(Wall(spec, solid))
+    sph = None
+    if to == "particles":
+        sph = empty_sph(3, mat)
+        parts.append(sph)
+        inters += [Wall(copy.copy(spec), sph), PenaltyCoupling("c", sph, solid)]
+    ev = ElementErosion("erosion", solid, {0: ErosionRules(effective_strain=0.002)}, to=to,
+                        per_element=per_element, sph=sph)
+    return Stepper(parts, inters, [ev]), ev
+
+
+@pytest.mark.parametrize("to", ["particles", "nothing"])
+def test_impact_with_erosion_keeps_its_books(to):
+    """The block hits the wall and elements erode: the total mass (nodes and
+    particles) stays to round-off with conversion, and E_total (with
+    E_removed for plain erosion) stays within 5 % of the initial kinetic
+    energy: the wall's penalty contact alone gains 3 % in this impact before
+    anything erodes (measured), and each erosion moves the books by O(dt)
+    (energies taken at the coming half kick's estimate)."""
+    st, ev = _impact(to)
+    m0 = st.parts[0].nodes.m.sum()
+    e0 = st.kinetic_now()
+    for _ in range(400):
+        st.step()
+    rec = st.record()
+    assert ev.eroded > 0
+    if to == "particles":
+        sph = st.parts[1]
+        assert sph.p.n == ev.eroded
+        assert st.parts[0].nodes.m.sum() + sph.p.m.sum() == pytest.approx(m0, rel=1e-12)
+    else:
+        assert st.parts[0].nodes.m.sum() + ev.mass_removed == pytest.approx(m0, rel=1e-12)
+        assert rec["E_removed"] > 0.0
+    assert abs(rec["E_total"] - e0) < 0.05 * e0
+
+
+def test_restart_across_a_conversion_is_bitwise():
+    """Checkpoint before the first conversion, restore into a fresh model,
+    continue: the same particles, nodes and books as the run through."""
+    st, ev = _impact("particles")
+    n_first = None
+    scalars = groups = None
+    for k in range(300):
+        if ev.eroded == 0:
+            scalars, groups = copy.deepcopy(st.state())
+        st.step()
+        if ev.eroded and n_first is None:
+            n_first = k
+    assert n_first is not None and st.parts[1].p.n > 0
+    st2, ev2 = _impact("particles")
+    st2.restore(*copy.deepcopy((scalars, groups)))
+    while st2.step_count < st.step_count:
+        st2.step()
+    for a, b in ((st.parts[0].nodes, st2.parts[0].nodes), (st.parts[1].p, st2.parts[1].p)):
+        for name, arr in a.arrays().items():
+            assert np.array_equal(arr, getattr(b, name)), name
+    assert ev2.eroded == ev.eroded
+    # and from a checkpoint taken after conversions
+    scalars, groups = copy.deepcopy(st.state())
+    st3, ev3 = _impact("particles")
+    st3.restore(scalars, groups)
+    for _ in range(20):
+        st.step()
+        st3.step()
+    for name, arr in st.parts[1].p.arrays().items():
+        assert np.array_equal(arr, getattr(st3.parts[1].p, name)), name
+    assert st3.interactions[2].faces.shape == st.interactions[2].faces.shape
