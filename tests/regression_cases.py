@@ -50,6 +50,10 @@ CASES: dict[str, tuple[int, list[str]]] = {
     "beam_tied": (40, ["mesh.beam.block.divisions=[40, 2, 2]"]),
     "beam_hybrid": (40, ["mesh.beam.block.divisions=[40, 2, 2]"]),
     "beam_sph": (40, ['body.beam.dx="125 mm"']),
+    # 1,000 CSCM elements; the first elements erode near step 60
+    "erosion_blocks_fem": (100, []),
+    "erosion_blocks_plain": (100, []),
+    "erosion_blocks_sph": (100, []),
 }
 
 

@@ -51,6 +51,14 @@ the wall, capped so that one step cannot reverse the relative sliding.
 Zero-mass particles (initial cracks) are pushed out with the spring's
 acceleration and exert no force, as at the wall.
 
+Particles born during the run (eroded elements, :mod:`sphdyn.events.erosion`)
+and particles that face a newly exposed face may start inside the contact
+thickness. The spring then acts on the penetration beyond the one they had
+at that moment, :math:`\delta - \delta_0`, with :math:`\delta_0` only
+shrinking as they move out (LS-DYNA's IGNORE = 2): a spring that was never
+loaded releases no energy. Particles present at the start have
+:math:`\delta_0 = 0`.
+
 Limitations: one face per particle (at a concave corner of the master
 surface a particle is held out of the nearer face only). With the default
 master surface (all exterior faces) the faces follow erosion: an eroded
@@ -76,7 +84,8 @@ _INSIDE_RTOL = 1e-9
 @njit(cache=True, error_model="numpy", parallel=True)
 def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, faces,
                             offsets, cand, thickness_factor, method, alpha, friction, dt,
-                            a_p, a_n, face_of, shares, force, normal_force, skip):
+                            a_p, a_n, face_of, shares, force, normal_force, skip, pen0,
+                            fresh):
     r"""Particle-face penalty forces (module docstring) into the particles' and nodes' ``a``.
 
     Parameters
@@ -100,6 +109,12 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
     force : (N, 3) out, the force on each particle [N] (N/m in 2D).
     normal_force : (N,) out, its component along the contact direction [N].
     skip : (N,) bool, particles left out (those tied by :func:`tie_forces`).
+    pen0 : (N,) in/out, penetration each particle is allowed without force
+        [m] (a particle born or exposed inside the contact thickness): the
+        spring acts on :math:`\delta - \delta_0`, and :math:`\delta_0` only
+        shrinks, to the smallest penetration seen (LS-DYNA's IGNORE = 2).
+    fresh : (N,) bool in/out, particles whose allowance is taken now (their
+        current penetration), then cleared.
 
     Returns
     -------
@@ -135,6 +150,8 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
                 bf = f
                 xi, eta, cx, cy, cz, nx, ny, nz, clamped = res
         if bf < 0:
+            pen0[i] = 0.0
+            fresh[i] = False
             continue
         r0 = xp[i, 0] - cx
         r1 = xp[i, 1] - cy
@@ -153,11 +170,18 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
             gap = dist - tp
             e0, e1, e2 = r0 / dist, r1 / dist, r2 / dist
         else:
-            continue
-        if gap >= 0.0:
+            gap = 0.0  # behind the plane of a face's boundary: no contact
+        pen = max(-gap, 0.0)
+        if fresh[i]:
+            pen0[i] = pen
+            fresh[i] = False
+        elif pen < pen0[i]:
+            pen0[i] = pen
+        if pen - pen0[i] <= 0.0:
             continue
         count += 1
-        an = spring_acceleration(-gap, method, alpha, dt, kbulk[i], vol0[i], rho0[i], dim)
+        an = spring_acceleration(pen - pen0[i], method, alpha, dt, kbulk[i], vol0[i],
+                                 rho0[i], dim)
         if mp[i] <= 0.0:  # pushed out, no force of its own
             a_p[i, 0] += an * e0
             a_p[i, 1] += an * e1
@@ -367,6 +391,10 @@ class PenaltyCoupling(InteractionBase):
             raise ValueError(f"{name}: faces must have shape (F, {4 if dim == 3 else 2}) "
                              f"in {dim}D, got {self.faces.shape}")
         self.master_nodes = np.unique(self.faces)
+        # penetration allowed without force: particles born (or exposed to new
+        # faces) inside the contact thickness (the kernel's pen0 / fresh)
+        self.pen0 = np.zeros(sph_part.p.n)
+        self.fresh = np.zeros(sph_part.p.n, dtype=np.bool_)
         self.count = 0
         self.n_builds = 0
         self.total_normal = 0.0
@@ -377,9 +405,15 @@ class PenaltyCoupling(InteractionBase):
 
     # ------------------------------------------------------------- set-up
     def _allocate(self) -> None:
-        """Work arrays, the time-step limit and the candidate list for the particles."""
+        """Work arrays, the time-step limit and the candidate list for the particles
+        (particles added since the last call take their allowance at their
+        first contact evaluation)."""
         p = self.part.p
         n = p.n
+        old = self.pen0.size
+        if n > old:
+            self.pen0 = np.concatenate([self.pen0, np.zeros(n - old)])
+            self.fresh = np.concatenate([self.fresh, np.ones(n - old, dtype=np.bool_)])
         self.face_of = np.full(n, -1, dtype=np.int64)
         self.shares = np.zeros((n, 4, 3))
         self.force = np.zeros((n, 3))
@@ -451,8 +485,12 @@ class PenaltyCoupling(InteractionBase):
             self.tie_offset = self.tie_offset[keep]
             self.tie_shares = np.zeros((self.tied.size, 4, 3))
             self.tie_force = np.zeros((self.tied.size, 3))
+        in_contact = self.face_of >= 0
         self.faces = faces
         self.master_nodes = np.unique(self.faces)
+        # particles not in contact may face a newly exposed face inside their
+        # thickness: they take their allowance there (those in contact keep theirs)
+        self.fresh[:in_contact.size] |= ~in_contact
         self._allocate()
 
     # ----------------------------------------------------------- protocol
@@ -475,7 +513,7 @@ class PenaltyCoupling(InteractionBase):
             p.x, p.v, p.m, p.vol0, p.rho0, p.bulk_modulus, p.dim, q.x, q.v, q.m, self.faces,
             self.offsets, self.cand, self.thickness_factor, self.method, self.alpha,
             self.friction, dt, a_out, a_n, self.face_of, self.shares, self.force,
-            self.normal_force, self.skip))
+            self.normal_force, self.skip, self.pen0, self.fresh))
         self.total_normal = float(self.normal_force.sum())
         if self.tied.size:
             self.total_tie = float(tie_forces(
@@ -492,11 +530,15 @@ class PenaltyCoupling(InteractionBase):
 
     def state(self) -> tuple[dict, dict[str, np.ndarray]]:
         return {}, {"offsets": self.offsets, "cand": self.cand, "xp_ref": self.xp_ref,
-                    "xn_ref": self.xn_ref}
+                    "xn_ref": self.xn_ref, "pen0": self.pen0, "fresh": self.fresh,
+                    "face_of": self.face_of}
 
     def restore(self, scalars: dict, arrays: dict) -> None:
         if np.any(self.solid.el.active == 0):  # eroded before the checkpoint
             self.mesh_changed()
+        for name in ("pen0", "fresh", "face_of"):
+            if name in arrays:
+                setattr(self, name, arrays[name].copy())
         self.offsets = arrays["offsets"].copy()
         self.cand = arrays["cand"].copy()
         self.xp_ref = arrays["xp_ref"].copy()
