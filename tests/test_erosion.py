@@ -343,3 +343,36 @@ def test_restart_across_a_conversion_is_bitwise():
     for name, arr in st.parts[1].p.arrays().items():
         assert np.array_equal(arr, getattr(st3.parts[1].p, name)), name
     assert st3.interactions[2].faces.shape == st.interactions[2].faces.shape
+
+
+def test_a_particle_born_inside_the_contact_thickness_keeps_that_penetration_free():
+    """LS-DYNA's IGNORE = 2 for born particles: a particle appearing 3 mm deep
+    in a face's 5 mm contact thickness feels nothing there; pushed 1 mm deeper
+    it feels the spring of 1 mm (a = alpha 1 mm / dt^2, paper eq. 8, 1e-12);
+    moving out shrinks the allowance to the smallest penetration seen.
+    Particles present from the start have no allowance."""
+    x, cells = block([0, 0, 0], [0.01, 0.01, 0.01], (1, 1, 1), 3)
+    mat = material(**CONCRETE)
+    solid = part(x, cells, 3, mat=mat)
+    sph = empty_sph(3, mat)
+    cp = PenaltyCoupling("c", sph, solid, alpha=0.1)
+    p = sph.p
+    rows = p.grow(1, notify=False)
+    p.x[rows] = [0.005, 0.005, 0.012]  # 2 mm above the top face: 3 mm deep
+    p.m[rows], p.vol0[rows], p.rho0[rows], p.rho[rows] = 2.4e-3, 1e-6, RHO, RHO
+    p.h[rows] = p.h0[rows] = 0.012
+    p.notify_grown(rows.start, rows.stop)
+    dt = 1e-6
+
+    def accel(z):
+        p.x[0, 2] = z
+        cp.update_geometry(0.0)
+        a = np.zeros((1, 3))
+        cp.forces(0.0, dt, a)
+        return a[0, 2]
+
+    assert accel(0.012) == 0.0
+    assert accel(0.011) == pytest.approx(0.1 * 0.001 / dt ** 2, rel=1e-9)
+    assert accel(0.013) == 0.0  # 2 mm deep: the allowance is now 2 mm
+    assert accel(0.0125) == pytest.approx(0.1 * 0.0005 / dt ** 2, rel=1e-9)
+    assert cp.pen0[0] == pytest.approx(0.002, rel=1e-12)
