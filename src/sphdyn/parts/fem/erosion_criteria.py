@@ -150,15 +150,30 @@ def erosion_flags(x, conn, active, b0, dim, damage, ngp, dt_el, cfl, rules, flag
                 flags[e] = BY_TIME_STEP
                 count += 1
                 continue
-            if rules[e, 0] == np.inf and rules[e, 1] == np.inf and rules[e, 2] == np.inf:
-                continue
-            deformation_gradient(x, conn, e, b0, dim, F)
-            e1, eff = strain_measures(F)
             d = 0.0
             for k in range(ngp):
                 d += damage[e * ngp + k]
             d /= ngp
-            if d > DAMAGE_THRESHOLD and e1 > rules[e, 0]:
+            damaged = d > DAMAGE_THRESHOLD and rules[e, 0] < np.inf
+            if not damaged and rules[e, 1] == np.inf and rules[e, 2] == np.inf:
+                continue  # no rule can hold: no strain needed (most elements)
+            deformation_gradient(x, conn, e, b0, dim, F)
+            if rules[e, 2] == np.inf:
+                # only principal strains asked: Gershgorin's bound on the
+                # largest eigenvalue of C = F^T F spares the eigenvalues of
+                # elements far from every limit
+                bound = 0.0
+                for i in range(3):
+                    row = 0.0
+                    for j in range(3):
+                        cij = F[0, i] * F[0, j] + F[1, i] * F[1, j] + F[2, i] * F[2, j]
+                        row += cij if i == j else abs(cij)
+                    bound = max(bound, row)
+                limit = min(rules[e, 1], rules[e, 0] if damaged else np.inf)
+                if math.sqrt(max(bound, 0.0)) - 1.0 <= limit:
+                    continue
+            e1, eff = strain_measures(F)
+            if damaged and e1 > rules[e, 0]:
                 flags[e] = BY_DAMAGE
             elif e1 > rules[e, 1]:
                 flags[e] = BY_PRINCIPAL
