@@ -12,22 +12,25 @@ import numpy as np
 from .interactions import ParticleContact, Wall
 from .mesh_assembly import erosion_events, mesh_interactions, mesh_part
 from .kernels import KernelContext
-from .model import Model, build_model, debris_meshes
+from .model import Model, build_model, debris_meshes, sublayer_meshes
 from .parts import SPHPart, SPHSettings
 from .stepper import Stepper
 
 
-def sph_settings(deck, converted: int = 0, debris: int = 0) -> SPHSettings:
+def sph_settings(deck, converted: int = 0, sublayer: int = 0,
+                 debris: int = 0) -> SPHSettings:
     """The SPH scheme's settings from ``[sph]``, ``[time]`` and the bodies;
     ``converted`` bodies made of mesh elements follow after the deck's, with
-    the [sph] formulation and artificial stress, then ``debris`` bodies of
-    eroded elements, updated-Lagrangian (debris has no reference shape)."""
+    the [sph] formulation and artificial stress, then the ``sublayer`` bodies
+    of bars and the ``debris`` bodies of eroded elements, updated-Lagrangian
+    (a bar's particles follow its nodes; debris has no reference shape)."""
     sph = deck.sph
     tl = tuple((b.formulation or sph.formulation) == "total_lagrangian" for b in deck.body)
     eps = tuple(sph.artificial_stress.epsilon if b.artificial_stress is None
                 else b.artificial_stress for b in deck.body)
-    tl += (sph.formulation == "total_lagrangian",) * converted + (False,) * debris
-    eps += (sph.artificial_stress.epsilon,) * (converted + debris)
+    tl += ((sph.formulation == "total_lagrangian",) * converted
+           + (False,) * (sublayer + debris))
+    eps += (sph.artificial_stress.epsilon,) * (converted + sublayer + debris)
     return SPHSettings(
         correction=bool(sph.correction), alpha=sph.viscosity.alpha,
         beta=sph.viscosity.beta, xsph=sph.xsph,
@@ -53,10 +56,12 @@ def build_stepper(deck, model: Model | None = None, events=(), monitors=()) -> S
     p = model.particles
     parts, interactions, part = [], [], None
     debris = len(debris_meshes(model.meshes))
+    sublayer = len(sublayer_meshes(model.meshes))
     if p.n or debris:
         kernel = KernelContext.named(deck.sph.kernel, p.dim, deck.sph.support_scale)
-        settings = sph_settings(deck, len(model.body_names) - len(deck.body) - debris,
-                                debris)
+        settings = sph_settings(
+            deck, len(model.body_names) - len(deck.body) - sublayer - debris, sublayer,
+            debris)
         part = SPHPart(p, model.groups, kernel, settings, phase=model.phase,
                        variation=model.variation)
         parts.append(part)

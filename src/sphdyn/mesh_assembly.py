@@ -5,7 +5,8 @@ Called by :func:`sphdyn.assembly.build_stepper` with the meshes of
 ``<set>_reaction_x|y|z``, a load's ``<set>_force``, a mesh's damping
 ``E_damping_<mesh>``, a wall on a mesh ``F_wall_<wall>_<mesh>``, a coupling
 ``F_<mesh>_coupling`` (penalty) or ``F_<mesh>_coupling_x|y|z`` (tied, hybrid),
-the debris coupling of an eroding mesh ``F_<mesh>_debris``, its erosion
+the sublayer of a bar ``F_<mesh>_sublayer_x|y|z`` (the bond force), the
+debris coupling of an eroding mesh ``F_<mesh>_debris``, its erosion
 ``eroded_<mesh>`` and the rest of :meth:`sphdyn.events.ElementErosion.columns`.
 """
 
@@ -20,6 +21,7 @@ from .deck.errors import format_problem
 from .events import ElementErosion, ErosionRules
 from .interactions import HybridCoupling, PenaltyCoupling, TiedCoupling, Wall
 from .interactions.nodal import MassDamping, NodalLoad, PrescribedMotion
+from .interactions.sublayer import SublayerCoupling
 from .materials import get_model
 from .mesh_model import MeshModel
 from .parts import SolidSettings
@@ -34,6 +36,13 @@ def _material(deck, k: int):
     return model, model.pack(m.values())
 
 
+def section_of(spec) -> BeamSection:
+    """The cross-section of a [mesh.line]'s [mesh.section]."""
+    sec = spec.section
+    return (BeamSection.rectangle(sec.width, sec.height) if sec.shape == "rectangle"
+            else BeamSection.circle(sec.diameter))
+
+
 def mesh_part(deck, mm: MeshModel):
     """The solid or line part of one mesh (initial velocity set)."""
     spec = mm.spec
@@ -46,17 +55,19 @@ def mesh_part(deck, mm: MeshModel):
         part = solid_part(mm.name, mm.points, mm.cells, deck.run.dimension, materials,
                           mat=mm.mat, settings=settings)
     else:
-        sec = spec.section
-        section = (BeamSection.rectangle(sec.width, sec.height) if sec.shape == "rectangle"
-                   else BeamSection.circle(sec.diameter))
+        section = section_of(spec)
         model, params = _material(deck, int(mm.mat[0]))
+        if spec.sublayer is not None:  # the elements carry (1 - r) of the bar's mass
+            values = dict(deck.material[int(mm.mat[0])].values())
+            values["density"] *= 1.0 - spec.sublayer.mass_ratio
+            params = model.pack(values)
         if mm.element == "beam" and model.name != "elastic":
             raise DeckError([format_problem(
                 f"mesh[{mm.index}] '{mm.name}'.material", f"beams are elastic resultant "
                 f"beams; material model '{model.name}' is not elastic",
                 "use an elastic material, or element = \"truss\" for an inelastic bar")])
         part = LinePart(mm.name, mm.points, mm.cells, element=mm.element, section=section,
-                        material=(model, params), orientation=sec.orientation,
+                        material=(model, params), orientation=spec.section.orientation,
                         damping=spec.damping, dt_scale=spec.cfl)
     part.kin.v[:] = np.asarray(spec.velocity, dtype=float)
     return part
@@ -124,6 +135,11 @@ def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
                 out.append(MassDamping(f"{mm.name}_particles", sph_part,
                                        np.setdiff1d(rows, slaves), mm.spec.damping))
             out += coupling  # after every other interaction on the particles
+        if mm.spec.sublayer is not None:
+            own = model.body_names.index(f"{mm.name}_sublayer")
+            rows = np.flatnonzero(sph_part.p.body == own)
+            out.append(SublayerCoupling(f"{mm.name}_sublayer", sph_part, part, rows,
+                                        np.arange(part.kin.n)))
         ero = mm.spec.erosion
         if ero is not None and ero.to == "particles" and not (
                 mm.converted is not None and mm.converted.spec.coupling == "penalty"):

@@ -91,7 +91,7 @@ def _read(spec, where: str, dim: int) -> MeshData:
         b = spec.block
         return block_mesh(b.lo, b.hi, b.divisions, dim)
     if spec.line is not None:
-        return line_mesh(spec.line.start, spec.line.end, spec.line.divisions)
+        return line_mesh(spec.line.start, spec.line.end, spec.line.count)
     try:
         mesh = read_mesh(spec.file, dim, kind=SOLID_KIND[dim])
     except (ValueError, OSError, KeyError, IndexError) as exc:

@@ -252,8 +252,12 @@ def build_model(deck) -> Model:
             parts.append(_converted_particles(deck, mm, len(body_names), density_of, n_hist))
             phase_parts.append(np.full(parts[-1].n, -1, np.int8))
             body_names.append(_converted_name(mm, body_names))
+    for mm in sublayer_meshes(meshes):  # bars' nodes as particles (thesis 6.1)
+        parts.append(_sublayer_particles(deck, mm, len(body_names), n_hist))
+        phase_parts.append(np.full(parts[-1].n, -1, np.int8))
+        body_names.append(_extra_name(mm, body_names, "sublayer"))
     for mm in debris_meshes(meshes):  # bodies that start empty: eroded elements
-        body_names.append(_debris_name(mm, body_names))
+        body_names.append(_extra_name(mm, body_names, "debris"))
     particles = (Particles.concatenate(parts) if parts
                  else Particles.allocate(0, dim, n_hist))
     particles.hist_names = list(next(iter(layouts), ()))
@@ -266,6 +270,7 @@ def build_model(deck) -> Model:
         groups.append(MaterialGroup(m.name, models[m.name], params[m.name],
                                     np.zeros(0, np.int64), k))
 
+    _check_sublayers(deck, meshes, particles, body_names)
     for g in groups:
         if not g.idx.size:  # a debris group, filled during the run
             continue
@@ -330,14 +335,88 @@ def debris_meshes(meshes) -> list[MeshModel]:
             if mm.spec.erosion is not None and mm.spec.erosion.to == "particles"]
 
 
-def _debris_name(mm: MeshModel, taken: list[str]) -> str:
-    """The body name of a mesh's eroded-element particles: ``<mesh>_debris``."""
-    name = f"{mm.name}_debris"
+def sublayer_meshes(meshes) -> list[MeshModel]:
+    """The bars with [mesh.sublayer], in deck order: their bodies follow the
+    converted ones."""
+    return [mm for mm in meshes if mm.spec.sublayer is not None]
+
+
+def _extra_name(mm: MeshModel, taken: list[str], what: str) -> str:
+    """The body name of a mesh's ``what`` particles: ``<mesh>_<what>``."""
+    name = f"{mm.name}_{what}"
     if name in taken:
+        key = "erosion" if what == "debris" else what
         raise DeckError([format_problem(
-            f"mesh[{mm.index}] '{mm.name}'.erosion", f"its particles form a body named "
+            f"mesh[{mm.index}] '{mm.name}'.{key}", f"its particles form a body named "
             f"'{name}', and a [[body]] has that name", "rename the mesh or the body")])
     return name
+
+
+def _sublayer_particles(deck, mm: MeshModel, b: int, n_hist: int) -> Particles:
+    """One particle per node of a bar (:mod:`sphdyn.interactions.sublayer`): its
+    share ``mass_ratio`` of the bar's lumped mass, the bar's material (its
+    density is the concrete's, set by :func:`_check_sublayers`), h =
+    sph.h_factor times the mean element length, body ``b``."""
+    from .mesh_assembly import section_of
+    from .interactions.sublayer import sublayer_masses
+
+    mat = deck.material[int(mm.mat[0])]
+    x, conn = mm.points, mm.cells
+    m = sublayer_masses(x, conn, section_of(mm.spec).area, mat.density,
+                        mm.spec.sublayer.mass_ratio)
+    length = float(np.mean(np.linalg.norm(x[conn[:, 1]] - x[conn[:, 0]], axis=1)))
+    p = Particles.allocate(x.shape[0], deck.run.dimension, n_hist)
+    p.x[:] = x
+    p.x0[:] = x
+    p.v[:] = np.asarray(mm.spec.velocity, dtype=float)
+    p.m[:] = m
+    p.rho[:] = mat.density
+    p.rho0[:] = mat.density
+    p.vol0[:] = m / mat.density
+    p.mat[:] = int(mm.mat[0])
+    p.h[:] = deck.sph.h_factor * length
+    p.h0[:] = p.h
+    p.body[:] = b
+    return p
+
+
+def _check_sublayers(deck, meshes, particles: Particles, body_names: list[str]) -> None:
+    """A bar must meet the concrete: at least one of its nodes needs a particle
+    of the [mesh.sublayer] body (or of any deck body) within its support
+    radius (nodes of a bar that sticks out, as in a pull-out test, need not).
+    The bar's particles take the density of the concrete around them."""
+    from scipy.spatial import cKDTree
+
+    from .kernels import kernel_id, support
+
+    for mm in sublayer_meshes(meshes):
+        sub = mm.spec.sublayer
+        own = body_names.index(f"{mm.name}_sublayer")
+        hosts = ([body_names.index(sub.body)] if sub.body is not None
+                 else list(range(len(deck.body))))
+        host = np.flatnonzero(np.isin(particles.body, hosts))
+        rows = np.flatnonzero(particles.body == own)
+        where = f"mesh[{mm.index}] '{mm.name}'.line"
+        radius = (support(kernel_id(deck.sph.kernel)) * deck.sph.support_scale
+                  * particles.h[rows])
+        dist = (cKDTree(particles.x[host]).query(particles.x[rows])[0] if host.size
+                else np.full(rows.size, np.inf))
+        if host.size:  # the host's density: the energy identity of SPH needs
+            # neighbours of alike density (docs/theory.md, "Sublayer coupling")
+            near = cKDTree(particles.x[host]).query(particles.x[rows])[1]
+            rho = float(np.mean(particles.rho0[host[near]]))
+            particles.rho[rows] = rho
+            particles.rho0[rows] = rho
+            particles.vol0[rows] = particles.m[rows] / rho
+        if not np.any(dist <= radius):
+            at = ", ".join(f"{c:.4g}" for c in particles.x[rows[0]])
+            raise DeckError([format_problem(
+                where, f"the bar lies outside the concrete: none of its {rows.size} "
+                f"nodes (the first at ({at}) m) has a particle of "
+                f"{'body ' + repr(sub.body) if sub.body else 'any body'} within its "
+                f"support ({radius.max():.4g} m)",
+                "move the bar into the concrete body (or name the body it is in: "
+                "[mesh.sublayer] body)")])
 
 
 def _converted_name(mm: MeshModel, taken: list[str]) -> str:

@@ -196,7 +196,7 @@ def estimate_size(deck) -> SizeEstimate:
     pairs = ball_volume(radius, dim)
     per_particle = PARTICLE_BYTES + 8 * _history_width(deck)
     meshes = {m.name: float(np.prod(m.block.divisions)) if m.block is not None
-              else float(m.line.divisions) for m in deck.mesh if m.file is None}
+              else float(m.line.count) for m in deck.mesh if m.file is None}
     return SizeEstimate(bodies, n, pairs, n * per_particle,
                         n * pairs * PAIR_BYTES if n and pairs else 0.0, meshes)
 

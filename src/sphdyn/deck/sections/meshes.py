@@ -51,14 +51,29 @@ class LineMesh(Section):
 
     start: Position = Field(description="First node.")
     end: Position = Field(description="Last node.")
-    divisions: integer("element count", lo=1) = Field(description="Number of elements.")
+    divisions: Optional[integer("element count", lo=1)] = Field(
+        None, description="Number of elements (or give element_length).")
+    element_length: Optional[PositiveLength] = Field(
+        None, description="Element length: the line gets the nearest whole number "
+                          "of equal elements (or give divisions).")
 
     @model_validator(mode="after")
     def _has_length(self):
         if self.start == self.end:
             raise problem("start and end are the same point",
                           "give two different end points of the line")
+        if (self.divisions is None) == (self.element_length is None):
+            raise problem("a line needs divisions or element_length (one of them)",
+                          "give divisions = 20 or element_length = \"25 mm\"")
         return self
+
+    @property
+    def count(self) -> int:
+        """The number of elements."""
+        if self.divisions is not None:
+            return self.divisions
+        length = sum((a - b) ** 2 for a, b in zip(self.start, self.end)) ** 0.5
+        return max(1, round(length / self.element_length))
 
 
 class BeamSection(Section):
@@ -162,6 +177,25 @@ class Convert(PenaltyKeys):
         return self
 
 
+class Sublayer(Section):
+    """[mesh.sublayer]: the bar's nodes are also SPH particles in the concrete (thesis 6.1).
+
+    Every node of the line becomes a particle of the bar's material that
+    moves with it (one degree of freedom); the particles meet the concrete
+    particles through their overlapping supports. They form a body named
+    ``<mesh>_sublayer`` (updated-Lagrangian) with h = sph.h_factor times the
+    element length.
+    """
+
+    mass_ratio: real("mass ratio", lo=0, hi=1, lo_open=True, hi_open=True) = Field(
+        0.5, description="The particles' share of the bar's mass (0 < r < 1; the "
+                         "elements carry 1 - r). Equal (0.5) by default, as the thesis "
+                         "found best.")
+    body: Optional[reference_to("body")] = Field(
+        None, description="The concrete body the bar lies in (default: any): every "
+                          "node must have one of its particles within its support.")
+
+
 class MeshErosion(PenaltyKeys):
     """[mesh.erosion]: elements erode by their material's [material.erosion] rules.
 
@@ -244,6 +278,9 @@ class Mesh(Section):
         None, description="A region of elements replaced by SPH particles.")
     erosion: Optional[MeshErosion] = Field(
         None, description="Elements erode during the run ([mesh.erosion]).")
+    sublayer: Optional[Sublayer] = Field(
+        None, description="A bar inside SPH concrete, coupled by its nodes' particles "
+                          "([mesh.sublayer], line meshes).")
 
     @model_validator(mode="after")
     def _one_source(self):
@@ -264,6 +301,9 @@ class Mesh(Section):
             if self.erosion is not None:
                 raise problem("only solid elements erode",
                               "remove [mesh.erosion] from the line mesh")
+        elif self.sublayer is not None:
+            raise problem("a sublayer couples bars (a [mesh.line] of beams or trusses)",
+                          "remove [mesh.sublayer], or make the mesh a [mesh.line]")
         else:
             extra = [k for k in ("element", "section") if getattr(self, k) is not None]
             if extra:

@@ -1,0 +1,203 @@
+"""Sublayer coupling of rebar in SPH concrete (thesis 6.1): masses, bond, books.
+
+What is pinned here, with its tolerance:
+
+* the mass split: nodes plus particles carry the bar's rho A L exactly
+  (1e-12), the particles the ratio r of it; r of 0 or 1 refused;
+* one degree of freedom: the particles sit on their nodes and move with them;
+  the bar's own particle pairs carry no force and are out of its particles'
+  velocity gradient (changing the other bar particles' velocities leaves a
+  particle's L unchanged to round-off, 1e-12);
+* a bar sliding freely in a block: total momentum to round-off (1e-12) and
+  energy within 2 % (the first kick's half step);
+* pull-out from a deck: the pulled end's reaction, the bond force the
+  concrete gives the bar and the reaction of the held plate agree within
+  0.1 % at the end (quasi-static), the energy balance closes within 0.3 %
+  of the external work, and the bar particles stay evenly spaced on their
+  nodes (no clumping: the symptom of the tensile instability);
+* bad input: a bar outside the concrete, a mass ratio of 0, a sublayer on a
+  solid mesh: refused naming the field.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from sphdyn.assembly import build_stepper
+from sphdyn.deck import DeckError, loads_deck
+from sphdyn.interactions.sublayer import sublayer_masses
+from sphdyn.io import read_history_csv
+from sphdyn.simulation import Simulation
+from test_mesh_decks import _bad
+
+PULLOUT = """
+[run]
+dimension = 3
+t_end = "{t_end}"
+[[material]]
+name = "concrete"
+model = "elastic"
+density = 2400.0
+E = "30 GPa"
+nu = 0.2
+[[material]]
+name = "steel"
+model = "elastic"
+density = 7850.0
+E = "200 GPa"
+nu = 0.3
+[[body]]
+name = "block"
+material = "concrete"
+dx = "10 mm"
+geometry = {{ shape = "box", lo = [0, 0, 0], hi = ["100 mm", "60 mm", "60 mm"] }}
+[[mesh]]
+name = "bar"
+material = "steel"
+element = "truss"
+line = {{ start = {start}, end = ["125 mm", "30 mm", "30 mm"], element_length = "10 mm" }}
+section = {{ shape = "circle", diameter = "10 mm" }}
+{velocity}
+[mesh.sublayer]
+mass_ratio = {ratio}
+{sets}
+[output]
+every = "1 ms"
+history_every = 10
+progress = false
+vtk = false
+"""
+SETS = """
+[[set]]
+name = "plate"
+body = "block"
+region = { shape = "box", lo = ["90 mm", -1, -1], hi = [1, 1, 1] }
+[[set]]
+name = "grip"
+mesh = "bar"
+region = { shape = "box", lo = ["124 mm", -1, -1], hi = [1, 1, 1] }
+[[boundary]]
+set = "plate"
+type = "fixed"
+[[boundary]]
+set = "grip"
+type = "displacement"
+displacement = ["0.2 mm", 0, 0]
+ramp_time = "1.5 ms"
+ramp = "smooth"
+"""
+
+
+def deck_text(t_end="2 ms", ratio=0.5, sets=SETS, velocity="",
+              start='["5 mm", "30 mm", "30 mm"]'):
+    return PULLOUT.format(t_end=t_end, ratio=ratio, sets=sets, velocity=velocity,
+                          start=start)
+
+
+def test_mass_split_keeps_the_bar_mass():
+    x = np.zeros((5, 3))
+    x[:, 0] = [0.0, 0.1, 0.25, 0.3, 0.5]
+    conn = np.array([[0, 1], [1, 2], [2, 3], [3, 4]])
+    area, rho = 7.85e-5, 7850.0
+    m = sublayer_masses(x, conn, area, rho, 0.3)
+    assert m.sum() == pytest.approx(0.3 * rho * area * 0.5, rel=1e-12)
+    assert m[2] == pytest.approx(0.3 * rho * area * (0.15 + 0.05) / 2, rel=1e-12)
+    for bad in (0.0, 1.0):
+        with pytest.raises(ValueError, match="neither the nodes nor the particles"):
+            sublayer_masses(x, conn, area, rho, bad)
+
+
+def test_nodes_and_particles_carry_the_bar_mass_from_a_deck():
+    st = build_stepper(loads_deck(deck_text(ratio=0.25)))
+    bar, sph = st.part("bar"), st.part("sph")
+    rows = np.flatnonzero(sph.p.body == 1)
+    total = 7850.0 * np.pi * 0.005 ** 2 * 0.12
+    assert sph.p.m[rows].sum() == pytest.approx(0.25 * total, rel=1e-12)
+    # the nodes' masses hold the elements' (1 - r) and their particles'
+    assert bar.kin.m.sum() == pytest.approx(total, rel=1e-12)
+    assert np.array_equal(sph.p.x[rows], bar.kin.x)
+    assert "bar_sublayer" in [i.name for i in st.interactions]
+
+
+def test_the_bars_own_pairs_are_out_of_its_velocity_gradient():
+    """The block at rest, the bar's nodes moving: a bar particle's L comes
+    from the concrete pairs only, so the other bar particles' velocities do
+    not change it (to round-off), while its own velocity does."""
+    st = build_stepper(loads_deck(deck_text(sets="")))
+    bar, sph = st.part("bar"), st.part("sph")
+    p = sph.p
+    rows = np.flatnonzero(p.body == 1)
+    k = rows[0]  # near the block's face: an uneven neighbourhood (L of a rigid
+    # motion is not zero there, so the test can see its own velocity)
+
+    def gradient(v_bar):
+        bar.kin.v[:] = v_bar
+        for inter in st.interactions:
+            inter.constrain(0.0, 0.0)
+        sph.update_geometry(0.0, 0.0)
+        return p.L[k].copy()
+
+    rng = np.random.default_rng(0)
+    v = rng.normal(size=(bar.kin.n, 3))
+    L1 = gradient(v)
+    w = rng.normal(size=(bar.kin.n, 3))
+    w[0] = v[0]  # same own velocity, others changed
+    assert np.abs(L1).max() > 1.0  # [1/s]
+    # the own pairs' share is subtracted from the full sum: round-off remains
+    assert np.abs(gradient(w) - L1).max() < 1e-12 * np.abs(L1).max()
+    w[0] += 1.0
+    assert np.abs(gradient(w) - L1).max() > 1.0
+
+
+def test_free_bar_sliding_in_a_block_keeps_momentum_and_energy():
+    st = build_stepper(loads_deck(deck_text(sets="", velocity='velocity = ["1 m/s", 0, 0]')))
+    bar, sph = st.part("bar"), st.part("sph")
+    p = sph.p
+    free = p.bc == 0  # the block's particles (the bar's are slaves)
+
+    def momentum():
+        return (p.m[free, None] * p.v[free]).sum(0) + (bar.kin.m[:, None] * bar.kin.v).sum(0)
+
+    p0 = momentum()
+    e0 = 0.5 * np.sum(bar.kin.m * np.sum(bar.kin.v ** 2, axis=1))
+    for _ in range(2000):
+        st.step()
+    assert np.abs(momentum() - p0).max() < 1e-12 * np.abs(p0).max()
+    assert st.record()["E_total"] == pytest.approx(e0, rel=0.02)
+
+
+def test_pull_out_transfers_the_force_and_closes_the_books(tmp_path):
+    sim = Simulation.from_deck(loads_deck(deck_text()), tmp_path / "run")
+    sim.run()
+    h = read_history_csv(tmp_path / "run/history.csv")
+    grip, plate, bond = (h["grip_reaction_x"][-1], h["plate_reaction_x"][-1],
+                         h["F_bar_sublayer_x"][-1])
+    assert grip > 5e4  # the bar carries tens of kN
+    assert bond == pytest.approx(-grip, rel=1e-3)
+    assert plate == pytest.approx(-grip, rel=1e-3)
+    assert abs(h["E_total"][-1]) < 3e-3 * h["W_external"][-1]
+    bar, sph = sim.stepper.part("bar"), sim.stepper.part("sph")
+    rows = np.flatnonzero(sph.p.body == 1)
+    assert np.array_equal(sph.p.x[rows], bar.kin.x)
+    gaps = np.diff(np.sort(bar.kin.x[:, 0]))
+    assert gaps.max() / gaps.min() < 1.01  # the bar's particles do not clump
+
+
+def test_bar_outside_the_concrete_is_refused(tmp_path, capsys):
+    text = deck_text(sets="").replace('end = ["125 mm", "30 mm", "30 mm"]',
+                                      'end = ["125 mm", "30 mm", "300 mm"]')
+    text = text.replace('start = ["5 mm", "30 mm", "30 mm"]',
+                        'start = ["5 mm", "30 mm", "200 mm"]')
+    _bad(tmp_path, text, "mesh[0] 'bar'.line", ["outside the concrete"], capsys)
+
+
+def test_zero_mass_ratio_and_a_solid_sublayer_are_refused(tmp_path, capsys):
+    _bad(tmp_path, deck_text(sets="", ratio=0), "mesh[0].sublayer.mass_ratio", [], capsys)
+    solid = deck_text(sets="").replace(
+        'element = "truss"\nline = { start = ["5 mm", "30 mm", "30 mm"], end = ["125 mm", '
+        '"30 mm", "30 mm"], element_length = "10 mm" }\nsection = { shape = "circle", '
+        'diameter = "10 mm" }', 'block = { lo = [0, 0, "70 mm"], hi = ["0.1 m", "0.1 m", '
+        '"0.12 m"], divisions = [2, 2, 1] }')
+    with pytest.raises(DeckError, match="sublayer couples bars"):
+        loads_deck(solid)
