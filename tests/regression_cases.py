@@ -54,6 +54,7 @@ CASES: dict[str, tuple[int, list[str]]] = {
     "erosion_blocks_fem": (100, []),
     "erosion_blocks_plain": (100, []),
     "erosion_blocks_sph": (100, []),
+    "pullout_sublayer": (60, []),
 }
 
 
