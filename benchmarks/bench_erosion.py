@@ -22,9 +22,9 @@ from __future__ import annotations
 
 import argparse
 import json
-import time
 
 import numba
+from interleaved import best_step_times
 
 from sphdyn.bench import hex3d_stepper
 from sphdyn.events import ElementErosion, ErosionRules
@@ -55,13 +55,7 @@ def main() -> None:
         numba.set_num_threads(a.threads)
     models = {"none": stepper(a.elements, False, a.every, a.rule),
               "erosion": stepper(a.elements, True, a.every, a.rule)}
-    best = {k: float("inf") for k in models}
-    for _ in range(a.repeat):
-        for name, st in models.items():
-            t0 = time.perf_counter()
-            for _ in range(a.steps):
-                st.step()
-            best[name] = min(best[name], (time.perf_counter() - t0) / a.steps)
+    best = best_step_times(models, a.steps, a.repeat)
     n = models["none"].parts[0].el.n
     for name, t in best.items():
         print(json.dumps({"model": name, "elements": n, "ms_per_step": 1e3 * t,

@@ -16,10 +16,10 @@ from __future__ import annotations
 import argparse
 import json
 import re
-import time
 from pathlib import Path
 
 import numba
+from interleaved import best_step_times
 
 from sphdyn.assembly import build_stepper
 from sphdyn.deck import loads_deck
@@ -50,13 +50,7 @@ def main() -> None:
     for st in models.values():
         for _ in range(3):
             st.step()
-    best = {k: float("inf") for k in models}
-    for _ in range(a.repeat):
-        for name, st in models.items():
-            t0 = time.perf_counter()
-            for _ in range(a.steps):
-                st.step()
-            best[name] = min(best[name], (time.perf_counter() - t0) / a.steps)
+    best = best_step_times(models, a.steps, a.repeat)
     out = {}
     for name, st in models.items():
         n = st.part("sph").p.n
