@@ -211,5 +211,5 @@ def test_zero_mass_ratio_and_a_solid_sublayer_are_refused(tmp_path, capsys):
         '"30 mm", "30 mm"], element_length = "10 mm" }\nsection = { shape = "circle", '
         'diameter = "10 mm" }', 'block = { lo = [0, 0, "70 mm"], hi = ["0.1 m", "0.1 m", '
         '"0.12 m"], divisions = [2, 2, 1] }')
-    with pytest.raises(DeckError, match="sublayer couples bars"):
+    with pytest.raises(DeckError, match="couples bars"):
         loads_deck(solid)

@@ -21,6 +21,7 @@ from .deck.errors import format_problem
 from .events import ElementErosion, ErosionRules
 from .interactions import HybridCoupling, PenaltyCoupling, TiedCoupling, Wall
 from .interactions.nodal import MassDamping, NodalLoad, PrescribedMotion
+from .interactions.embedded import EmbeddedNodes
 from .interactions.sublayer import SublayerCoupling
 from .materials import get_model
 from .mesh_model import MeshModel
@@ -149,6 +150,22 @@ def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
                                        stiffness=ero.stiffness, alpha=ero.alpha,
                                        thickness_factor=ero.thickness_factor,
                                        friction=ero.friction))
+    for mm in model.meshes:  # last: they pass on what the bars' nodes were given
+        if mm.spec.embed is None:
+            continue
+        host = next(m for m in model.meshes if m.name == mm.spec.embed)
+        where = f"mesh[{mm.index}] '{mm.name}'.embed"
+        if host.element != "solid":
+            raise DeckError([format_problem(where, f"mesh '{host.name}' is a line of "
+                                            f"{host.element}s, not solid elements",
+                                            "embed the bar in a [mesh.block] or a file "
+                                            "of hex8 / quad4")])
+        try:
+            out.append(EmbeddedNodes(f"{mm.name}_embedded", meshes[mm.name],
+                                     meshes[host.name]))
+        except ValueError as exc:
+            raise DeckError([format_problem(where, str(exc).split(": ", 1)[-1],
+                                            "move the bar into the solid mesh")]) from None
     return out
 
 

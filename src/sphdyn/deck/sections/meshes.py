@@ -278,6 +278,10 @@ class Mesh(Section):
         None, description="A region of elements replaced by SPH particles.")
     erosion: Optional[MeshErosion] = Field(
         None, description="Elements erode during the run ([mesh.erosion]).")
+    embed: Optional[reference_to("mesh")] = Field(
+        None, description="A bar embedded in this solid mesh: each node moves with "
+                          "the element it lies in (perfect bond, LS-DYNA's "
+                          "CONSTRAINED_BEAM_IN_SOLID); line meshes.")
     sublayer: Optional[Sublayer] = Field(
         None, description="A bar inside SPH concrete, coupled by its nodes' particles "
                           "([mesh.sublayer], line meshes).")
@@ -301,15 +305,19 @@ class Mesh(Section):
             if self.erosion is not None:
                 raise problem("only solid elements erode",
                               "remove [mesh.erosion] from the line mesh")
-        elif self.sublayer is not None:
-            raise problem("a sublayer couples bars (a [mesh.line] of beams or trusses)",
-                          "remove [mesh.sublayer], or make the mesh a [mesh.line]")
+        elif self.sublayer is not None or self.embed is not None:
+            raise problem("a sublayer or an embedding couples bars (a [mesh.line] of "
+                          "beams or trusses)", "remove [mesh.sublayer] and embed, or make "
+                          "the mesh a [mesh.line]")
         else:
             extra = [k for k in ("element", "section") if getattr(self, k) is not None]
             if extra:
                 raise problem(f"{', '.join(extra)} belong to a [mesh.line]",
                               f"remove {', '.join(extra)} (solid elements: hex8 in 3D, "
                               "quad4 in 2D)")
+        if self.sublayer is not None and self.embed is not None:
+            raise problem("a bar is either in SPH concrete ([mesh.sublayer]) or in "
+                          "solid elements (embed)", "keep one of them")
         if self.group and self.file is None:
             raise problem("[[mesh.group]] names groups of a mesh file",
                           "remove [[mesh.group]] or read the mesh from a file")
