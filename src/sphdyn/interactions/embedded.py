@@ -14,7 +14,7 @@ element that contains it, at its parametric point :math:`\boldsymbol\xi_s`
   N_a m_s` (lumped);
 * forces: the bar's internal force on the node and what the interactions
   give it go to the element's nodes, :math:`\mathbf F_a = N_a\mathbf F_s`
-  (:func:`~.hybrid_coupling.hybrid_transfer`, as for the hybrid layer's
+  (:func:`~.slaves.forces_to_masters`, as for the hybrid layer's
   particles). :math:`\sum_a N_a = 1`: momentum is conserved exactly.
 
 The bar's volume overlaps the concrete's (perfect bond, no slip): the
@@ -29,7 +29,7 @@ import numpy as np
 from ..geometry.shapes import shape_derivatives, shape_functions
 from ..state import BC_FREE, BC_SLAVE
 from .base import InteractionBase
-from .hybrid_coupling import hybrid_kinematics, hybrid_transfer
+from .slaves import follow_masters, pass_on
 
 #: parametric tolerance of "inside an element" (the bar may end on a face)
 _INSIDE = 1e-9
@@ -106,15 +106,11 @@ class EmbeddedNodes(InteractionBase):
 
     def constrain(self, t: float, dt: float) -> None:
         q, s = self.part.kin, self.solid.nodes
-        hybrid_kinematics(self.rows, self.elem, self.N, self.conn, s.x, s.v, q.x, q.v)
+        follow_masters(self.rows, self.elem, self.N, self.conn, s.x, s.v, q.x, q.v)
 
     def forces(self, t: float, dt: float, a_out: np.ndarray) -> None:
-        q, s = self.part.kin, self.solid.nodes
-        live = a_out is q.a_ext  # else the stepper's restore (see TiedCoupling.forces)
-        a_n, aext_n = (s.a, s.a_ext) if live else (np.zeros_like(s.a), np.zeros_like(s.a))
-        hybrid_transfer(self.rows, self.elem, self.N, self.conn, q.m, q.a,
-                        a_out if live else np.zeros_like(a_out), s.m, a_n, aext_n,
-                        self.force)
+        pass_on(self.part.kin, self.solid.nodes, self.rows, self.elem, self.N, self.conn,
+                a_out, self.force)
 
     def columns(self, t: float) -> dict[str, float]:
         f = self.force.sum(axis=0)

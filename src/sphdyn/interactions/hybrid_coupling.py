@@ -37,7 +37,7 @@ material with the point's volume and mass.
   whole velocity gradient, but only its pairs with SPH particles carry
   forces; the share of the hybrid-hybrid pairs,
   :math:`\Delta t\,\sigma_h:\mathbf L^{hh}_h/\rho_h`
-  (:func:`hybrid_pair_gradient`), is taken off again after the step, so its
+  (:func:`~.slaves.set_pair_gradient`), is taken off again after the step, so its
   internal energy is the work of the interface's pair forces on its side
   (the SPH energy equation's share), with its share of the viscous heat.
 """
@@ -45,132 +45,12 @@ material with the point's volume and mass.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
 
 from ..geometry.shapes import shape_functions
 from ..state import BC_FREE, BC_SLAVE
 from .base import InteractionBase
-
-
-@njit(cache=True, error_model="numpy", parallel=True)
-def hybrid_kinematics(rows, elem, N, conn, xn, vn, xp, vp):
-    r""":math:`\mathbf x_h, \mathbf v_h = \sum_a N_a(\boldsymbol\xi_h)(\mathbf x_a, \mathbf v_a)`.
-
-    ``rows`` (H,) particle rows, ``elem`` (H,) their elements, ``N`` (H, nen)
-    shape functions at their points, ``conn`` (E, nen); ``xn``, ``vn`` (M, 3);
-    ``xp``, ``vp`` (N, 3) (hybrid rows written).
-    """
-    for k in prange(rows.shape[0]):
-        h = rows[k]
-        e = elem[k]
-        for i in range(3):
-            x = 0.0
-            v = 0.0
-            for a in range(conn.shape[1]):
-                x += N[k, a] * xn[conn[e, a], i]
-                v += N[k, a] * vn[conn[e, a], i]
-            xp[h, i] = x
-            vp[h, i] = v
-
-
-@njit(cache=True, error_model="numpy", parallel=True)
-def hybrid_pair_gradient(rows, hybrid, offsets, idx, fac, pos, v, vol, B, Finv, tl, Lhh):
-    r"""The hybrid-hybrid pairs' part of each hybrid particle's velocity gradient.
-
-    Updated-Lagrangian (``tl`` False; the terms of
-    :func:`sphdyn.parts.sph.passes.velocity_gradient` that those pairs gave):
-
-    .. math:: \mathbf L^{hh}_h = \Big[\sum_{j\ \mathrm{hybrid}} V_j\,
-              F_{hj} (\mathbf v_j - \mathbf v_h) \otimes
-              (\mathbf x_h - \mathbf x_j)\Big] B_h^T;
-
-    total-Lagrangian (``tl`` True; the terms of
-    :func:`sphdyn.parts.sph.total_lagrangian.deformation_gradient`, with
-    :math:`\mathbf L = \dot F F^{-1}`): the same sum with the reference
-    positions :math:`\mathbf X`, volumes and factors, times :math:`F_h^{-1}`.
-    Since :math:`\sigma : \mathbf L\, V = P : \dot F\, V_0`,
-    :func:`remove_pair_work` serves both.
-
-    ``fac`` (nnz,) the pair factors of all pairs (UL: before
-    :func:`hybrid_pairs_off`); ``pos``, ``v`` (N, 3) the positions of the
-    sum (current or reference) and velocities; ``vol`` (N,) the volumes the
-    pass used; ``B`` and ``Finv`` (N, 3, 3) (``Finv`` unused in UL);
-    ``Lhh`` (H, 3, 3) out [1/s].
-    """
-    for k in prange(rows.shape[0]):
-        i = rows[k]
-        raw = np.zeros((3, 3))
-        for q in range(offsets[i], offsets[i + 1]):
-            j = idx[q]
-            if not hybrid[j]:
-                continue
-            f = np.float64(fac[q]) * vol[j]
-            for a in range(3):
-                u = v[j, a] - v[i, a]
-                for b in range(3):
-                    raw[a, b] += u * f * (pos[i, b] - pos[j, b])
-        out = np.zeros((3, 3))
-        for a in range(3):
-            for b in range(3):
-                s = 0.0
-                for c in range(3):
-                    s += raw[a, c] * B[i, b, c]
-                out[a, b] = s
-        for a in range(3):
-            for b in range(3):
-                if tl:
-                    Lhh[k, a, b] = (out[a, 0] * Finv[i, 0, b] + out[a, 1] * Finv[i, 1, b]
-                                    + out[a, 2] * Finv[i, 2, b])
-                else:
-                    Lhh[k, a, b] = out[a, b]
-
-
-@njit(cache=True, error_model="numpy")
-def remove_pair_work(rows, sig, rho, Lhh, dt, e):
-    r""":math:`e_h \mathrel{-}= \Delta t\,\sigma_h : \mathbf L^{hh}_h / \rho_h`: the
-    stress work the material update booked for the hybrid-hybrid pairs, which
-    carry no force (their element books it). ``sig`` (N, 3, 3) [Pa]; ``rho``
-    (N,); ``Lhh`` (H, 3, 3) [1/s]; ``e`` (N,) [J/kg] in place."""
-    for k in range(rows.shape[0]):
-        i = rows[k]
-        w = 0.0
-        for a in range(3):
-            for b in range(3):
-                w += sig[i, a, b] * Lhh[k, a, b]
-        e[i] -= dt * w / rho[i]
-
-
-@njit(cache=True, error_model="numpy", parallel=True)
-def hybrid_pairs_off(rows, hybrid, offsets, idx, F):
-    """Zero the pair gradient factor ``F`` (nnz,) of every hybrid-hybrid pair
-    (both directions: every hybrid row is visited); ``hybrid`` (N,) bool."""
-    for k in prange(rows.shape[0]):
-        i = rows[k]
-        for q in range(offsets[i], offsets[i + 1]):
-            if hybrid[idx[q]]:
-                F[q] = 0.0
-
-
-@njit(cache=True, error_model="numpy")
-def hybrid_transfer(rows, elem, N, conn, mp, ap, aext_p, mn, a_n, aext_n, force):
-    r"""Hybrid particles' forces to their elements' nodes, :math:`N_a\mathbf F_h / m_a`:
-    the SPH passes' part :math:`m_h\mathbf a_h` **added** to ``a_n`` (M, 3),
-    the interactions' part :math:`m_h\mathbf a^{ext}_h` to ``aext_n`` (as
-    :func:`~.tied_coupling.tied_transfer`); ``force`` (H, 3) out,
-    :math:`\mathbf F_h` [N]. Serial in particle order (elements share nodes;
-    deterministic)."""
-    for k in range(rows.shape[0]):
-        h = rows[k]
-        e = elem[k]
-        for i in range(3):
-            force[k, i] = mp[h] * (ap[h, i] + aext_p[h, i])
-        for a in range(conn.shape[1]):
-            node = conn[e, a]
-            if mn[node] > 0.0:
-                w = N[k, a] * mp[h] / mn[node]
-                for i in range(3):
-                    a_n[node, i] += w * ap[h, i]
-                    aext_n[node, i] += w * aext_p[h, i]
+from .slaves import (follow_masters, pass_on, remove_pair_work, set_pair_gradient,
+                     set_pairs_off)
 
 
 class HybridCoupling(InteractionBase):
@@ -235,26 +115,22 @@ class HybridCoupling(InteractionBase):
         p = sph.p
         if self.tl:  # the pairs are out of the TL force pass already
             t = sph.tl
-            hybrid_pair_gradient(self.rows, self.hybrid, t.offsets, t.idx, t.fac, t.X, p.v,
+            set_pair_gradient(self.rows, self.hybrid, t.offsets, t.idx, t.fac, t.X, p.v,
                                  t.vol, t.B0, t.Finv, True, self.Lhh)
             return
-        hybrid_pair_gradient(self.rows, self.hybrid, sph.nl.offsets, sph.nl.idx, sph.F,
+        set_pair_gradient(self.rows, self.hybrid, sph.nl.offsets, sph.nl.idx, sph.F,
                              p.x, p.v, p.vol, p.B, p.B, False, self.Lhh)
-        hybrid_pairs_off(self.rows, self.hybrid, sph.nl.offsets, sph.nl.idx, sph.F)
+        set_pairs_off(self.rows, self.hybrid, sph.nl.offsets, sph.nl.idx, sph.F)
 
     def constrain(self, t: float, dt: float) -> None:
         p, q = self.part.p, self.solid.nodes
         self.dt = dt  # the step the material update of this step will take
-        hybrid_kinematics(self.rows, self.elem, self.N, self.conn, q.x, q.v, p.x, p.v)
+        follow_masters(self.rows, self.elem, self.N, self.conn, q.x, q.v, p.x, p.v)
 
     def forces(self, t: float, dt: float, a_out: np.ndarray) -> None:
-        p, q = self.part.p, self.solid.nodes
-        live = a_out is p.a_ext  # else the stepper's restore (see TiedCoupling.forces)
-        a_n, aext_n = (q.a, q.a_ext) if live else (np.zeros_like(q.a), np.zeros_like(q.a))
-        hybrid_transfer(self.rows, self.elem, self.N, self.conn, p.m, p.a,
-                        a_out if live else np.zeros_like(a_out), q.m, a_n, aext_n,
-                        self.force)
-        if live:
+        p = self.part.p
+        if pass_on(p, self.solid.nodes, self.rows, self.elem, self.N, self.conn, a_out,
+                   self.force):
             remove_pair_work(self.rows, p.sig, p.rho, self.Lhh, self.dt, p.e)
 
     def columns(self, t: float) -> dict[str, float]:

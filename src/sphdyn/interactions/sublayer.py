@@ -25,7 +25,7 @@ add a second, SPH bar in parallel (stiffer, with a stress of several GPa in
 the pull-out test) that is prone to the tensile instability in tension (a
 free bar sliding in a block blew up with them). After the velocity gradient
 their share of it is taken off the particles' ``L`` and their pair factors
-are zeroed (the hybrid layer's pair functions, :mod:`.hybrid_coupling`), so
+are zeroed (the shared pair functions of :mod:`.slaves`), so
 a bar particle's strain rate comes from the concrete around it only.
 
 The particles take the density of the concrete around them (and a nominal
@@ -49,7 +49,7 @@ import numpy as np
 
 from ..state import BC_FREE, BC_SLAVE
 from .base import InteractionBase
-from .hybrid_coupling import hybrid_pair_gradient, hybrid_pairs_off
+from .slaves import follow_masters, pass_on, set_pair_gradient, set_pairs_off
 
 
 def sublayer_masses(x, conn, area, density, ratio):
@@ -99,7 +99,10 @@ class SublayerCoupling(InteractionBase):
         p.bc[rows] = BC_SLAVE
         self.force = np.zeros((rows.size, 3))
         self.L_own = np.zeros((rows.size, 3, 3))  # the bar's own pairs' share of L
-        self.dt = 0.0
+        # a one-node "element" per particle: the shared slave kernels with N = 1
+        self.master = np.ascontiguousarray(nodes[:, None])
+        self.one = np.ones((rows.size, 1))
+        self.order = np.arange(rows.size, dtype=np.int64)
         self._mask(0, p.n)
         p.on_grow(self._mask)
         sph_part.pair_filters.append(self._pairs_off)
@@ -113,26 +116,18 @@ class SublayerCoupling(InteractionBase):
         """The SPH part's hook after its pair factors: the share of the bar's own
         pairs in the velocity gradient kept aside, then those pairs out."""
         sph, p = self.part, self.part.p
-        hybrid_pair_gradient(self.rows, self.own, sph.nl.offsets, sph.nl.idx, sph.F, p.x,
+        set_pair_gradient(self.rows, self.own, sph.nl.offsets, sph.nl.idx, sph.F, p.x,
                              p.v, p.vol, p.B, p.B, False, self.L_own)
         p.L[self.rows] -= self.L_own
-        hybrid_pairs_off(self.rows, self.own, sph.nl.offsets, sph.nl.idx, sph.F)
+        set_pairs_off(self.rows, self.own, sph.nl.offsets, sph.nl.idx, sph.F)
 
     def constrain(self, t: float, dt: float) -> None:
         p, q = self.part.p, self.line.kin
-        self.dt = dt  # the step the material update of this step will take
-        p.x[self.rows] = q.x[self.nodes]
-        p.v[self.rows] = q.v[self.nodes]
+        follow_masters(self.rows, self.order, self.one, self.master, q.x, q.v, p.x, p.v)
 
     def forces(self, t: float, dt: float, a_out: np.ndarray) -> None:
-        p, q = self.part.p, self.line.kin
-        live = a_out is p.a_ext  # a scratch array: the stepper's restore refreshes columns
-        m = p.m[self.rows, None]
-        a_int, a_ext = p.a[self.rows], a_out[self.rows]
-        self.force = m * (a_int + a_ext)
-        if live:  # one particle per node: no two rows write one node
-            q.a[self.nodes] += m * a_int / q.m[self.nodes, None]
-            q.a_ext[self.nodes] += m * a_ext / q.m[self.nodes, None]
+        pass_on(self.part.p, self.line.kin, self.rows, self.order, self.one, self.master,
+                a_out, self.force)
 
     def columns(self, t: float) -> dict[str, float]:
         f = self.force.sum(axis=0)
