@@ -163,8 +163,10 @@ class ElementErosion:
         for code in np.unique(self.flags[new]):
             self.count[REASONS[int(code)]] += int(np.sum(self.flags[new] == code))
         dt_half = 0.5 * stepper.dt_prev  # the coming half kick
-        born = self._particles(new, dt_half) if self.to == "particles" else None
-        m, kinetic, internal = s.erode(new, dt_half)
+        m, kinetic, internal = s.element_books(new, dt_half)
+        born = (self._particles(new, dt_half, kinetic, internal) if self.to == "particles"
+                else None)
+        s.erode(new)
         self.eroded += new.size
         if born is None:
             self.mass_removed += float(m.sum())
@@ -175,26 +177,28 @@ class ElementErosion:
         if born is not None:
             self._add(born)
 
-    def _particles(self, new: np.ndarray, dt_half: float):
-        """The particles of the elements ``new`` (k,), read before they erode."""
+    def _particles(self, new: np.ndarray, dt_half: float, kinetic: np.ndarray,
+                   internal: np.ndarray):
+        """The particles of the elements ``new`` (k,), read before they erode;
+        ``kinetic`` and ``internal`` (k,) their books
+        (:meth:`~sphdyn.parts.fem.SolidPart.element_books`)."""
         s, el, pts, q = self.solid, self.solid.el, self.solid.pts, self.solid.nodes
         k, npp, dim = new.size, self.N.shape[0], s.dim
         conn = el.conn[new]
         at = lambda a: np.einsum("on,knd->kod", self.N, a[conn]).reshape(-1, 3)  # noqa: E731
         x, v, acc, acc_ext = at(q.x), at(q.v), at(q.a), at(q.a_ext)
         m_el = el.m[new]
-        # kinetic energies after the coming half kick (the stepper's book)
-        ve = q.v[conn] + dt_half * q.a[conn]
+        # kinetic energy after the coming half kick (the stepper's book)
         vp = (v + dt_half * acc).reshape(k, npp, 3)
-        ke_nodes = 0.5 * (m_el / el.nen) * np.sum(ve * ve, axis=(1, 2))
         ke_parts = 0.5 * (m_el / npp) * np.sum(vp * vp, axis=(1, 2))
-        relative = np.maximum(ke_nodes - ke_parts, 0.0)
+        relative = np.maximum(kinetic - ke_parts, 0.0)
         self.energy_to_heat += float(relative.sum())
         ip = s.element_points(new)  # (k, ngp)
         mean = lambda a: a[ip].mean(axis=1)  # noqa: E731
-        e_el = (np.sum(pts.m[ip] * pts.e[ip], axis=1) + el.e_hg[new] + relative) / m_el
+        e_el = (internal + relative) / m_el
         rep = lambda a: np.repeat(a, npp, axis=0)  # noqa: E731
-        return dict(x=x, v=v, a=acc, a_ext=acc_ext, m=rep(m_el / npp), rho=rep(m_el / el.vol[new]),
+        return dict(x=x, v=v, a=acc, a_ext=acc_ext, m=rep(m_el / npp),
+                    rho=rep(m_el / el.vol[new]),
                     rho0=rep(mean(pts.rho0)), size=rep((el.vol[new] / npp) ** (1.0 / dim)),
                     e=rep(e_el), e_av=rep(mean(pts.e_av)), sig=rep(mean(pts.sig)),
                     damage=rep(mean(pts.damage)), hist=rep(mean(pts.hist)),

@@ -246,47 +246,49 @@ class SolidPart:
         """Point indices (k, ngp) of ``elements`` (k,)."""
         return elements[:, None] * self.ngp + np.arange(self.ngp)[None, :]
 
-    def erode(self, elements: np.ndarray,
-              dt_half: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        r"""Take ``elements`` (k,) out of the part; returns what they carried.
+    def element_books(self, elements: np.ndarray,
+                      dt_half: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        r"""What ``elements`` (k,) carry: masses (k,) [kg]; the kinetic energy of
+        their node shares (k,), :math:`\sum_I \tfrac12 (m_e/n_{en})
+        |\mathbf v_I + \Delta t_{1/2}\mathbf a_I|^2` [J] (``dt_half``: the
+        coming half kick, so at the time the stepper books its kinetic
+        energy); their internal energy (k,) [J], the points' work ``m e`` plus
+        the hourglass work."""
+        el, q, p = self.el, self.nodes, self.pts
+        m = el.m[elements].copy()
+        conn = el.conn[elements]
+        ve = q.v[conn] + dt_half * q.a[conn]  # (k, nen, 3)
+        kinetic = 0.5 * (m / el.nen) * np.sum(ve * ve, axis=(1, 2))
+        pts = self.element_points(elements)
+        internal = np.sum(p.m[pts] * p.e[pts], axis=1) + el.e_hg[elements]
+        return m, kinetic, internal
+
+    def erode(self, elements: np.ndarray) -> None:
+        """Take ``elements`` (k,) out of the part (read :meth:`element_books` first).
 
         Each element's mass leaves its nodes (the lumped share ``m_e / nen``
         each; their accelerations of this step are kept); nodes left with no
-        active element get zero mass, zero velocity and ``BC_FIXED``. The element's internal energy (its points' work
-        ``m e`` plus its hourglass work) leaves the part's books: the points'
-        masses and the hourglass work are zeroed, their rates too (the
-        material update then leaves their stress alone).
-
-        Returns
-        -------
-        m : (k,) element masses [kg]; kinetic : (k,) kinetic energy of their
-        node shares, :math:`\sum_I \tfrac12 (m_e/n_{en}) |\mathbf v_I|^2` [J],
-        at :math:`\mathbf v + \Delta t_{1/2}\,\mathbf a` (``dt_half``: the
-        coming half kick, so at the time the stepper books its kinetic energy);
-        internal : (k,) internal energy [J].
+        active element get zero mass, zero velocity and ``BC_FIXED``. The
+        element's internal energy leaves the part's books: the points' masses
+        and the hourglass work are zeroed, their rates too (the material update
+        then leaves their stress alone).
         """
         el, q, p = self.el, self.nodes, self.pts
         elements = np.asarray(elements, dtype=np.int64)
         pts = self.element_points(elements)
         nen = el.nen
-        m = el.m[elements].copy()
-        ve = q.v[el.conn[elements]] + dt_half * q.a[el.conn[elements]]  # (k, nen, 3)
-        kinetic = 0.5 * (m / nen) * np.sum(ve * ve, axis=(1, 2))
-        internal = np.sum(p.m[pts] * p.e[pts], axis=1) + el.e_hg[elements]
         el.active[elements] = 0
         el.dt_el[elements] = np.inf
         el.e_hg[elements] = 0.0
         p.m[pts] = 0.0
         p.L[pts] = 0.0
-        np.subtract.at(q.m, el.conn[elements].ravel(), np.repeat(m / nen, nen))
-        alive = np.bincount(el.conn[el.active == 1].ravel(), minlength=q.n) > 0
-        orphan = ~alive
+        np.subtract.at(q.m, el.conn[elements].ravel(), np.repeat(el.m[elements] / nen, nen))
+        orphan = np.bincount(el.conn[el.active == 1].ravel(), minlength=q.n) == 0
         q.m[orphan] = 0.0  # exactly: the subtraction leaves round-off
         q.v[orphan] = 0.0
         q.a[orphan] = 0.0
         q.a_ext[orphan] = 0.0
         q.bc[orphan] = BC_FIXED
-        return m, kinetic, internal
 
     # ------------------------------------------------------------- fields
     def element_stress(self) -> np.ndarray:
