@@ -143,12 +143,13 @@ def test_each_rule_flags_what_it_should():
     table[3, 3] = 1e-6  # element 3: minimum step 1 us
     flags = np.zeros(4, np.int8)
     n = erosion_flags(xs, cells, solid.el.active, ev.b0, 3, damage, 1, dt_el, 0.9, table,
-                      flags)
+                      flags, ev.work)
     assert flags.tolist() == [BY_PRINCIPAL, BY_DAMAGE, 0, BY_TIME_STEP]
     assert n == 3
     # the effective-strain rule alone: the 20 % element (eff = 2/3 ln 1.2 = 0.122)
     table = np.tile(ErosionRules(effective_strain=0.1).row(), (4, 1))
-    erosion_flags(xs, cells, solid.el.active, ev.b0, 3, damage, 1, dt_el, 0.9, table, flags)
+    erosion_flags(xs, cells, solid.el.active, ev.b0, 3, damage, 1, dt_el, 0.9, table, flags,
+                  ev.work)
     assert flags.tolist() == [BY_EFFECTIVE, 0, 0, 0]
 
 

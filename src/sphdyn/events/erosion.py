@@ -52,7 +52,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry.shapes import corner_signs, shape_functions
-from ..parts.fem.erosion_criteria import (REASONS, erosion_flags, reference_gradients)
+from ..parts.fem.erosion_criteria import REASONS, erosion_flags, reference_gradients
+from ..parts.fem.solid import block_scratch
 from ..state import BC_FREE
 
 TARGETS = ("particles", "nothing")
@@ -142,6 +143,7 @@ class ElementErosion:
         self.b0 = np.zeros((el.n, el.nen, 3))
         reference_gradients(solid.nodes.x0, el.conn, dim, solid.tab, self.b0)
         self.flags = np.zeros(el.n, dtype=np.int8)
+        self.work = block_scratch(el.n, 1, 0)  # a 3 x 3 slab per block (F)
         self.count = {reason: 0 for reason in REASONS.values()}
         self.eroded = 0
         self.born = 0
@@ -156,7 +158,7 @@ class ElementErosion:
     def apply(self, stepper) -> None:
         s, el, pts = self.solid, self.solid.el, self.solid.pts
         n = erosion_flags(s.nodes.x, el.conn, el.active, self.b0, s.dim, pts.damage, s.ngp,
-                          el.dt_el, s.s.cfl, self.rules, self.flags)
+                          el.dt_el, s.s.cfl, self.rules, self.flags, self.work)
         if n == 0:
             return
         new = np.flatnonzero(self.flags).astype(np.int64)

@@ -34,7 +34,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from .solid import ELEMENT_BLOCK, local_coordinates, volume_gradient
+from .solid import block_count, block_span, local_coordinates, volume_gradient
 
 BY_DAMAGE = 1
 BY_PRINCIPAL = 2
@@ -81,14 +81,13 @@ def sym3_eigenvalues(a00, a01, a02, a11, a12, a22):
 def strain_measures(F):
     r"""Maximum principal (engineering) strain and effective (logarithmic)
     strain of a deformation gradient ``F`` (3, 3) (module docstring)."""
-    c = np.zeros((3, 3))
-    for i in range(3):
-        for j in range(3):
-            s = 0.0
-            for k in range(3):
-                s += F[k, i] * F[k, j]
-            c[i, j] = s
-    l1, l2, l3 = sym3_eigenvalues(c[0, 0], c[0, 1], c[0, 2], c[1, 1], c[1, 2], c[2, 2])
+    c00 = F[0, 0] * F[0, 0] + F[1, 0] * F[1, 0] + F[2, 0] * F[2, 0]  # C = F^T F
+    c01 = F[0, 0] * F[0, 1] + F[1, 0] * F[1, 1] + F[2, 0] * F[2, 1]
+    c02 = F[0, 0] * F[0, 2] + F[1, 0] * F[1, 2] + F[2, 0] * F[2, 2]
+    c11 = F[0, 1] * F[0, 1] + F[1, 1] * F[1, 1] + F[2, 1] * F[2, 1]
+    c12 = F[0, 1] * F[0, 2] + F[1, 1] * F[1, 2] + F[2, 1] * F[2, 2]
+    c22 = F[0, 2] * F[0, 2] + F[1, 2] * F[1, 2] + F[2, 2] * F[2, 2]
+    l1, l2, l3 = sym3_eigenvalues(c00, c01, c02, c11, c12, c22)
     tiny = 1e-300
     e1 = 0.5 * math.log(max(l1, tiny))
     e2 = 0.5 * math.log(max(l2, tiny))
@@ -128,7 +127,7 @@ def deformation_gradient(x, conn, e, b0, dim, F):
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def erosion_flags(x, conn, active, b0, dim, damage, ngp, dt_el, cfl, rules, flags):
+def erosion_flags(x, conn, active, b0, dim, damage, ngp, dt_el, cfl, rules, flags, work):
     r"""Which active elements erode, and why (module docstring).
 
     ``damage`` (P,) point damage (``ngp`` points per element, the mean is
@@ -136,13 +135,15 @@ def erosion_flags(x, conn, active, b0, dim, damage, ngp, dt_el, cfl, rules, flag
     step); ``rules`` (E, 4) per element: ERODE - 1 of the damage rule, the
     principal-strain limit, the effective-strain limit (``inf`` where off)
     and the minimum step (0 where off). ``flags`` (E,) int8 out: 0, or the
-    code of the first rule that holds. Returns the number flagged.
+    code of the first rule that holds; ``work`` (B, >= 3, 3) scratch per block
+    (the part's :func:`~.solid.block_scratch`). Returns the number flagged.
     """
     ne = conn.shape[0]
     count = 0
-    for b in prange((ne + ELEMENT_BLOCK - 1) // ELEMENT_BLOCK):
-        F = np.zeros((3, 3))
-        for e in range(b * ELEMENT_BLOCK, min(ne, (b + 1) * ELEMENT_BLOCK)):
+    for b in prange(block_count(ne)):
+        F = work[b, 0:3]
+        lo, hi = block_span(b, ne)
+        for e in range(lo, hi):
             flags[e] = 0
             if active[e] == 0:
                 continue

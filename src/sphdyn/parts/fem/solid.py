@@ -161,6 +161,28 @@ ELEMENT_BLOCK = 256
 
 
 @njit(cache=True, error_model="numpy")
+def block_count(n):
+    """Blocks of :data:`ELEMENT_BLOCK` elements that cover ``n`` elements."""
+    return (n + ELEMENT_BLOCK - 1) // ELEMENT_BLOCK
+
+
+@njit(cache=True, error_model="numpy")
+def block_span(b, n):
+    """The elements ``lo:hi`` of block ``b`` (of ``n`` elements)."""
+    lo = b * ELEMENT_BLOCK
+    return lo, min(n, lo + ELEMENT_BLOCK)
+
+
+def block_scratch(n: int, nen: int, modes: int) -> np.ndarray:
+    """Scratch (B, 3 nen + modes + 3, 3) of the one-point passes, one slab per
+    block of :func:`block_count` (``n`` elements), made once by the part so that
+    a step allocates nothing: node coordinates, velocities and volume
+    derivatives (nen rows each), hourglass forces (``modes`` rows), their
+    share M (3 rows)."""
+    return np.empty((block_count(n), 3 * nen + modes + 3, 3))
+
+
+@njit(cache=True, error_model="numpy")
 def element_step(ell, c, dkk, q1, q2):
     r"""Stable step :math:`\ell/(Q + \sqrt{Q^2 + c^2})` of one element [s] with
     :math:`Q = Q_2 c + Q_1\ell|\dot\varepsilon_{kk}|` in compression (module
@@ -170,17 +192,19 @@ def element_step(ell, c, dkk, q1, q2):
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def element_volumes(x, conn, active, dim, tab, c, L, ngp, q1, q2, vol, dt_el):
+def element_volumes(x, conn, active, dim, tab, c, L, ngp, q1, q2, vol, dt_el, work):
     r"""Volumes ``vol`` (E,) [m^3] at ``x`` and the element steps ``dt_el`` (E,) [s]
     of :func:`element_step` (the element's largest point wave speed ``c``
     (P,), its first point's rate ``L`` (P, 3, 3)); the state a part needs
-    before its first force pass or after a restart."""
+    before its first force pass or after a restart. ``work``:
+    :func:`block_scratch`."""
     ne = conn.shape[0]
     nen = conn.shape[1]
-    for b in prange((ne + ELEMENT_BLOCK - 1) // ELEMENT_BLOCK):
-        xl = np.empty((nen, 3))
-        g = np.empty((nen, 3))
-        for e in range(b * ELEMENT_BLOCK, min(ne, (b + 1) * ELEMENT_BLOCK)):
+    for b in prange(block_count(ne)):
+        xl = work[b, 0:nen]
+        g = work[b, 2 * nen:3 * nen]
+        lo, hi = block_span(b, ne)
+        for e in range(lo, hi):
             local_coordinates(x, x, 0.0, conn, e, xl)
             vol[e] = volume_gradient(xl, dim, tab, g)
             ce = 0.0
@@ -193,7 +217,7 @@ def element_volumes(x, conn, active, dim, tab, c, L, ngp, q1, q2, vol, dt_el):
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def uniform_strain_rate(x, v, conn, active, m_el, dt, dim, tab, L, rho):
+def uniform_strain_rate(x, v, conn, active, m_el, dt, dim, tab, L, rho, work):
     r"""Velocity gradient and density of one-point elements (mid-step geometry).
 
     For each active element: :math:`L = \sum_I \mathbf v_I \otimes \mathbf b_I`
@@ -202,15 +226,17 @@ def uniform_strain_rate(x, v, conn, active, m_el, dt, dim, tab, L, rho):
     V/\partial x / V`), so the material's energy increment :math:`\Delta
     t\,\bar\sigma:D / \rho` is the stress power of the mid-step volume (with
     the volume at :math:`n+1` the energy balance would err at first order in
-    dt). ``L`` (E, 3, 3) out [1/s] (zz = 0 in 2D).
+    dt). ``L`` (E, 3, 3) out [1/s] (zz = 0 in 2D); ``work``:
+    :func:`block_scratch`.
     """
     ne = conn.shape[0]
     nen = conn.shape[1]
-    for b in prange((ne + ELEMENT_BLOCK - 1) // ELEMENT_BLOCK):
-        xl = np.empty((nen, 3))
-        vl = np.empty((nen, 3))
-        g = np.empty((nen, 3))
-        for e in range(b * ELEMENT_BLOCK, min(ne, (b + 1) * ELEMENT_BLOCK)):
+    for b in prange(block_count(ne)):
+        xl = work[b, 0:nen]
+        vl = work[b, nen:2 * nen]
+        g = work[b, 2 * nen:3 * nen]
+        lo, hi = block_span(b, ne)
+        for e in range(lo, hi):
             if active[e] == 0:
                 continue
             element_nodes(x, v, 0.5 * dt, conn, e, xl, vl)
@@ -313,7 +339,7 @@ def hourglass_resultants(e, vl, xl, g, V, gam, hg_form, coef, hg, dt, dim, Q, M)
 
 @njit(cache=True, error_model="numpy", parallel=True)
 def uniform_forces(x, v, conn, active, sig, L, rho, c, e_spec, e_av, dim, tab, gam,
-                   hg_form, qh, hg, e_hg, q1, q2, dt, vol, dt_el, fe):
+                   hg_form, qh, hg, e_hg, q1, q2, dt, vol, dt_el, fe, work):
     r"""Nodal forces (E, nen, 3) of one-point elements: stress, bulk viscosity, hourglass.
 
     The geometry at :math:`n+1` (``x`` (N, 3)) is computed here, element by
@@ -325,19 +351,21 @@ def uniform_forces(x, v, conn, active, sig, L, rho, c, e_spec, e_av, dim, tab, g
     :data:`HG_STIFFNESS`, ``qh`` its coefficient; ``hg`` (E, 4, 3)
     stiffness-form generalised forces [N] (updated); ``e_hg`` (E,) hourglass
     work [J] (updated); bulk viscosity ``q1`` (quadratic), ``q2`` (linear),
-    whose heat goes to ``e_spec`` and ``e_av`` (E,) [J/kg]. Equations: module
-    docstring and :func:`hourglass_resultants`.
+    whose heat goes to ``e_spec`` and ``e_av`` (E,) [J/kg]; ``work``:
+    :func:`block_scratch`. Equations: module docstring and
+    :func:`hourglass_resultants`.
     """
     ne = conn.shape[0]
     nen = conn.shape[1]
     nm = gam.shape[0]
-    for b in prange((ne + ELEMENT_BLOCK - 1) // ELEMENT_BLOCK):
-        xl = np.empty((nen, 3))
-        vl = np.empty((nen, 3))
-        g = np.empty((nen, 3))
-        Q = np.zeros((nm, 3))
-        M = np.zeros((3, 3))
-        for e in range(b * ELEMENT_BLOCK, min(ne, (b + 1) * ELEMENT_BLOCK)):
+    for b in prange(block_count(ne)):
+        xl = work[b, 0:nen]
+        vl = work[b, nen:2 * nen]
+        g = work[b, 2 * nen:3 * nen]
+        Q = work[b, 3 * nen:3 * nen + nm]
+        M = work[b, 3 * nen + nm:3 * nen + nm + 3]
+        lo, hi = block_span(b, ne)
+        for e in range(lo, hi):
             if active[e] == 0:
                 for I in range(nen):
                     for k in range(3):

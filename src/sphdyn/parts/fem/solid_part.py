@@ -29,8 +29,9 @@ from ...fields import von_mises
 from ...state import BC_FIXED, STATE, Elements, MaterialPoints, Nodes
 from ..base import register_part
 from .gather import gather_loads, node_element_list
-from .solid import (DT_BLOCKS, HG_STIFFNESS, HG_VISCOUS, element_volumes, min_time_step,
-                    reduced_forces, reduced_strain_rate, uniform_forces, uniform_strain_rate)
+from .solid import (DT_BLOCKS, HG_STIFFNESS, HG_VISCOUS, block_scratch, element_volumes,
+                    min_time_step, reduced_forces, reduced_strain_rate, uniform_forces,
+                    uniform_strain_rate)
 
 INTEGRATIONS = ("one_point", "selective_reduced")
 HOURGLASS_FORMS = {"viscous": HG_VISCOUS, "stiffness": HG_STIFFNESS}
@@ -99,6 +100,7 @@ class SolidPart:
         self.hg_form = HOURGLASS_FORMS[settings.hourglass]
         self._dt_t = np.empty(DT_BLOCKS)  # scratch of the parallel stable step
         self._dt_k = np.empty(DT_BLOCKS, dtype=np.int64)
+        self.work = block_scratch(elements.n, elements.nen, self.gam.shape[0])
         nen = elements.nen
         elements.add("fe", (nen, 3))  # element nodal forces, gathered into the nodes
         elements.add("dt_el", ())  # element steps of the last force pass [s]
@@ -172,13 +174,13 @@ class SolidPart:
                                 self.dN, el.xl, el.g, p.Bg, p.wg, p.L, p.rho, el.vol)
         else:
             uniform_strain_rate(q.x, q.v, el.conn, el.active, el.m, dt, self.dim, self.tab,
-                                p.L, p.rho)
+                                p.L, p.rho, self.work)
 
     def _element_geometry(self) -> None:
         """Volumes and element steps at the current positions (no forces)."""
         q, el, p, s = self.nodes, self.el, self.pts, self.s
         element_volumes(q.x, el.conn, el.active, self.dim, self.tab, p.c, p.L, self.ngp,
-                        s.q1, s.q2, el.vol, el.dt_el)
+                        s.q1, s.q2, el.vol, el.dt_el, self.work)
 
     def _forces(self, dt: float) -> None:
         """Element nodal forces (and element steps) gathered into the nodes'
@@ -191,7 +193,7 @@ class SolidPart:
             uniform_forces(q.x, q.v, el.conn, el.active, p.sig, p.L, p.rho, p.c, p.e,
                            p.e_av, self.dim, self.tab, self.gam, self.hg_form,
                            s.hourglass_coefficient, el.hg, el.e_hg, s.q1, s.q2, dt, el.vol,
-                           el.dt_el, el.fe)
+                           el.dt_el, el.fe, self.work)
         gather_loads(el.fe, 0, self.offsets, self.slots, q.m, q.a)
 
     # ----------------------------------------------------------- protocol
