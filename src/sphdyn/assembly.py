@@ -72,6 +72,6 @@ def build_stepper(deck, model: Model | None = None, events=(), monitors=()) -> S
     meshes = {mm.name: mesh_part(deck, mm) for mm in model.meshes}
     parts += meshes.values()
     interactions += mesh_interactions(deck, model, part, meshes)
-    events = list(events) + erosion_events(deck, model, part, meshes, interactions)
+    events = list(events) + erosion_events(deck, model, part, meshes)
     dt_max = deck.time.dt_max if deck.time.dt_max is not None else np.inf
     return Stepper(parts, interactions, events, monitors, dt_max=dt_max)

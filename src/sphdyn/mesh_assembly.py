@@ -169,7 +169,7 @@ def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
     return out
 
 
-def erosion_events(deck, model, sph_part, meshes: dict, interactions) -> list:
+def erosion_events(deck, model, sph_part, meshes: dict) -> list:
     """The :class:`~sphdyn.events.ElementErosion` of every mesh with [mesh.erosion],
     with its materials' [material.erosion] rules."""
     out = []

@@ -270,7 +270,7 @@ def build_model(deck) -> Model:
         groups.append(MaterialGroup(m.name, models[m.name], params[m.name],
                                     np.zeros(0, np.int64), k))
 
-    _check_sublayers(deck, meshes, particles, body_names)
+    _seat_sublayers(deck, meshes, particles, body_names)
     for g in groups:
         if not g.idx.size:  # a debris group, filled during the run
             continue
@@ -355,8 +355,8 @@ def _extra_name(mm: MeshModel, taken: list[str], what: str) -> str:
 def _sublayer_particles(deck, mm: MeshModel, b: int, n_hist: int) -> Particles:
     """One particle per node of a bar (:mod:`sphdyn.interactions.sublayer`): its
     share ``mass_ratio`` of the bar's lumped mass, the bar's material (its
-    density is the concrete's, set by :func:`_check_sublayers`), h =
-    sph.h_factor times the mean element length, body ``b``."""
+    density and volume are the concrete's, set by :func:`_seat_sublayers`),
+    h = sph.h_factor times the mean element length, body ``b``."""
     from .mesh_assembly import section_of
     from .interactions.sublayer import sublayer_masses
 
@@ -370,9 +370,6 @@ def _sublayer_particles(deck, mm: MeshModel, b: int, n_hist: int) -> Particles:
     p.x0[:] = x
     p.v[:] = np.asarray(mm.spec.velocity, dtype=float)
     p.m[:] = m
-    p.rho[:] = mat.density
-    p.rho0[:] = mat.density
-    p.vol0[:] = m / mat.density
     p.mat[:] = int(mm.mat[0])
     p.h[:] = deck.sph.h_factor * length
     p.h0[:] = p.h
@@ -380,11 +377,12 @@ def _sublayer_particles(deck, mm: MeshModel, b: int, n_hist: int) -> Particles:
     return p
 
 
-def _check_sublayers(deck, meshes, particles: Particles, body_names: list[str]) -> None:
-    """A bar must meet the concrete: at least one of its nodes needs a particle
-    of the [mesh.sublayer] body (or of any deck body) within its support
-    radius (nodes of a bar that sticks out, as in a pull-out test, need not).
-    The bar's particles take the density of the concrete around them."""
+def _seat_sublayers(deck, meshes, particles: Particles, body_names: list[str]) -> None:
+    """Seat every bar in its concrete: its particles take the density of the
+    concrete around them (and the volume m / rho). A bar must meet the
+    concrete: at least one of its nodes needs a particle of the
+    [mesh.sublayer] body (or of any deck body) within its support radius
+    (nodes of a bar that sticks out, as in a pull-out test, need not)."""
     from scipy.spatial import cKDTree
 
     from .kernels import kernel_id, support
@@ -399,15 +397,10 @@ def _check_sublayers(deck, meshes, particles: Particles, body_names: list[str]) 
         where = f"mesh[{mm.index}] '{mm.name}'.line"
         radius = (support(kernel_id(deck.sph.kernel)) * deck.sph.support_scale
                   * particles.h[rows])
-        dist = (cKDTree(particles.x[host]).query(particles.x[rows])[0] if host.size
-                else np.full(rows.size, np.inf))
-        if host.size:  # the host's density: the energy identity of SPH needs
-            # neighbours of alike density (docs/theory.md, "Sublayer coupling")
-            near = cKDTree(particles.x[host]).query(particles.x[rows])[1]
-            rho = float(np.mean(particles.rho0[host[near]]))
-            particles.rho[rows] = rho
-            particles.rho0[rows] = rho
-            particles.vol0[rows] = particles.m[rows] / rho
+        if host.size:
+            dist, near = cKDTree(particles.x[host]).query(particles.x[rows])
+        else:
+            dist = np.full(rows.size, np.inf)
         if not np.any(dist <= radius):
             at = ", ".join(f"{c:.4g}" for c in particles.x[rows[0]])
             raise DeckError([format_problem(
@@ -417,6 +410,12 @@ def _check_sublayers(deck, meshes, particles: Particles, body_names: list[str]) 
                 f"support ({radius.max():.4g} m)",
                 "move the bar into the concrete body (or name the body it is in: "
                 "[mesh.sublayer] body)")])
+        # the concrete's density: the energy identity of SPH needs neighbours
+        # of alike density (docs/theory.md, "Sublayer coupling of rebar")
+        rho = float(np.mean(particles.rho0[host[near]]))
+        particles.rho[rows] = rho
+        particles.rho0[rows] = rho
+        particles.vol0[rows] = particles.m[rows] / rho
 
 
 def _converted_name(mm: MeshModel, taken: list[str]) -> str:
