@@ -5,6 +5,7 @@ the master surface that follows erosion, and restart across a conversion."""
 from __future__ import annotations
 
 import copy
+import itertools
 import math
 
 import numpy as np
@@ -377,3 +378,59 @@ def test_a_particle_born_inside_the_contact_thickness_keeps_that_penetration_fre
     assert accel(0.013) == 0.0  # 2 mm deep: the allowance is now 2 mm
     assert accel(0.0125) == pytest.approx(0.1 * 0.0005 / dt ** 2, rel=1e-9)
     assert cp.pen0[0] == pytest.approx(0.002, rel=1e-12)
+
+
+def test_penalty_ties_follow_their_faces_through_erosion():
+    """Penalty ties (tie_factor > 0) keep their face when other elements erode
+    (same face nodes after the faces are renumbered) and end when their own
+    element erodes."""
+    x, cells = block([0, 0, 0], [0.02, 0.02, 0.01], (2, 2, 1), 3)
+    mat = material(**CONCRETE)
+    solid = part(x, cells, 3, mat=mat)
+    sph = empty_sph(3, mat)
+    p = sph.p
+    rows = p.grow(2, notify=False)
+    p.x[rows] = [[0.005, 0.005, 0.015], [0.015, 0.015, 0.015]]  # over two top faces
+    p.m[rows], p.vol0[rows], p.rho0[rows], p.rho[rows] = 2.4e-3, 1e-6, RHO, RHO
+    p.h[rows] = p.h0[rows] = 0.012
+    p.notify_grown(rows.start, rows.stop)
+    cp = PenaltyCoupling("c", sph, solid, tie_factor=1.0)
+    assert cp.tied.size == 2
+    centres = x[cells].mean(axis=1)
+    under = [int(np.argmin(np.linalg.norm(centres[:, :2] - p.x[i, :2], axis=1)))
+             for i in range(2)]
+    other = next(e for e in range(4) if e not in under)
+    nodes = [set(cp.faces[f].tolist()) for f in cp.tie_face]
+    solid.erode(np.array([other]))
+    cp.mesh_changed()
+    assert cp.tied.size == 2
+    assert [set(cp.faces[f].tolist()) for f in cp.tie_face] == nodes
+    solid.erode(np.array([under[0]]))
+    cp.mesh_changed()
+    assert cp.tied.tolist() == [1]
+    assert set(cp.faces[cp.tie_face[0]].tolist()) == nodes[1]
+
+
+def test_particles_of_an_element_sit_at_its_octants_with_its_mass():
+    """One cube of side a turned into 8 particles: at the octants' centres
+    (a/4, 3a/4 per axis), each with m_e / 8, density m_e / V, nominal volume
+    m / rho_0 and h = h_factor (V / 8)^(1/3) (1e-12)."""
+    a = 0.02
+    x, cells = block([0, 0, 0], [a, a, a], (1, 1, 1), 3)
+    mat = material(**CONCRETE)
+    solid = part(x, cells, 3, mat=mat)
+    sph = empty_sph(3, mat)
+    st = Stepper([solid, sph])
+    ev = ElementErosion("e", solid, {0: ErosionRules(min_time_step=1.0)}, sph=sph,
+                        per_element=8, h_factor=1.2)
+    ev.rules[:, 3] = np.inf
+    ev.apply(st)
+    p = sph.p
+    assert p.n == 8
+    want = np.array(sorted(itertools.product([a / 4, 3 * a / 4], repeat=3)))
+    assert np.allclose(np.array(sorted(map(tuple, p.x))), want, rtol=0, atol=1e-15)
+    m_e = RHO * a ** 3
+    assert np.allclose(p.m, m_e / 8, rtol=1e-12)
+    assert np.allclose(p.rho, m_e / a ** 3, rtol=1e-12)
+    assert np.allclose(p.vol0, p.m / RHO, rtol=1e-12)
+    assert np.allclose(p.h, 1.2 * a / 2, rtol=1e-12)

@@ -136,3 +136,19 @@ def test_erosion_into_particles_with_a_tied_coupling_is_refused(tmp_path, capsys
     conv = ('convert = {region = {shape = "box", lo = [0, 0, 0], hi = [0.04, 0.04, 0.02]}, '
             'coupling = "tied"}\n' + TO_PARTICLES)
     _bad(tmp_path, cube(erosion=conv), "mesh[0]", ["tied", "penalty"], capsys)
+
+
+def test_eroded_elements_leave_the_mesh_frames(tmp_path):
+    """The mesh block of the frames holds the remaining elements only, with
+    cell fields of the same length."""
+    from sphdyn.io import read_frame_meshes
+
+    sim = Simulation.from_deck(loads_deck(cube(t_end="0.15 ms", every="0.15 ms")),
+                               tmp_path / "run")
+    sim.run()
+    el = sim.stepper.part("cube").el
+    assert 0 < int(el.active.sum()) < el.n
+    mesh = read_frame_meshes(sorted((tmp_path / "run/frames").glob("*.h5"))[-1])["cube"]
+    assert mesh.cells.shape[0] == int(el.active.sum())
+    assert np.array_equal(mesh.cells, el.conn[el.active == 1])
+    assert all(v.shape[0] == mesh.cells.shape[0] for v in mesh.cell_data.values())

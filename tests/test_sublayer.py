@@ -231,3 +231,13 @@ def test_restart_with_a_sublayer_bar_is_bitwise(tmp_path):
     h_part = read_history_csv(tmp_path / "part/history.csv")
     for col in h_full:
         assert np.array_equal(h_full[col], h_part[col]), col
+
+
+def test_bar_particles_take_the_concretes_density():
+    """The bar's particles carry the concrete's density and the volume their
+    mass fills at it (the SPH energy identity needs alike densities)."""
+    st = build_stepper(loads_deck(deck_text(sets="")))
+    p = st.part("sph").p
+    rows = np.flatnonzero(p.body == 1)
+    assert np.all(p.rho0[rows] == 2400.0) and np.all(p.rho[rows] == 2400.0)
+    assert np.allclose(p.vol0[rows], p.m[rows] / 2400.0, rtol=1e-15)
