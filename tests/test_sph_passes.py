@@ -6,7 +6,7 @@ import pytest
 from sphdyn import kernels
 from sphdyn.geometry import box_lattice
 from sphdyn.neighbours import build_neighbours
-from sphdyn.parts.sph.passes import (forces, particle_volumes, scaled_stress,
+from sphdyn.parts.sph.passes import (forces, scaled_stress,
                                update_density_and_h, velocity_gradient, xsph_velocity)
 
 
@@ -42,11 +42,9 @@ def _grad(c, v, correct, with_factors=False):
     n = c["x"].shape[0]
     L = np.zeros((n, 3, 3))
     B = np.zeros((n, 3, 3))
-    vol = np.zeros(n)
-    particle_volumes(c["m"], c["rho"], vol)
     nl = c["nl"]
     F = np.zeros(nl.idx.size)
-    velocity_gradient(c["x"], v, c["h"], vol, nl.offsets, nl.idx, c["kid"], c["sigma"],
+    velocity_gradient(c["x"], v, c["h"], c["m"], c["rho"], nl.offsets, nl.idx, c["kid"], c["sigma"],
                       c["dim"], 1.0, correct, F, L, B)
     return (L, B, F) if with_factors else (L, B)
 
@@ -161,6 +159,45 @@ def test_momentum_conserved_to_round_off(dim, correct):
     scale = (c["m"][:, None] * np.abs(a)).sum()
     assert np.abs(total).max() < 1e-12 * scale
     assert np.all(dedt >= -1e-12 * np.abs(dedt).max())  # viscosity only heats
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("correct", [False, True])
+def test_stress_power_balances_at_a_density_jump(dim, correct):
+    # Semi-discrete energy identity: the kinetic-energy rate of the stress
+    # forces, sum_i m_i a_i . v_i, and the internal-energy rate of the
+    # material update, sum_i m_i (sigma_i / rho_i) : L_i, cancel exactly for
+    # any stresses and velocities -- also where the density jumps (steel at
+    # 7850 against concrete at 2400: a projectile, sublayer bars, detonation
+    # products). This holds for weights m_j / rho_i in L (Monaghan), not for
+    # volumes m_j / rho_j: that pairing misses here by 2.5 % (3D, corrected)
+    # to several times (2D) of the net
+    # power (checked below with a 1 % bound, so the test can fail).
+    # Tolerance 1e-11 of sum |terms| (round-off of ~1e3 pair terms per
+    # particle).
+    c = _cloud(dim, n_side=9 if dim == 2 else 6, jitter=0.2, seed=5)
+    rng = np.random.default_rng(6)
+    n = c["x"].shape[0]
+    steel = c["x"][:, 0] < c["x"][:, 0].mean()
+    c["rho"] = np.where(steel, 7850.0, 2400.0) * rng.uniform(0.95, 1.05, n)
+    c["m"] = c["rho"] * c["dx"] ** dim * rng.uniform(0.8, 1.2, n)
+    s = rng.normal(size=(n, 3, 3)) * 1e6
+    sig = 0.5 * (s + s.transpose(0, 2, 1))
+    v = rng.normal(size=(n, 3))
+    if dim == 2:
+        sig[:, 2, :2] = sig[:, :2, 2] = 0.0
+        v[:, 2] = 0.0
+    L, _ = _grad(c, v, correct)
+    a, _ = _forces(c, sig, v=v, correct=correct)  # no viscosity: stress only
+    kinetic = c["m"][:, None] * a * v
+    internal = (c["m"] / c["rho"])[:, None, None] * sig * L
+    scale = np.abs(kinetic).sum() + np.abs(internal).sum()
+    assert abs(kinetic.sum() + internal.sum()) < 1e-11 * scale
+    # the volume pairing m_j / rho_j misses the balance at the jump
+    vol_weights = dict(c, m=c["m"] / c["rho"], rho=np.ones(n))
+    L_vol, _ = _grad(vol_weights, v, correct)
+    internal_vol = (c["m"] / c["rho"])[:, None, None] * sig * L_vol
+    assert abs(kinetic.sum() + internal_vol.sum()) > 0.01 * abs(kinetic.sum())
 
 
 def test_viscosity_acts_only_on_approaching_pairs():

@@ -45,13 +45,14 @@ def follow_masters(rows, elem, N, conn, xn, vn, xp, vp):
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def set_pair_gradient(rows, member, offsets, idx, fac, pos, v, vol, B, Finv, tl, Lhh):
+def set_pair_gradient(rows, member, offsets, idx, fac, pos, v, w, rho, B, Finv, tl, Lhh):
     r"""The share of the pairs within a set in each member's velocity gradient.
 
     Updated-Lagrangian (``tl`` False; the terms of
     :func:`sphdyn.parts.sph.passes.velocity_gradient` that those pairs gave):
 
-    .. math:: \mathbf L^{ss}_i = \Big[\sum_{j\ \mathrm{in\ the\ set}} V_j\,
+    .. math:: \mathbf L^{ss}_i = \Big[\sum_{j\ \mathrm{in\ the\ set}}
+              \frac{m_j}{\rho_i}\,
               F_{ij} (\mathbf v_j - \mathbf v_i) \otimes
               (\mathbf x_i - \mathbf x_j)\Big] B_i^T;
 
@@ -65,7 +66,9 @@ def set_pair_gradient(rows, member, offsets, idx, fac, pos, v, vol, B, Finv, tl,
     ``rows`` (S,) the members' rows, ``member`` (N,) bool; ``fac`` (nnz,) the
     pair factors of all pairs (UL: before :func:`set_pairs_off`); ``pos``,
     ``v`` (N, 3) the positions of the sum (current or reference) and
-    velocities; ``vol`` (N,) the volumes the pass used; ``B`` and ``Finv``
+    velocities; ``w`` (N,) the weights of the pass (UL: the masses, divided
+    here by ``rho`` (N,) of row i; TL: the reference volumes, ``rho``
+    unused); ``B`` and ``Finv``
     (N, 3, 3) (``Finv`` unused in UL); ``Lhh`` (S, 3, 3) out [1/s].
     """
     for k in prange(rows.shape[0]):
@@ -73,11 +76,12 @@ def set_pair_gradient(rows, member, offsets, idx, fac, pos, v, vol, B, Finv, tl,
         for a in range(3):
             for b in range(3):
                 Lhh[k, a, b] = 0.0
+        scale = 1.0 if tl else 1.0 / rho[i]
         for q in range(offsets[i], offsets[i + 1]):
             j = idx[q]
             if not member[j]:
                 continue
-            f = np.float64(fac[q]) * vol[j]
+            f = np.float64(fac[q]) * (w[j] * scale)
             for a in range(3):
                 u = v[j, a] - v[i, a]
                 for b in range(3):

@@ -29,12 +29,14 @@ are zeroed (the shared pair functions of :mod:`.slaves`), so
 a bar particle's strain rate comes from the concrete around it only.
 
 The particles take the density of the concrete around them (and a nominal
-volume :math:`m_s/\rho_c`; :func:`sphdyn.model.build_model`): the SPH
-momentum equation with :math:`\sigma_i/\rho_i^2 + \sigma_j/\rho_j^2` and a
-velocity gradient with volumes :math:`m_j/\rho_j` conserve energy only when
-neighbours have alike densities; with the steel's 7850 kg/m^3 among
-concrete at 2400 the pull-out test made 14 % of its external work out of
-nothing.
+volume :math:`m_s/\rho_c`; :func:`sphdyn.model.build_model`). A bar
+particle's strain rate is sampled from its concrete neighbours with the
+weights :math:`m_j/\rho_i` of the energy-consistent velocity gradient
+(:mod:`sphdyn.parts.sph.passes`); at the steel's 7850 kg/m^3 those weights
+would be the concrete volumes times :math:`\rho_c/\rho_s \approx 0.31`, a
+strain rate three times too small. (Before the solver paired its force with
+that gradient, volumes :math:`m_j/\rho_j` in ``L`` made the pull-out test
+create 14 % of its external work out of nothing at the steel's density.)
 
 The bar's mass :math:`\rho_s A L` is split between the elements and the
 particles by the ratio :math:`r` (the particles' share, :math:`0 < r < 1`;
@@ -117,7 +119,7 @@ class SublayerCoupling(InteractionBase):
         pairs in the velocity gradient kept aside, then those pairs out."""
         sph, p = self.part, self.part.p
         set_pair_gradient(self.rows, self.own, sph.nl.offsets, sph.nl.idx, sph.F, p.x,
-                             p.v, p.vol, p.B, p.B, False, self.L_own)
+                             p.v, p.m, p.rho, p.B, p.B, False, self.L_own)
         p.L[self.rows] -= self.L_own
         set_pairs_off(self.rows, self.own, sph.nl.offsets, sph.nl.idx, sph.F)
 

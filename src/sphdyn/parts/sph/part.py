@@ -40,7 +40,7 @@ from ...neighbours import build_neighbours, mean_neighbours, update_neighbours
 from ...state import Particles
 from ..base import register_part
 from .artificial_stress import artificial_stress_forces, artificial_stress_tensor
-from .passes import (forces, particle_volumes, scaled_stress, update_density_and_h,
+from .passes import (forces, scaled_stress, update_density_and_h,
                      velocity_gradient, xsph_velocity)
 from .swegle import FLAG_FRACTION, REL_STRESS_TOL, count_unstable, stress_scale, swegle_indicator
 from .tl_scheme import TotalLagrangian
@@ -100,7 +100,7 @@ class SPHPart:
             p.phase = phase
         if variation is not None:
             p.variation = variation
-        for name, tail in (("B", (3, 3)), ("dedt_av", ()), ("S", (3, 3)), ("vol", ()),
+        for name, tail in (("B", (3, 3)), ("dedt_av", ()), ("S", (3, 3)),
                            ("size", ()), ("bulk_modulus", ()), ("young", ()),
                            ("as_eps", ()), ("swegle", ())):
             p.add(name, tail)
@@ -277,8 +277,7 @@ class SPHPart:
         if self.F.shape[0] != nl.idx.shape[0]:
             self.F = np.empty(nl.idx.shape[0])  # only after a neighbour rebuild
         if self.has_ul:
-            particle_volumes(p.m, p.rho, p.vol)
-            velocity_gradient(p.x, p.v, p.h, p.vol, nl.offsets, nl.idx, k.kid, k.sigma,
+            velocity_gradient(p.x, p.v, p.h, p.m, p.rho, nl.offsets, nl.idx, k.kid, k.sigma,
                               self.dim, k.support_scale, self.s.correction, self.F, p.L,
                               p.B)
         if self.tl is not None:

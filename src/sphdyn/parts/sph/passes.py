@@ -9,7 +9,24 @@ so the loops are race-free. Pair quantities use the mean smoothing length
 with :math:`\kappa` the support scale (the paper's kappa), which keeps
 :math:`\nabla_i W_{ij} = -\nabla_j W_{ji}` and hence exact momentum
 conservation. Notation: :math:`\mathbf g_{ij} = \nabla_i W(\mathbf x_i -
-\mathbf x_j, h_{ij})`, :math:`V_j = m_j / \rho_j`.
+\mathbf x_j, h_{ij})`.
+
+Energy pairing. The momentum equation (:func:`forces`) is
+:math:`\dot{\mathbf v}_i = \sum_j m_j (\sigma_i/\rho_i^2 + \sigma_j/\rho_j^2)
+B\mathbf g`; the internal energy rate whose sum with the kinetic energy is
+exactly conserved is :math:`\dot e_i = (\sigma_i/\rho_i) : \mathbf L_i` with
+
+.. math:: \mathbf L_i = \frac{1}{\rho_i}\sum_j m_j (\mathbf v_j - \mathbf v_i)
+          \otimes \mathbf g_{ij} B_i^T
+
+(Monaghan 1992, eq. 3.4 for the scalar case; Gray, Monaghan & Swift 2001,
+eq. 4.8), i.e. quadrature weights :math:`m_j/\rho_i`, not the volumes
+:math:`m_j/\rho_j`. Both agree where the density is uniform; where bodies of
+different densities meet through the kernel (steel against concrete, a
+mesostructure's phases, detonation products against a slab) only the former
+keeps the energy balance closed. Its trace gives the summation form of the
+continuity equation, :math:`\dot\rho_i = \sum_j m_j (\mathbf v_i - \mathbf
+v_j)\cdot\mathbf g_{ij}`.
 
 References
 ----------
@@ -33,13 +50,6 @@ _DET_TOL = 1e-6
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def particle_volumes(m, rho, vol):
-    """``vol = m / rho`` [m^3] (N,), the particle volumes used as quadrature weights."""
-    for i in prange(m.shape[0]):
-        vol[i] = m[i] / rho[i]
-
-
-@njit(cache=True, error_model="numpy", parallel=True)
 def scaled_stress(sig, rho, S):
     """``S = sigma / rho^2`` (N, 3, 3) [Pa m^6/kg^2], the stress term of the momentum sum."""
     for i in prange(sig.shape[0]):
@@ -50,14 +60,15 @@ def scaled_stress(sig, rho, S):
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def velocity_gradient(x, v, h, vol, offsets, idx, kid, sigma, dim, support_scale, correct,
+def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_scale, correct,
                       F, L, B):
     r"""Velocity gradient with optional Randles-Libersky renormalisation.
 
     .. math::
-        L_i = \sum_j V_j (\mathbf v_j - \mathbf v_i) \otimes \mathbf g_{ij}\, B_i^T,
+        L_i = \sum_j \frac{m_j}{\rho_i} (\mathbf v_j - \mathbf v_i) \otimes
+              \mathbf g_{ij}\, B_i^T,
         \qquad
-        B_i = \Big[\sum_j V_j (\mathbf x_j - \mathbf x_i) \otimes
+        B_i = \Big[\sum_j \frac{m_j}{\rho_i} (\mathbf x_j - \mathbf x_i) \otimes
               \mathbf g_{ij}\Big]^{-T}
 
     (``L[i, a, b] = dv_a/dx_b``). Without correction ``B_i = I``. With it, any
@@ -79,7 +90,9 @@ def velocity_gradient(x, v, h, vol, offsets, idx, kid, sigma, dim, support_scale
     ----------
     x, v : (N, 3) positions [m] and velocities [m/s].
     h : (N,) smoothing length [m].
-    vol : (N,) particle volumes m/rho [m^3] (0 for zero-mass particles).
+    m, rho : (N,) masses [kg] (0 for zero-mass particles) and densities
+        [kg/m^3]; the weight of pair ij is m_j / rho_i (the energy partner of
+        :func:`forces`, see the module docstring).
     offsets, idx : CSR neighbour list.
     kid, sigma, dim, support_scale : kernel id, normalisation, dimension (2: z
         terms skipped), support scale kappa.
@@ -102,6 +115,7 @@ def velocity_gradient(x, v, h, vol, offsets, idx, kid, sigma, dim, support_scale
         vi2 = v[i, 2]
         three = dim == 3
         hi = h[i]
+        irho = 1.0 / rho[i]
         for k in range(offsets[i], offsets[i + 1]):
             j = idx[k]
             d0 = xi0 - x[j, 0]
@@ -120,7 +134,7 @@ def velocity_gradient(x, v, h, vol, offsets, idx, kid, sigma, dim, support_scale
                 scale *= ih
             fk = scale * dwdq_over_q(kid, np.sqrt(r2) * ih)
             F[k] = fk
-            f = fk * vol[j]
+            f = fk * (m[j] * irho)
             if f == 0.0:
                 continue
             g0 = f * d0
