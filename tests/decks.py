@@ -72,3 +72,13 @@ checkpoint_every = {ck}
 progress = false
 fields = ["velocity", "stress", "von_mises", "plastic_strain", "damage"]
 """
+
+
+#: An elastic steel [[material]] named "steel" (E 200 GPa, nu 0.3, 7850 kg/m^3).
+STEEL = """[[material]]
+name = "steel"
+model = "elastic"
+density = 7850.0
+E = "200 GPa"
+nu = 0.3
+"""

@@ -55,6 +55,8 @@ CASES: dict[str, tuple[int, list[str]]] = {
     "erosion_blocks_plain": (100, []),
     "erosion_blocks_sph": (100, []),
     "pullout_sublayer": (60, []),
+    # 600 particles (two layers through the thickness), the ramp's first steps
+    "l_specimen": (40, ['body.L.dx="25 mm"']),
 }
 
 

@@ -22,6 +22,7 @@ from sphdyn.geometry.shapes import shape_functions
 from sphdyn.interactions.embedded import locate
 from sphdyn.io import read_history_csv
 from sphdyn.simulation import Simulation
+from decks import STEEL
 
 COMPOSITE = """
 [run]
@@ -33,13 +34,7 @@ model = "elastic"
 density = 2400.0
 E = "30 GPa"
 nu = 0.0
-[[material]]
-name = "steel"
-model = "elastic"
-density = 7850.0
-E = "200 GPa"
-nu = 0.3
-[[mesh]]
+""" + STEEL + """[[mesh]]
 name = "block"
 material = "concrete"
 damping = "20000 1/s"

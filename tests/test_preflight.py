@@ -27,6 +27,10 @@ class _Shape:
     (_Shape(shape="cylinder", radius=0.05, length=0.3), 3, math.pi * 0.05 ** 2 * 0.3),
     (_Shape(shape="ring", inner_radius=0.03, outer_radius=0.04, length=None), 2,
      math.pi * (0.04 ** 2 - 0.03 ** 2)),
+    (_Shape(shape="prism", points=((0, 0), (0.25, 0), (0.25, 0.25), (0.5, 0.25),
+                                   (0.5, 0.5), (0, 0.5)), length=0.05), 3,
+     (0.25 - 0.0625) * 0.05),
+    (_Shape(shape="prism", points=((0, 0), (0, 0.1), (0.3, 0)), length=None), 2, 0.015),
 ])
 def test_shape_volumes_are_the_closed_forms(shape, dim, volume):
     assert shape_volume(shape, dim) == pytest.approx(volume, rel=1e-14)

@@ -31,6 +31,7 @@ from sphdyn.interactions.sublayer import sublayer_masses
 from sphdyn.io import read_history_csv
 from sphdyn.simulation import Simulation
 from test_mesh_decks import _bad
+from decks import STEEL
 
 PULLOUT = """
 [run]
@@ -42,13 +43,7 @@ model = "elastic"
 density = 2400.0
 E = "30 GPa"
 nu = 0.2
-[[material]]
-name = "steel"
-model = "elastic"
-density = 7850.0
-E = "200 GPa"
-nu = 0.3
-[[body]]
+{STEEL}[[body]]
 name = "block"
 material = "concrete"
 dx = "10 mm"
@@ -92,7 +87,7 @@ ramp = "smooth"
 
 def deck_text(t_end="2 ms", ratio=0.5, sets=SETS, velocity="",
               start='["5 mm", "30 mm", "30 mm"]'):
-    return PULLOUT.format(t_end=t_end, ratio=ratio, sets=sets, velocity=velocity,
+    return PULLOUT.format(STEEL=STEEL, t_end=t_end, ratio=ratio, sets=sets, velocity=velocity,
                           start=start)
 
 

@@ -11,7 +11,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import kernels
 from .geometry import select
+from .geometry.spacing import adapted_smoothing_lengths
 from .heterogeneity.cracks import crack_mask
 from .heterogeneity.mass import body_rng, mass_field
 from .heterogeneity.mesostructure import AGGREGATE, ITZ, MORTAR, generate_phases
@@ -252,6 +254,7 @@ def build_model(deck) -> Model:
             parts.append(_converted_particles(deck, mm, len(body_names), density_of, n_hist))
             phase_parts.append(np.full(parts[-1].n, -1, np.int8))
             body_names.append(_converted_name(mm, body_names))
+    n_bodies = sum(p.n for p in parts)  # the particles of bodies and converted meshes
     for mm in sublayer_meshes(meshes):  # bars' nodes as particles (thesis 6.1)
         parts.append(_sublayer_particles(deck, mm, len(body_names), n_hist))
         phase_parts.append(np.full(parts[-1].n, -1, np.int8))
@@ -261,6 +264,15 @@ def build_model(deck) -> Model:
     particles = (Particles.concatenate(parts) if parts
                  else Particles.allocate(0, dim, n_hist))
     particles.hist_names = list(next(iter(layouts), ()))
+    hs = deck.sph.smoothing_length
+    if hs.initial == "adaptive" and n_bodies > dim:
+        # support sized by the local spacing (geometry.spacing); a bar's
+        # sublayer particles keep theirs (element length)
+        particles.h[:n_bodies] = adapted_smoothing_lengths(
+            particles.x[:n_bodies], particles.h[:n_bodies], deck.sph.h_factor, dim,
+            hs.min_factor, hs.max_factor,
+            kernels.support(kernels.kernel_id(deck.sph.kernel)) * deck.sph.support_scale)
+        particles.h0[:n_bodies] = particles.h[:n_bodies]
 
     groups, factor = _material_groups(deck, particles, models, params)
     have = {g.material for g in groups}

@@ -60,6 +60,11 @@ def shape_volume(geometry, dim: int) -> float:
         return math.prod(h - l for l, h in zip(g.lo[:dim], g.hi[:dim]))
     if g.shape == "sphere":
         return ball_volume(g.radius, dim)
+    if g.shape == "prism":  # shoelace area of the polygon
+        u, v = zip(*g.points)
+        area = 0.5 * abs(sum(u[k] * v[(k + 1) % len(u)] - u[(k + 1) % len(u)] * v[k]
+                             for k in range(len(u))))
+        return area if dim == 2 else area * g.length
     outer = g.radius if g.shape == "cylinder" else g.outer_radius
     inner = 0.0 if g.shape == "cylinder" else g.inner_radius
     area = ball_volume(outer, 2) - ball_volume(inner, 2)

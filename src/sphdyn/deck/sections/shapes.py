@@ -2,6 +2,7 @@
 
 from typing import Annotated, Literal, Optional, Union
 
+import numpy as np
 from pydantic import AfterValidator, Field, ValidationInfo, field_validator
 
 from ..messages import problem, show_number
@@ -39,12 +40,13 @@ def _length_in_3d(length: Optional[float]) -> Optional[float]:
     """A cylinder's or ring's length: required in 3D, refused in 2D."""
     dim = dimension()
     if length is None and dim == 3:
-        raise problem("a cylinder or ring in a 3D deck needs a length",
+        raise problem("a cylinder, ring or prism in a 3D deck needs a length",
                       "add length = \"100 mm\" (or a number in metres)")
     if length is not None and dim == 2:
         raise problem("this key means nothing in a 2D deck (run.dimension = 2; a "
-                      "cylinder or ring is then a disc or annulus in the x-y plane, "
-                      "per unit depth)", "remove it, or set run.dimension = 3")
+                      "cylinder, ring or prism is then a disc, annulus or polygon "
+                      "in the x-y plane, per unit depth)",
+                      "remove it, or set run.dimension = 3")
     return length
 
 
@@ -91,7 +93,57 @@ class Ring(Section):
         return outer
 
 
-Geometry = Annotated[Union[Box, Cylinder, Ring, Sphere],
+def _simple_polygon(points: tuple) -> tuple:
+    """A prism's polygon: three or more vertices, no zero area, no crossing edges."""
+    if len(points) < 3:
+        raise problem(f"a prism's polygon needs at least 3 points, got {len(points)}",
+                      "list the vertices in order, e.g. points = [[0, 0], [0.5, 0], "
+                      "[0.5, 0.25], [0, 0.25]]")
+    p = np.asarray(points, dtype=float)
+    q = np.roll(p, -1, axis=0)
+    area = 0.5 * float(np.sum(p[:, 0] * q[:, 1] - q[:, 0] * p[:, 1]))
+    size = float(np.max(p.max(axis=0) - p.min(axis=0)))
+    if abs(area) <= 1e-12 * max(size, 1e-300) ** 2:
+        raise problem("a prism's polygon has zero area (all points on a line)",
+                      "give the vertices of the cross-section in order")
+    k = len(p)
+
+    def cross(o, a, b):
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    for i in range(k):
+        for j in range(i + 2, k):
+            if i == 0 and j == k - 1:
+                continue  # adjacent through the closing edge
+            a, b, c, d = p[i], q[i], p[j], q[j]
+            if (cross(a, b, c) * cross(a, b, d) < 0 and
+                    cross(c, d, a) * cross(c, d, b) < 0):
+                raise problem(f"a prism's polygon crosses itself (edges {i + 1} and "
+                              f"{j + 1})", "list the vertices in order around the "
+                              "cross-section")
+    return points
+
+
+class Prism(Section):
+    """A polygon extruded along an axis (the polygon itself in 2D): an
+    L-specimen, an I- or T-section."""
+
+    shape: Literal["prism"] = Field(description="Kind of shape.")
+    points: Annotated[tuple[tuple[quantity(LENGTH), quantity(LENGTH)], ...],
+                      AfterValidator(_simple_polygon)] = Field(
+        description="Polygon vertices [u, v] in order (either sense), in the plane "
+                    "normal to axis: (x, y) for z, (y, z) for x, (z, x) for y. "
+                    "Vertices on multiples of dx from the polygon's bounding box "
+                    "give an exact volume.")
+    axis: PlanarAxis = Field("z", description="Extrusion direction; must be z in 2D.")
+    base: quantity(LENGTH) = Field(
+        0.0, description="Start of the extrusion along the axis (3D).")
+    length: AxialLength = Field(
+        None, validate_default=True,
+        description="Length of the extrusion; required in 3D, not allowed in 2D.")
+
+
+Geometry = Annotated[Union[Box, Cylinder, Ring, Sphere, Prism],
                      Field(discriminator="shape")]
 
 

@@ -31,6 +31,13 @@ class SmoothingLength(Section):
         0.5, description="Lower bound on h as a fraction of h0.")
     max_factor: real("factor", lo=1) = Field(
         2.0, description="Upper bound on h as a multiple of h0.")
+    initial: Literal["nominal", "adaptive"] = Field(
+        "nominal", description="h0 of each particle. nominal: h_factor times its "
+        "body's dx (or its element's size); adaptive: h_factor times the local "
+        "spacing (the distance to the dimension-th nearest particle), within "
+        "[min_factor, max_factor] times the nominal h, for clustered or irregular "
+        "particles (LS-DYNA's HMIN/HMAX idea; docs/theory.md). A lattice keeps its "
+        "nominal h.")
 
 
 class Neighbours(Section):
