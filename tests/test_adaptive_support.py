@@ -149,3 +149,19 @@ def test_deck_adaptive_support_follows_each_region():
     assert np.all(p.h[coarse_seam] < nominal.h[coarse_seam])
     assert np.all(p.h >= 0.4 * nominal.h - 1e-15)
     assert np.array_equal(p.h0, p.h)
+
+
+def test_adapted_support_stays_within_the_bounds():
+    # h within [min_factor, max_factor] times the nominal h (HMIN/HMAX):
+    # the refined half (spacing dx/2) is pinned at 0.8 x nominal when the
+    # lower bound is 0.8, and with a nominal h a quarter of eta dx every
+    # particle is pinned at max_factor x nominal.
+    dx, eta, q = 0.01, 1.3, 2.0
+    x, fine = _mixed_cloud(2, dx)
+    nominal = np.full(x.shape[0], eta * dx)
+    h = adapted_smoothing_lengths(x, nominal, eta, 2, 0.8, 2.0, q)
+    assert np.allclose(h[fine], 0.8 * nominal[fine], rtol=1e-12)
+    assert np.all(h[~fine] <= nominal[~fine] * (1 + 1e-12))
+    small = nominal / 4
+    h = adapted_smoothing_lengths(x, small, eta, 2, 0.5, 1.5, q)
+    assert np.allclose(h, 1.5 * small, rtol=1e-12)

@@ -11,7 +11,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import kernels
 from .geometry import select
 from .geometry.spacing import adapted_smoothing_lengths
 from .heterogeneity.cracks import crack_mask
@@ -23,7 +22,7 @@ from .initial import initial_fields
 from .interactions.wall import STIFFNESS, WallSpec
 from .deck import DeckError
 from .deck.errors import format_problem
-from .preflight import checked_lattices
+from .preflight import checked_lattices, support_radius
 from .materials import MaterialGroup, get_model
 from .mesh_model import MeshModel, build_meshes, mesh_node_set
 from .probes import Probe, quantity
@@ -270,8 +269,7 @@ def build_model(deck) -> Model:
         # sublayer particles keep theirs (element length)
         particles.h[:n_bodies] = adapted_smoothing_lengths(
             particles.x[:n_bodies], particles.h[:n_bodies], deck.sph.h_factor, dim,
-            hs.min_factor, hs.max_factor,
-            kernels.support(kernels.kernel_id(deck.sph.kernel)) * deck.sph.support_scale)
+            hs.min_factor, hs.max_factor, support_radius(deck.sph))
         particles.h0[:n_bodies] = particles.h[:n_bodies]
 
     groups, factor = _material_groups(deck, particles, models, params)
@@ -391,13 +389,12 @@ def _sublayer_particles(deck, mm: MeshModel, b: int, n_hist: int) -> Particles:
 
 def _seat_sublayers(deck, meshes, particles: Particles, body_names: list[str]) -> None:
     """Seat every bar in its concrete: its particles take the density of the
-    concrete around them (and the volume m / rho). A bar must meet the
+    concrete around them (and the volume m / rho), so that they sample the
+    concrete's strain rate (:mod:`sphdyn.interactions.sublayer`). A bar must meet the
     concrete: at least one of its nodes needs a particle of the
     [mesh.sublayer] body (or of any deck body) within its support radius
     (nodes of a bar that sticks out, as in a pull-out test, need not)."""
     from scipy.spatial import cKDTree
-
-    from .kernels import kernel_id, support
 
     for mm in sublayer_meshes(meshes):
         sub = mm.spec.sublayer
@@ -407,8 +404,7 @@ def _seat_sublayers(deck, meshes, particles: Particles, body_names: list[str]) -
         host = np.flatnonzero(np.isin(particles.body, hosts))
         rows = np.flatnonzero(particles.body == own)
         where = f"mesh[{mm.index}] '{mm.name}'.line"
-        radius = (support(kernel_id(deck.sph.kernel)) * deck.sph.support_scale
-                  * particles.h[rows])
+        radius = support_radius(deck.sph) * particles.h[rows]
         if host.size:
             dist, near = cKDTree(particles.x[host]).query(particles.x[rows])
         else:
@@ -422,8 +418,9 @@ def _seat_sublayers(deck, meshes, particles: Particles, body_names: list[str]) -
                 f"support ({radius.max():.4g} m)",
                 "move the bar into the concrete body (or name the body it is in: "
                 "[mesh.sublayer] body)")])
-        # the concrete's density: the energy identity of SPH needs neighbours
-        # of alike density (docs/theory.md, "Sublayer coupling of rebar")
+        # the concrete's density: the weights m_j / rho_i of a bar particle's
+        # velocity gradient are then the concrete's volumes (docs/theory.md,
+        # "Sublayer coupling of rebar")
         rho = float(np.mean(particles.rho0[host[near]]))
         particles.rho[rows] = rho
         particles.rho0[rows] = rho

@@ -23,6 +23,7 @@ import numpy as np
 
 from .deck import DeckError
 from .deck.errors import format_problem
+from .geometry.lattice import polygon_area
 
 #: Bytes of per-particle state and work arrays (besides history variables and
 #: neighbour lists): about 850 measured for block3d at 1M particles
@@ -53,6 +54,14 @@ def ball_volume(radius: float, dim: int) -> float:
     return math.pi * _power(radius, 2) if dim == 2 else 4.0 / 3.0 * math.pi * _power(radius, 3)
 
 
+def support_radius(sph) -> float:
+    """The support radius in units of h for the deck's [sph] section ``sph``:
+    the kernel's times ``support_scale``."""
+    from .kernels import kernel_id, support
+
+    return support(kernel_id(sph.kernel)) * sph.support_scale
+
+
 def shape_volume(geometry, dim: int) -> float:
     """Closed-form volume of a body geometry [m^3], or area [m^2] in 2D."""
     g = geometry
@@ -60,10 +69,8 @@ def shape_volume(geometry, dim: int) -> float:
         return math.prod(h - l for l, h in zip(g.lo[:dim], g.hi[:dim]))
     if g.shape == "sphere":
         return ball_volume(g.radius, dim)
-    if g.shape == "prism":  # shoelace area of the polygon
-        u, v = zip(*g.points)
-        area = 0.5 * abs(sum(u[k] * v[(k + 1) % len(u)] - u[(k + 1) % len(u)] * v[k]
-                             for k in range(len(u))))
+    if g.shape == "prism":
+        area = abs(polygon_area(g.points))
         return area if dim == 2 else area * g.length
     outer = g.radius if g.shape == "cylinder" else g.outer_radius
     inner = 0.0 if g.shape == "cylinder" else g.inner_radius
@@ -189,15 +196,12 @@ def estimate_size(deck) -> SizeEstimate:
     Memory: :data:`PARTICLE_BYTES` plus 8 bytes per history variable per
     particle and :data:`PAIR_BYTES` per neighbour pair.
     """
-    from .kernels import kernel_id, support
-
     dim = deck.run.dimension
     sph = deck.sph
     bodies = {b.name: lattice_count(shape_volume(b.geometry, dim), b.dx, dim)
               for b in deck.body}
     n = float(sum(bodies.values()))
-    radius = (support(kernel_id(sph.kernel)) * sph.support_scale * sph.h_factor
-              * (1.0 + sph.neighbours.skin_factor))
+    radius = support_radius(sph) * sph.h_factor * (1.0 + sph.neighbours.skin_factor)
     pairs = ball_volume(radius, dim)
     per_particle = PARTICLE_BYTES + 8 * _history_width(deck)
     meshes = {m.name: float(np.prod(m.block.divisions)) if m.block is not None

@@ -36,6 +36,7 @@ __all__ = [
     "ring_lattice",
     "sphere_lattice",
     "prism_lattice",
+    "polygon_area",
     "polygon_contains",
     "lattice_from_shape",
 ]
@@ -296,6 +297,14 @@ def sphere_lattice(centre, radius: float, dx: float, dim: int) -> np.ndarray:
 #: In-plane coordinates of a prism's polygon for each axis (cyclic order, so
 #: that a counter-clockwise polygon has its normal along +axis).
 PRISM_PLANES = {0: (1, 2), 1: (2, 0), 2: (0, 1)}
+
+
+def polygon_area(poly) -> float:
+    """Signed area of the polygon ``poly`` (k, 2) [m^2] (shoelace formula;
+    positive counter-clockwise)."""
+    p = np.asarray(poly, dtype=np.float64)
+    q = np.roll(p, -1, axis=0)
+    return 0.5 * float(np.sum(p[:, 0] * q[:, 1] - q[:, 0] * p[:, 1]))
 
 
 def polygon_contains(poly: np.ndarray, pts: np.ndarray, tol: float) -> np.ndarray:

@@ -116,10 +116,10 @@ class HybridCoupling(InteractionBase):
         if self.tl:  # the pairs are out of the TL force pass already
             t = sph.tl
             set_pair_gradient(self.rows, self.hybrid, t.offsets, t.idx, t.fac, t.X, p.v,
-                                 t.vol, p.rho, t.B0, t.Finv, True, self.Lhh)
+                              t.vol, p.rho, t.B0, t.Finv, True, self.Lhh)
             return
         set_pair_gradient(self.rows, self.hybrid, sph.nl.offsets, sph.nl.idx, sph.F,
-                             p.x, p.v, p.m, p.rho, p.B, p.B, False, self.Lhh)
+                          p.x, p.v, p.m, p.rho, p.B, p.B, False, self.Lhh)
         set_pairs_off(self.rows, self.hybrid, sph.nl.offsets, sph.nl.idx, sph.F)
 
     def constrain(self, t: float, dt: float) -> None:

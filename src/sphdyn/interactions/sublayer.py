@@ -119,7 +119,7 @@ class SublayerCoupling(InteractionBase):
         pairs in the velocity gradient kept aside, then those pairs out."""
         sph, p = self.part, self.part.p
         set_pair_gradient(self.rows, self.own, sph.nl.offsets, sph.nl.idx, sph.F, p.x,
-                             p.v, p.m, p.rho, p.B, p.B, False, self.L_own)
+                          p.v, p.m, p.rho, p.B, p.B, False, self.L_own)
         p.L[self.rows] -= self.L_own
         set_pairs_off(self.rows, self.own, sph.nl.offsets, sph.nl.idx, sph.F)
 

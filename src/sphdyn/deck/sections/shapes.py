@@ -5,6 +5,7 @@ from typing import Annotated, Literal, Optional, Union
 import numpy as np
 from pydantic import AfterValidator, Field, ValidationInfo, field_validator
 
+from ...geometry.lattice import polygon_area
 from ..messages import problem, show_number
 from ..scope import dimension
 from ..units import LENGTH
@@ -101,7 +102,7 @@ def _simple_polygon(points: tuple) -> tuple:
                       "[0.5, 0.25], [0, 0.25]]")
     p = np.asarray(points, dtype=float)
     q = np.roll(p, -1, axis=0)
-    area = 0.5 * float(np.sum(p[:, 0] * q[:, 1] - q[:, 0] * p[:, 1]))
+    area = polygon_area(p)
     size = float(np.max(p.max(axis=0) - p.min(axis=0)))
     if abs(area) <= 1e-12 * max(size, 1e-300) ** 2:
         raise problem("a prism's polygon has zero area (all points on a line)",
