@@ -9,12 +9,16 @@ purpose, after a deliberate change of results::
     python tests/regression_cases.py            # all decks
     python tests/regression_cases.py disc_impact # one
 
-Runs use one Numba thread: the threaded energy sums of the kick are
-reductions whose order depends on the thread count.
+Runs use one Numba thread (the threaded energy sums of the kick are
+reductions whose order depends on the thread count) and an empty Numba cache
+(:func:`fresh_numba_env`); ``--out DIR`` writes elsewhere than the stored
+data (the test does).
 """
 
 from __future__ import annotations
 
+import os
+import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -57,6 +61,19 @@ CASES: dict[str, tuple[int, list[str]]] = {
     "pullout_sublayer": (60, []),
     # 600 particles (two layers through the thickness), the ramp's first steps
     "l_specimen": (40, ['body.L.dx="25 mm"']),
+    # 20 mm elements / particles (a staircase web of 80 mm), the ramp's first steps
+    "igirder_fem": (40, ['mesh.girder.prism.element_size="20 mm"']),
+    "igirder_sph": (40, ['body.girder.dx="20 mm"',  # the supports' lowest layer
+                         'set.support_left.region.hi=["62 mm", 1, "11 mm"]',
+                         'set.support_right.region.hi=["1462 mm", 1, "11 mm"]',
+                         'set.load.region.lo=["738 mm", -1, "189 mm"]']),
+    # 600 elements, 10 mm; the projectile at 5 mm spacing strikes within 20 steps
+    "penetration_fem": (60, ["mesh.target.block.divisions=[10, 10, 6]",
+                             'body.projectile.dx="5 mm"']),
+    "penetration_plain": (60, ["mesh.target.block.divisions=[10, 10, 6]",
+                               'body.projectile.dx="5 mm"']),
+    "penetration_sph": (60, ["mesh.target.block.divisions=[10, 10, 6]",
+                             'body.projectile.dx="5 mm"']),
 }
 
 
@@ -83,15 +100,35 @@ def run_case(name: str, outdir: Path) -> dict[str, np.ndarray]:
     return out
 
 
-def write(names: list[str]) -> None:
-    DATA.mkdir(parents=True, exist_ok=True)
+def write(names: list[str], out: Path = DATA) -> None:
+    """Run the cases ``names`` and store each as ``out/<name>.npz``."""
+    out.mkdir(parents=True, exist_ok=True)
     for name in names:
         with tempfile.TemporaryDirectory() as tmp:
             res = run_case(name, Path(tmp) / name)
-        np.savez_compressed(DATA / f"{name}.npz", **res)
+        np.savez_compressed(out / f"{name}.npz", **res)
         n = res["particle/x"].shape[0]
         print(f"{name}: {n} particles, {res['history/time'].size} history rows")
 
 
+def fresh_numba_env() -> dict:
+    """The environment of a run whose kernels are all compiled in the process:
+    one thread and an empty Numba cache directory. A kernel loaded from
+    Numba's on-disk cache can differ in the last bits from one compiled in
+    the process (fastmath contraction across an inlined helper, seen in the
+    total-Lagrangian and coupling kernels), so the stored results and the
+    test both run this way."""
+    env = dict(os.environ, NUMBA_NUM_THREADS="1")
+    env["NUMBA_CACHE_DIR"] = tempfile.mkdtemp(prefix="sphdyn-regression-numba-")
+    return env
+
+
 if __name__ == "__main__":
-    write(sys.argv[1:] or list(CASES))
+    args = sys.argv[1:]
+    target = DATA
+    if args[:1] == ["--out"]:
+        target, args = Path(args[1]), args[2:]
+    if "NUMBA_CACHE_DIR" not in os.environ:  # run again in a fresh environment
+        sys.exit(subprocess.call([sys.executable, __file__, "--out", str(target), *args],
+                                 env=fresh_numba_env()))
+    write(args or list(CASES), target)

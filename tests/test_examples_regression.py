@@ -1,20 +1,22 @@
 """Every example deck still gives the stored results (issue 13: results unchanged).
 
 Each deck of ``examples/`` runs a few steps at a coarse spacing
-(:mod:`regression_cases`); its final particle arrays and every history row
-are compared with ``tests/data/regression/<deck>.npz``, written on the code
+(:mod:`regression_cases`, all in one subprocess with its own Numba cache);
+its final particle arrays and every history row are compared with ``tests/data/regression/<deck>.npz``, written on the code
 before the parts/interactions/events architecture. The comparison is
 bitwise: the reshaping moved code, not arithmetic. A case may be given a
 relative tolerance in ``TOLERANCE`` only where the order of a floating-point
 reduction had to change, with the reason next to it.
 """
 
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from regression_cases import CASES, DATA, run_case
+from regression_cases import CASES, DATA, fresh_numba_env
 
 #: deck -> relative tolerance (scaled by the array's largest magnitude) and why.
 #: Empty: every case is bitwise identical.
@@ -50,11 +52,22 @@ def _differences(name: str, got: dict, want: dict) -> list[str]:
     return problems
 
 
+@pytest.fixture(scope="module")
+def results(tmp_path_factory) -> Path:
+    """Every case run once, in a subprocess that compiles all kernels itself
+    (:func:`regression_cases.fresh_numba_env`), as the stored results were."""
+    out = tmp_path_factory.mktemp("regression")
+    script = Path(__file__).with_name("regression_cases.py")
+    subprocess.run([sys.executable, str(script), "--out", str(out)], check=True,
+                   env=fresh_numba_env(), capture_output=True)
+    return out
+
+
 @pytest.mark.parametrize("name", sorted(CASES))
-def test_example_matches_stored_result(name, tmp_path):
+def test_example_matches_stored_result(name, results):
     assert (Path(__file__).parents[1] / "examples" / f"{name}.toml").exists()
     want = dict(np.load(DATA / f"{name}.npz"))
-    got = run_case(name, tmp_path / name)
+    got = dict(np.load(results / f"{name}.npz"))
     problems = _differences(name, got, want)
     assert not problems, f"{name} changed:\n" + "\n".join(problems)
 

@@ -11,6 +11,7 @@ import pytest
 
 from fem_models import block, material, part
 from sphdyn.interactions.nodal import MassDamping, NodalLoad, PrescribedMotion, ramp
+from sphdyn.state import BC_COMPONENTS, BC_VELOCITY
 from sphdyn.stepper import Stepper
 from stepping import step
 
@@ -111,6 +112,66 @@ def test_prescribed_displacement_lands_exactly_and_books_its_work():
     # reaction at the fixed end ~ -E A eps at the end of the ramp (dynamic
     # overshoot is small for a ramp of ten transits): within 10 %
     assert rows[-1]["fix_reaction_x"] == pytest.approx(-E * 0.01 * 1e-3, rel=0.10)
+
+
+def test_roller_ends_let_a_pulled_bar_contract_freely():
+    """A bar (nu = 0.3) held at one end in x only and pulled at the other by a
+    1 mm x-displacement on x only (components = [0]: roller ends), damped to
+    rest: the state is uniaxial, so the ends contract laterally by
+    nu eps b (1e-3 relative: the damped remainder of the motion); the
+    x-reaction is -E A eps (2e-3: finite strain, the section shrinks by
+    2 nu eps = 6e-4, measured 1.1e-3) and the free components carry no
+    reaction (the kick leaves them to their accelerations: < 1e-9 of the
+    x-reaction, round-off). Fully fixed ends (the control) do not contract."""
+    L, b, d = 1.0, 0.1, 1e-3
+    x, cells = block([0, 0, 0], [L, b, b], (10, 2, 2), 3)
+
+    def run(components):
+        p = part(x, cells, 3, mat=material(density=RHO, E=E, nu=0.3))
+        left = np.flatnonzero(x[:, 0] == 0.0)
+        right = np.flatnonzero(np.isclose(x[:, 0], L))
+        c = math.sqrt(E / RHO)
+        T = 20.0 * L / c
+        inter = [PrescribedMotion("fix", p, left, components=components),
+                 PrescribedMotion("pull", p, right, "displacement", (d, 0, 0), T, "smooth",
+                                  components=components),
+                 MassDamping("damping", p, np.arange(p.nodes.n), 2 * math.pi * c / (2 * L))]
+        s = Stepper([p], inter)
+        while s.t < 3 * T:
+            s.step()
+        width = np.ptp(p.nodes.x[right, 1])
+        return p, s.record(), width
+
+    p, rec, width = run((0,))
+    assert p.kin.bc[0] == BC_COMPONENTS + 1
+    eps = d / L
+    assert width - b == pytest.approx(-0.3 * eps * b, rel=1e-3)
+    assert rec["fix_reaction_x"] == pytest.approx(-E * b * b * eps, rel=2e-3)
+    for key in ("fix_reaction_y", "fix_reaction_z", "pull_reaction_y", "pull_reaction_z"):
+        assert abs(rec[key]) < 1e-9 * abs(rec["fix_reaction_x"])
+    _, _, width_fixed = run((0, 1, 2))
+    assert width_fixed == pytest.approx(b, rel=1e-12)
+
+
+def test_component_conditions_on_the_same_items_combine():
+    """Two conditions holding x and y of the same node: the flag is the
+    union mask (x|y = 3); a third on z makes it a full velocity condition;
+    one kick moves a held component to its target and a free one by dt a."""
+    from sphdyn.integrate import kick, kick_scratch
+    x, cells = block([0, 0, 0], [1.0, 1.0, 1.0], (1, 1, 1), 3)
+    p = part(x, cells, 3)
+    node = np.array([0])
+    PrescribedMotion("a", p, node, "velocity", (1.0, 0, 0), components=(0,))
+    PrescribedMotion("b", p, node, "velocity", (0, 2.0, 0), components=(1,))
+    assert p.kin.bc[0] == BC_COMPONENTS + 3
+    q = p.kin
+    q.v[0] = (5.0, 5.0, 5.0)
+    q.a[0] = (10.0, 10.0, 10.0)
+    kick(q.v, q.a, q.a_ext, q.m, q.bc, q.bc_v, 0.1, np.zeros_like(q.v), kick_scratch(q.n))
+    assert q.v[0].tolist() == [1.0, 2.0, 6.0]
+    PrescribedMotion("c", p, node, "fixed", components=(2,))
+    assert p.kin.bc[0] == BC_VELOCITY
+    assert q.bc_v[0].tolist() == [1.0, 2.0, 0.0]
 
 
 def test_damping_books_the_energy_it_removes():

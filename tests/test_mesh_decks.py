@@ -392,5 +392,12 @@ def test_deck_schema_refuses_inconsistent_meshes(tmp_path):
         bar_deck(source='block = {lo = [0, 0, 0], hi = [1, 1, 1], divisions = [2, 2]}')
     with pytest.raises(DeckError, match="displacement boundary needs a ramp_time"):
         loads_deck(_bar_text().replace('ramp_time = "2 ms"', ""))
+    # a displacement along a direction the condition leaves free, a repeated one
+    with pytest.raises(DeckError, match="has a x component, but components = \\['y'\\]"):
+        loads_deck(_bar_text().replace('ramp = "smooth"', 'ramp = "smooth"\ncomponents = ["y"]'))
+    with pytest.raises(DeckError, match="at most once"):
+        loads_deck(_bar_text().replace('type = "fixed"', 'type = "fixed"\ncomponents = ["x", "x"]'))
+    with pytest.raises(DeckError, match="components"):
+        loads_deck(_bar_text().replace('type = "fixed"', 'type = "fixed"\ncomponents = ["w"]'))
     with pytest.raises(DeckError, match="no \\[\\[body\\]\\] table"):
         loads_deck('[run]\ndimension = 3\nt_end = 1.0\n' + MATERIALS)

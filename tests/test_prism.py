@@ -86,3 +86,70 @@ def test_bad_prisms_are_refused_naming_the_field(geometry, dim, words):
     with pytest.raises(DeckError) as err:
         loads_deck(_deck(geometry, dim))
     assert words in str(err.value) and "geometry" in str(err.value)
+
+
+# an I-section 120 x 200 mm: flanges 40 mm thick, web 40 mm
+I_POLY = [[0, 0], [0.12, 0], [0.12, 0.04], [0.08, 0.04], [0.08, 0.16], [0.12, 0.16],
+          [0.12, 0.2], [0, 0.2], [0, 0.16], [0.04, 0.16], [0.04, 0.04], [0, 0.04]]
+I_AREA = 2 * 0.12 * 0.04 + 0.04 * 0.12
+
+
+def test_prism_mesh_fills_the_i_and_its_centres_are_the_prism_particles():
+    """[mesh.prism] = the elements whose centres are the particles of the
+    prism body at dx = element size (same geometry for an SPH model and its
+    FEM reference): the same points to 1e-12 m, the volume exact (1e-9; the
+    vertices sit on the grid), every element right-handed, no unused node,
+    the end-face node sets on the extrusion's ends."""
+    from sphdyn.geometry.mesh import check_elements, element_jacobians, prism_mesh
+    m = prism_mesh(I_POLY, 0.02, 3, axis="x", base=0.1, length=0.4)
+    check_elements(m)
+    det = element_jacobians(m.points, m.cells, m.kind)
+    assert det.min() > 0
+    assert np.sum(det.mean(axis=1) * 8) == pytest.approx(I_AREA * 0.4, rel=1e-9)
+    assert np.array_equal(np.unique(m.cells), np.arange(m.n_nodes))
+    centres = m.points[m.cells].mean(axis=1)
+    x = prism_lattice(I_POLY, 0.02, 3, axis="x", base=0.1, length=0.4)
+    order = lambda a: a[np.lexsort(np.round(a, 9).T)]  # noqa: E731
+    assert np.allclose(order(centres), order(x), rtol=0, atol=1e-12)
+    assert np.allclose(m.points[m.node_sets["xmin"], 0], 0.1)
+    assert np.allclose(m.points[m.node_sets["xmax"], 0], 0.5)
+    # per section: (6 + 1 + ... ) nodes; the web's grid lines are shared
+    assert m.node_sets["xmin"].size == m.n_nodes // 21
+    # 2D: the polygon itself as quads
+    q = prism_mesh(L_POLY, 0.05, 2)
+    assert q.kind == "quad4" and q.n_elements * 0.05**2 == pytest.approx(L_AREA, rel=1e-9)
+    assert np.all(q.points[:, 2] == 0.0)
+
+
+def test_prism_mesh_deck_and_its_errors():
+    """A [mesh.prism] deck builds the I; a 2D prism with a length and a mesh
+    with two sources are refused naming the field."""
+    from sphdyn.model import build_model
+    pts = ('[[0, 0], ["120 mm", 0], ["120 mm", "40 mm"], ["80 mm", "40 mm"], '
+           '["80 mm", "160 mm"], ["120 mm", "160 mm"], ["120 mm", "200 mm"], [0, "200 mm"], '
+           '[0, "160 mm"], ["40 mm", "160 mm"], ["40 mm", "40 mm"], [0, "40 mm"]]')
+
+    def deck(prism, dim=3, extra=""):
+        return f"""
+[run]
+dimension = {dim}
+t_end = "1 us"
+{STEEL}[[mesh]]
+name = "girder"
+material = "steel"
+prism = {prism}
+{extra}
+"""
+    d = loads_deck(deck(f'{{ points = {pts}, axis = "x", length = "400 mm", '
+                        'element_size = "20 mm" }'))
+    model = build_model(d)
+    mm = model.meshes[0]
+    assert mm.cells.shape[0] == round(I_AREA * 0.4 / 0.02**3)
+    with pytest.raises(DeckError, match=r"mesh\[0\]\.prism\.length: .*means nothing in a 2D deck"):
+        loads_deck(deck(f'{{ points = {pts}, length = "400 mm", element_size = "20 mm" }}',
+                        dim=2))
+    with pytest.raises(DeckError, match="exactly one source"):
+        loads_deck(deck(f'{{ points = {pts}, axis = "x", length = "400 mm", '
+                        'element_size = "20 mm" }',
+                        extra='block = { lo = [0, 0, 0], hi = [1, 1, 1], '
+                              'divisions = [1, 1, 1] }'))

@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from .state import BC_FIXED, BC_SLAVE
+from .state import BC_COMPONENTS, BC_FIXED, BC_SLAVE
 
 
 #: particles per block of the kick's energy sums: the sums are taken block by
@@ -45,7 +45,8 @@ def kick(v, a, a_contact, m, bc, bc_v, dt_kick, v_out_mean, sums):
     ``v`` (N, 3) is advanced in place from :math:`n-1/2` to :math:`n+1/2`;
     ``a`` (N, 3) is the total acceleration (including ``a_contact``, the part
     from contact, (N, 3)). ``bc``/``bc_v`` impose fixed or prescribed
-    velocities. ``v_out_mean`` (N, 3) receives :math:`\mathbf v^n`. ``sums`` is
+    velocities, on every component or (``BC_COMPONENTS | mask``) on the
+    masked ones only, the others free. ``v_out_mean`` (N, 3) receives :math:`\mathbf v^n`. ``sums`` is
     the (blocks, 3) scratch of :func:`kick_scratch`: each block of
     :data:`KICK_BLOCK` particles is summed in order, then the blocks in order,
     so the energies are the same bits on any number of threads.
@@ -81,6 +82,11 @@ def kick(v, a, a_contact, m, bc, bc_v, dt_kick, v_out_mean, sums):
                     t0 = 0.0
                     t1 = 0.0
                     t2 = 0.0
+                elif bc[i] >= BC_COMPONENTS:  # the masked components only
+                    mask = bc[i] - BC_COMPONENTS
+                    t0 = bc_v[i, 0] if mask & 1 else n0
+                    t1 = bc_v[i, 1] if mask & 2 else n1
+                    t2 = bc_v[i, 2] if mask & 4 else n2
                 else:
                     t0 = bc_v[i, 0]
                     t1 = bc_v[i, 1]
@@ -149,6 +155,16 @@ def cfl_time_step(h, c, v, scale, cfl):
             best = t
             k = i
     return cfl * best, k
+
+
+@njit(cache=True, error_model="numpy")
+def ordered_sum(values):
+    """Sum of ``values`` (N,) in index order (the same bits on any thread count
+    and any BLAS)."""
+    s = 0.0
+    for i in range(values.shape[0]):
+        s += values[i]
+    return s
 
 
 @njit(cache=True, error_model="numpy")

@@ -100,7 +100,8 @@ def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
         value = {"fixed": (0.0, 0.0, 0.0), "velocity": bnd.velocity,
                  "displacement": bnd.displacement}[bnd.type]
         out.append(PrescribedMotion(_unique(bnd.set, taken), part, idx, kind=bnd.type,
-                                    value=value, ramp_time=bnd.ramp_time, shape=bnd.ramp))
+                                    value=value, ramp_time=bnd.ramp_time, shape=bnd.ramp,
+                                    components=bnd.axes))
         if bnd.rotations == "fixed":
             rot = getattr(part.kin, "rot", None)
             if rot is None:
@@ -141,11 +142,17 @@ def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
             rows = np.flatnonzero(sph_part.p.body == own)
             out.append(SublayerCoupling(f"{mm.name}_sublayer", sph_part, part, rows,
                                         np.arange(part.kin.n)))
-        ero = mm.spec.erosion
-        if ero is not None and ero.to == "particles" and not (
+        ero, con = mm.spec.erosion, mm.spec.contact
+        if con is not None:
+            out.append(PenaltyCoupling(f"{mm.name}_contact", sph_part, part,
+                                       stiffness=con.stiffness, alpha=con.alpha,
+                                       thickness_factor=con.thickness_factor,
+                                       friction=con.friction))
+        elif ero is not None and ero.to == "particles" and not (
                 mm.converted is not None and mm.converted.spec.coupling == "penalty"):
-            # the debris meets the remaining elements by penalty (a [mesh.convert]
-            # penalty coupling does it already: it couples every particle)
+            # the debris meets the remaining elements by penalty ([mesh.contact]
+            # or a [mesh.convert] penalty coupling does it already: they couple
+            # every particle)
             out.append(PenaltyCoupling(f"{mm.name}_debris", sph_part, part,
                                        stiffness=ero.stiffness, alpha=ero.alpha,
                                        thickness_factor=ero.thickness_factor,

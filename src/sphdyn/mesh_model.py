@@ -19,7 +19,8 @@ from .deck import DeckError
 from .deck.errors import format_problem
 from .geometry import select
 from .geometry.convert import element_centroids, elements_to_particles, hybrid_points
-from .geometry.mesh import MeshData, block_mesh, check_elements, line_mesh, read_mesh
+from .geometry.mesh import (MeshData, block_mesh, check_elements, line_mesh, prism_mesh,
+                            read_mesh)
 
 #: Element kind of a solid mesh by dimension.
 SOLID_KIND = {3: "hex8", 2: "quad4"}
@@ -90,6 +91,9 @@ def _read(spec, where: str, dim: int) -> MeshData:
     if spec.block is not None:
         b = spec.block
         return block_mesh(b.lo, b.hi, b.divisions, dim)
+    if spec.prism is not None:
+        m = spec.prism
+        return prism_mesh(m.points, m.element_size, dim, m.axis, m.base, m.length)
     if spec.line is not None:
         return line_mesh(spec.line.start, spec.line.end, spec.line.count)
     try:

@@ -23,7 +23,7 @@ from .interactions.wall import STIFFNESS, WallSpec
 from .deck import DeckError
 from .deck.errors import format_problem
 from .preflight import checked_lattices, support_radius
-from .materials import MaterialGroup, get_model
+from .materials import MaterialGroup, get_model, history_layout
 from .mesh_model import MeshModel, build_meshes, mesh_node_set
 from .probes import Probe, quantity
 from .state import Particles
@@ -121,9 +121,12 @@ def _phase_materials(deck, b: int, body, x: np.ndarray, dim: int, mat_index: dic
     return table[phases], phases
 
 
-def _material_groups(deck, particles: Particles, models: dict,
-                     params: dict) -> tuple[list[MaterialGroup], np.ndarray]:
+def _material_groups(deck, particles: Particles, models: dict, params: dict,
+                     first: dict) -> tuple[list[MaterialGroup], np.ndarray]:
     """Material groups of the particles and the (N,) variation factor.
+
+    ``first`` gives each model's first history column
+    (:func:`~sphdyn.materials.history_layout`).
 
     One group per material, or, with ``[material.variation]``, one per
     class of the varied parameter: the parameter times the class factor
@@ -137,9 +140,11 @@ def _material_groups(deck, particles: Particles, models: dict,
         idx = np.flatnonzero(particles.mat == k).astype(np.int64)
         if not idx.size:
             continue
+        column = first[models[m.name].history_names]
         var = m.variation
         if var is None or var.cov == 0.0:
-            groups.append(MaterialGroup(m.name, models[m.name], params[m.name], idx, k))
+            groups.append(MaterialGroup(m.name, models[m.name], params[m.name], idx, k,
+                                        column))
             continue
         rng = variation_rng(deck.run.seed, k)
         if var.scope == "sample":
@@ -153,7 +158,7 @@ def _material_groups(deck, particles: Particles, models: dict,
             sub = idx[cls == c]
             values = {**base, var.parameter: base[var.parameter] * f[c]}
             groups.append(MaterialGroup(f"{m.name}#{c}", models[m.name],
-                                        models[m.name].pack(values), sub, k))
+                                        models[m.name].pack(values), sub, k, column))
             factor[sub] = f[c]
     return groups, factor
 
@@ -197,13 +202,8 @@ def build_model(deck) -> Model:
     mat_index = {m.name: k for k, m in enumerate(deck.material)}
     models = {m.name: get_model(m.model) for m in deck.material}
     params = {name: models[name].pack(m.values()) for name, m in mats.items()}
-    n_hist = max([len(models[n].history_names) for n in mats] + [0])
-    layouts = {models[n].history_names for n in mats} - {()}
-    if len(layouts) > 1:
-        raise ValueError(
-            "materials with different history variables cannot share a model yet "
-            f"({' vs '.join(str(list(h)) for h in sorted(layouts))}): history columns "
-            "are stored by position; use materials of one model family per run")
+    hist_names, first = history_layout(models.values())
+    n_hist = len(hist_names)
 
     density_of = np.array([m.density for m in deck.material])
     parts, phase_parts = [], []
@@ -245,7 +245,7 @@ def build_model(deck) -> Model:
         p.h[:] = deck.sph.h_factor * body.dx
         p.h0[:] = p.h
         p.body[:] = b
-        p.hist_names = list(models[body.material].history_names)
+        p.hist_names = hist_names
         parts.append(p)
     body_names = [b.name for b in deck.body]
     for mm in meshes:
@@ -262,7 +262,7 @@ def build_model(deck) -> Model:
         body_names.append(_extra_name(mm, body_names, "debris"))
     particles = (Particles.concatenate(parts) if parts
                  else Particles.allocate(0, dim, n_hist))
-    particles.hist_names = list(next(iter(layouts), ()))
+    particles.hist_names = list(hist_names)
     hs = deck.sph.smoothing_length
     if hs.initial == "adaptive" and n_bodies > dim:
         # support sized by the local spacing (geometry.spacing); a bar's
@@ -272,13 +272,14 @@ def build_model(deck) -> Model:
             hs.min_factor, hs.max_factor, support_radius(deck.sph))
         particles.h0[:n_bodies] = particles.h[:n_bodies]
 
-    groups, factor = _material_groups(deck, particles, models, params)
+    groups, factor = _material_groups(deck, particles, models, params, first)
     have = {g.material for g in groups}
     for k in sorted({int(k) for mm in debris_meshes(meshes) for k in np.unique(mm.mat)}
                     - have):  # an empty group for the debris of each eroding material
         m = deck.material[k]
         groups.append(MaterialGroup(m.name, models[m.name], params[m.name],
-                                    np.zeros(0, np.int64), k))
+                                    np.zeros(0, np.int64), k,
+                                    first[models[m.name].history_names]))
 
     _seat_sublayers(deck, meshes, particles, body_names)
     for g in groups:
@@ -287,7 +288,7 @@ def build_model(deck) -> Model:
         particles.c[g.idx] = g.model.wave_speed(g.params, particles.rho0[g.idx[0]])  # one density per material
         h0 = g.model.initial_history(g.params)
         if len(h0):
-            particles.hist[np.ix_(g.idx, np.arange(len(h0)))] = h0
+            particles.hist[np.ix_(g.idx, g.column + np.arange(len(h0)))] = h0
 
     body_index = {b.name: k for k, b in enumerate(deck.body)}
     sets: dict[str, np.ndarray] = {}

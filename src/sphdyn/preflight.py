@@ -62,6 +62,12 @@ def support_radius(sph) -> float:
     return support(kernel_id(sph.kernel)) * sph.support_scale
 
 
+def prism_volume(prism, dim: int) -> float:
+    """Volume of a prism (a body's or a [mesh.prism]) [m^3], its area [m^2] in 2D."""
+    area = abs(polygon_area(prism.points))
+    return area if dim == 2 else area * prism.length
+
+
 def shape_volume(geometry, dim: int) -> float:
     """Closed-form volume of a body geometry [m^3], or area [m^2] in 2D."""
     g = geometry
@@ -70,8 +76,7 @@ def shape_volume(geometry, dim: int) -> float:
     if g.shape == "sphere":
         return ball_volume(g.radius, dim)
     if g.shape == "prism":
-        area = abs(polygon_area(g.points))
-        return area if dim == 2 else area * g.length
+        return prism_volume(g, dim)
     outer = g.radius if g.shape == "cylinder" else g.outer_radius
     inner = 0.0 if g.shape == "cylinder" else g.inner_radius
     area = ball_volume(outer, 2) - ball_volume(inner, 2)
@@ -204,10 +209,25 @@ def estimate_size(deck) -> SizeEstimate:
     radius = support_radius(sph) * sph.h_factor * (1.0 + sph.neighbours.skin_factor)
     pairs = ball_volume(radius, dim)
     per_particle = PARTICLE_BYTES + 8 * _history_width(deck)
-    meshes = {m.name: float(np.prod(m.block.divisions)) if m.block is not None
-              else float(m.line.count) for m in deck.mesh if m.file is None}
+    meshes = {m.name: _element_count(m, dim) for m in deck.mesh if m.file is None}
     return SizeEstimate(bodies, n, pairs, n * per_particle,
                         n * pairs * PAIR_BYTES if n and pairs else 0.0, meshes)
+
+
+def _element_count(mesh, dim: int) -> float:
+    """Elements of a generated [[mesh]] (the prism's by its volume)."""
+    if mesh.block is not None:
+        return float(np.prod(mesh.block.divisions))
+    if mesh.prism is not None:
+        return lattice_count(prism_volume(mesh.prism, dim), mesh.prism.element_size, dim)
+    return float(mesh.line.count)
+
+
+def _mesh_source(mesh) -> str:
+    """The deck key that sets a generated mesh's size."""
+    if mesh.prism is not None:
+        return "prism.element_size"
+    return f"{'block' if mesh.block is not None else 'line'}.divisions"
 
 
 def check_size(deck) -> SizeEstimate:
@@ -219,7 +239,7 @@ def check_size(deck) -> SizeEstimate:
             k = max(range(len(deck.mesh)), key=lambda j: est.meshes.get(deck.mesh[j].name, 0))
             m = deck.mesh[k]
             raise DeckError([format_problem(
-                f"mesh[{k}].{'block' if m.block is not None else 'line'}.divisions",
+                f"mesh[{k}].{_mesh_source(m)}",
                 f"the model needs {est.summary()}, over the memory limit of "
                 f"{show_bytes(limit)} ({source}); mesh '{m.name}' alone has "
                 f"{show_count(est.meshes[m.name])} elements",

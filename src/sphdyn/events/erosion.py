@@ -231,9 +231,9 @@ class ElementErosion:
         p.L[rows] = 0.0
         p.c[rows] = f["c"]
         p.damage[rows] = f["damage"]
-        nh = min(p.hist.shape[1], f["hist"].shape[1])
-        p.hist[rows] = 0.0
-        p.hist[rows, :nh] = f["hist"][:, :nh]
+        p.hist[rows] = 0.0  # the element's history, column by column by name
+        for col, name in enumerate(self.solid.pts.hist_names):
+            p.hist[rows, p.hist_names.index(name)] = f["hist"][:, col]
         p.mat[rows] = f["mat"]
         p.body[rows] = self.body
         p.notify_grown(rows.start, rows.stop)

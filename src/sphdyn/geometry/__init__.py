@@ -22,6 +22,7 @@ from .mesh import (
     check_elements,
     element_jacobians,
     line_mesh,
+    prism_mesh,
     read_mesh,
 )
 from .regions import REGION_SHAPES, bounding_box, select
@@ -41,6 +42,7 @@ __all__ = [
     "MeshData",
     "block_mesh",
     "line_mesh",
+    "prism_mesh",
     "read_mesh",
     "element_jacobians",
     "check_elements",

@@ -33,7 +33,8 @@ from pathlib import Path
 import meshio
 import numpy as np
 
-from .lattice import _check_dim, _point
+from .lattice import (PRISM_PLANES, _RTOL, _axis_index, _check_dim, _count, _point,
+                      _positive, polygon_contains)
 from .shapes import corner_signs, shape_derivatives
 
 __all__ = [
@@ -41,6 +42,7 @@ __all__ = [
     "MeshData",
     "block_mesh",
     "line_mesh",
+    "prism_mesh",
     "read_mesh",
     "element_jacobians",
     "check_elements",
@@ -340,6 +342,75 @@ def block_mesh(lo, hi, divisions, dim: int) -> MeshData:
     return MeshData(points, cells, kind, node_sets=node_sets,
                     element_sets={"all": np.arange(cells.shape[0])},
                     source=f"block_mesh({dim}D box)")
+
+
+def prism_mesh(points, element_size: float, dim: int, axis="z", base: float = 0.0,
+               length=None) -> MeshData:
+    """Structured mesh of a prism: the cells of a grid over a polygon that lie
+    in it, extruded along an axis (hex8; quad4 of the polygon itself in 2D).
+    An I-, T- or L-section member meshed like the particles of the
+    ``prism`` body shape (:func:`~sphdyn.geometry.lattice.prism_lattice`).
+
+    Parameters
+    ----------
+    points : (k, 2) array_like, k >= 3
+        Polygon vertices [m] in order, in the plane normal to ``axis``:
+        (x, y) for "z", (y, z) for "x", (z, x) for "y".
+    element_size : float
+        Nominal element edge [m]: each direction of the polygon's bounding box
+        (and the extrusion) gets the nearest whole number of equal elements.
+    dim : {2, 3}
+        In 2D the axis must be "z" and ``length`` absent.
+    axis, base, length
+        3D: the prism spans ``[base, base + length]`` along the axis [m].
+
+    Returns
+    -------
+    MeshData
+        The elements of the block mesh of the bounding box whose centroids lie
+        in the polygon (within 1e-9 of its size), the nodes they use
+        (renumbered in grid order). With ``element_size`` equal to a particle
+        spacing ``dx`` and the extents whole multiples of it, the centroids
+        are the particles of the ``prism`` lattice; with the vertices on the
+        grid, the mesh fills the polygon
+        exactly (else it is the staircase of the cells whose centres are in).
+        Sets: ``"all"`` (nodes and elements), ``"<axis>min"``/``"<axis>max"``
+        for the extrusion's end faces (3D).
+    """
+    dim = _check_dim(dim)
+    size = _positive("element_size", element_size)
+    poly = np.asarray(points, dtype=np.float64)
+    if poly.ndim != 2 or poly.shape[1] != 2 or poly.shape[0] < 3:
+        raise ValueError(f"points must be three or more [u, v] pairs, got shape {poly.shape}")
+    ax = _axis_index(axis)
+    if dim == 2 and (ax != 2 or length is not None):
+        raise ValueError("a 2D prism mesh is the polygon in the x-y plane: axis 'z', no length")
+    pu, pv = PRISM_PLANES[ax]
+    lo, hi, n = np.zeros(3), np.zeros(3), [1, 1, 1]
+    (lo[pu], lo[pv]), (hi[pu], hi[pv]) = poly.min(axis=0), poly.max(axis=0)
+    if dim == 3:
+        lo[ax], hi[ax] = float(base), float(base) + _positive("length", length)
+    for a in range(dim):
+        n[a] = _count(hi[a] - lo[a], size)
+    box = block_mesh(lo, hi, n[:dim], dim)
+    centres = box.points[box.cells].mean(axis=1)
+    extent = max(float(np.max(hi[:dim] - lo[:dim])), size)
+    keep = polygon_contains(poly, centres[:, [pu, pv]], _RTOL * extent)
+    if not keep.any():
+        raise ValueError(f"no element of size {size} m has its centre in the polygon")
+    cells = box.cells[keep]
+    used = np.unique(cells)
+    renumber = np.full(box.n_nodes, -1, dtype=np.int64)
+    renumber[used] = np.arange(used.size)
+    node_sets = {"all": np.arange(used.size)}
+    if dim == 3:
+        name = "xyz"[ax]
+        for end, value in (("min", lo[ax]), ("max", hi[ax])):
+            on = np.isclose(box.points[used, ax], value, rtol=0.0, atol=_RTOL * extent)
+            node_sets[f"{name}{end}"] = np.flatnonzero(on)
+    return MeshData(box.points[used], renumber[cells], box.kind, node_sets=node_sets,
+                    element_sets={"all": np.arange(cells.shape[0])},
+                    source=f"prism_mesh({dim}D, {poly.shape[0]}-gon)")
 
 
 def line_mesh(start, end, n: int) -> MeshData:

@@ -23,7 +23,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ..state import BC_FIXED, BC_VELOCITY
+from ..state import BC_COMPONENTS, BC_FIXED, BC_VELOCITY
 from .base import InteractionBase
 
 RAMPS = ("linear", "smooth")
@@ -112,6 +112,9 @@ class PrescribedMotion(_SetInteraction):
         reached over the ramp, then held).
     value : (3,) vector.
     ramp_time : T [s]; ``shape``: ``linear`` or ``smooth``.
+    components : the axes (0, 1, 2) the condition holds (default all); the
+        others stay free (a roller support holds only the normal). Conditions
+        on different components of the same items combine.
 
     Each step [t, t + dt] the items get the velocity that moves them exactly
     along the displacement history: :math:`(d(t + \\Delta t) - d(t))/\\Delta t`
@@ -123,20 +126,37 @@ class PrescribedMotion(_SetInteraction):
     """
 
     def __init__(self, name: str, part, idx, kind: str = "fixed", value=(0.0, 0.0, 0.0),
-                 ramp_time: float = 0.0, shape: str = "linear"):
+                 ramp_time: float = 0.0, shape: str = "linear", components=(0, 1, 2)):
         super().__init__(name, part, idx)
         if kind not in ("fixed", "velocity", "displacement"):
             raise ValueError(f"{name}: kind must be fixed, velocity or displacement")
         if shape not in RAMPS:
             raise ValueError(f"{name}: ramp shape must be one of {RAMPS}")
+        self.comps = np.unique(np.asarray(components, dtype=np.int64))
+        if self.comps.size == 0 or self.comps[0] < 0 or self.comps[-1] > 2:
+            raise ValueError(f"{name}: components must be axes 0, 1, 2, got {components!r}")
         self.kind, self.shape = kind, shape
         self.value = np.asarray(value, dtype=float)
         self.ramp_time = float(ramp_time)
         q = part.kin
-        q.bc[self.idx] = BC_FIXED if kind == "fixed" else BC_VELOCITY
-        q.bc_v[self.idx] = 0.0
-        q.v[self.idx] = self.velocity(0.0, 0.0)
+        if self.comps.size == 3:
+            q.bc[self.idx] = BC_FIXED if kind == "fixed" else BC_VELOCITY
+        else:
+            mask = int(np.sum(1 << self.comps))
+            old = q.bc[self.idx].astype(np.int64)
+            # earlier conditions on the same items combine with this one
+            held = np.where(old >= BC_COMPONENTS, old - BC_COMPONENTS,
+                            np.where((old == BC_FIXED) | (old == BC_VELOCITY), 7, 0))
+            mask = held | mask
+            q.bc[self.idx] = np.where(mask == 7, BC_VELOCITY, BC_COMPONENTS + mask)
+        self._set(q.v, self.velocity(0.0, 0.0))
+        self._set(q.bc_v, self.velocity(0.0, 0.0))
         self.reaction = np.zeros(3)
+
+    def _set(self, target: np.ndarray, value: np.ndarray) -> None:
+        """``target[idx, comps] = value[comps]`` (the held components only)."""
+        for c in self.comps:
+            target[self.idx, c] = value[c]
 
     def displacement(self, t: float) -> np.ndarray:
         """Prescribed displacement at ``t`` [m] (``displacement`` kind)."""
@@ -154,7 +174,7 @@ class PrescribedMotion(_SetInteraction):
 
     def prescribe(self, t: float, dt: float) -> None:
         if self.kind != "fixed":
-            self.part.kin.bc_v[self.idx] = self.velocity(t, dt)
+            self._set(self.part.kin.bc_v, self.velocity(t, dt))
 
     def forces(self, t: float, dt: float, a_out: np.ndarray) -> None:
         return None

@@ -22,7 +22,7 @@ from .base import (
     register,
     von_mises,
 )
-from .registry import ENTRY_POINT_GROUP, load_entry_points, material_schemas
+from .registry import ENTRY_POINT_GROUP, history_layout, load_entry_points, material_schemas
 from .elastic import ELASTIC, ElasticParams, elastic_point, elastic_update
 from .j2 import J2, J2Params, j2_point, j2_update
 from .cscm import CSCM, CscmParams, cscm_point, cscm_update
@@ -35,6 +35,7 @@ __all__ = [
     "MaterialModel",
     "available_models",
     "get_model",
+    "history_layout",
     "load_entry_points",
     "material_schemas",
     "register",

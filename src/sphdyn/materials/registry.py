@@ -55,6 +55,42 @@ class MaterialGroup:
     params: np.ndarray
     idx: np.ndarray  # int64 item indices
     material: int = 0
+    column: int = 0  # first column of the model's history in the part's hist
+
+    def history(self, hist: np.ndarray) -> np.ndarray:
+        """The part's history (N, width) as the kernel sees it: its columns from
+        ``column`` on (a view; the array itself when ``column`` is 0)."""
+        return hist if self.column == 0 else hist[:, self.column:]
+
+
+def history_layout(models) -> tuple[list[str], dict[tuple[str, ...], int]]:
+    """One history array for items of several material models.
+
+    The models' column lists (``history_names``) are laid side by side: the
+    longest first, at column 0; a list that is the start of the columns so
+    far shares them (models of one family); any other follows the last
+    column. Returns the names of the columns and, per list of names, its
+    first column (:attr:`MaterialGroup.column`). Each item's model sees its
+    own columns from 0 (:meth:`MaterialGroup.history`), the others of its
+    row stay at zero. ``ValueError`` if a name would sit in two columns.
+    """
+    layouts = []
+    for m in models:
+        if m.history_names not in layouts:
+            layouts.append(m.history_names)
+    names: list[str] = []
+    first: dict[tuple[str, ...], int] = {}
+    for layout in sorted(layouts, key=len, reverse=True):
+        if tuple(names[:len(layout)]) == layout:
+            first[layout] = 0
+            continue
+        clash = sorted(set(layout) & set(names))
+        if clash:
+            raise ValueError(f"history variables {clash} of two material models would "
+                             "need two columns; use one of these models per run")
+        first[layout] = len(names)
+        names += layout
+    return names, first
 
 
 @dataclass(frozen=True)

@@ -6,11 +6,11 @@ the SPH particle fields on it; :mod:`~sphdyn.state.mesh` the mesh nodes,
 elements and integration points of finite-element parts.
 """
 
-from .particles import (BC_FIXED, BC_FREE, BC_SLAVE, BC_VELOCITY, KINEMATICS, PARTICLE_FIELDS,
-                        Kinematics, Particles)
+from .particles import (BC_COMPONENTS, BC_FIXED, BC_FREE, BC_SLAVE, BC_VELOCITY, KINEMATICS,
+                        PARTICLE_FIELDS, Kinematics, Particles)
 from .mesh import POINT_FIELDS, Elements, MaterialPoints, Nodes
 from .store import STATE, WORK, ArrayStore
 
-__all__ = ["ArrayStore", "BC_FIXED", "BC_FREE", "BC_SLAVE", "BC_VELOCITY", "Elements", "KINEMATICS",
-           "Kinematics", "MaterialPoints", "Nodes", "PARTICLE_FIELDS", "POINT_FIELDS",
+__all__ = ["ArrayStore", "BC_COMPONENTS", "BC_FIXED", "BC_FREE", "BC_SLAVE", "BC_VELOCITY",
+           "Elements", "KINEMATICS", "Kinematics", "MaterialPoints", "Nodes", "PARTICLE_FIELDS", "POINT_FIELDS",
            "Particles", "STATE", "WORK"]

@@ -29,6 +29,10 @@ BC_VELOCITY = 2
 #: hybrid coupling's slave particle): the kick leaves it alone and books
 #: neither its kinetic energy nor work (its mass is carried by its masters)
 BC_SLAVE = 3
+#: ``BC_COMPONENTS | mask`` (mask 1..6, bits x = 1, y = 2, z = 4): the
+#: components in the mask take ``bc_v``, the others move freely (a support
+#: that holds one direction: LS-DYNA's SPC with DOFX/DOFY/DOFZ)
+BC_COMPONENTS = 8
 
 #: name -> (tail shape, dtype) of the kinematics every part has (particles now,
 #: mesh nodes later). ``a_ext`` is the part of ``a`` from interactions (walls,
@@ -63,9 +67,11 @@ class Kinematics(ArrayStore):
     m : (N,) float64
         Mass [kg] (kg/m in 2D). May be zero (initial cracks).
     bc : (N,) int8
-        ``BC_FREE``, ``BC_FIXED``, ``BC_VELOCITY`` or ``BC_SLAVE``.
+        ``BC_FREE``, ``BC_FIXED``, ``BC_VELOCITY``, ``BC_SLAVE`` or
+        ``BC_COMPONENTS | mask``.
     bc_v : (N, 3) float64
-        Prescribed velocity for ``BC_VELOCITY`` items [m/s].
+        Prescribed velocity for ``BC_VELOCITY`` items and the masked
+        components of ``BC_COMPONENTS`` items [m/s].
     active : (N,) int8
         1 for items taking part in the run (erosion will clear it).
     """

@@ -30,7 +30,7 @@ class Mesostructure(Section):
     Aggregate, mortar and interfacial transition zone (ITZ) are generated
     on the body's particles (thesis sec. 7.2; docs/mesostructure.md) and
     each phase takes its own [[material]] (e.g. CSCM with different fc or
-    density; all of one model family). The field is seeded by run.seed and
+    density, or elastic aggregate in CSCM mortar). The field is seeded by run.seed and
     the body's index, so ensembles vary it through run.seed.
     """
 

@@ -1,14 +1,16 @@
 """Deck section [[mesh]]: finite-element parts and the regions turned into particles.
 
 A mesh is a generated block of hexahedra (3D) or plane-strain quadrilaterals
-(2D) ([mesh.block]), a generated line of beams or trusses ([mesh.line]), or a
+(2D) ([mesh.block]), a generated prism of them (a polygon section extruded,
+[mesh.prism]), a generated line of beams or trusses ([mesh.line]), or a
 Gmsh / Abaqus file (``file``). Its elements use the deck's materials through
 the same point functions as particles (docs/theory.md, "Solid elements").
 [mesh.convert] replaces the elements of a region by SPH particles (one per
 element, at its centroid, with its volume and mass; thesis ch. 4) and couples
 them to the remaining mesh. [mesh.erosion] lets elements erode during the
 run by their material's [material.erosion] rules, deleted or turned into SPH
-particles (thesis 5.3).
+particles (thesis 5.3). [mesh.contact] makes the particles of every body
+meet the mesh's faces (an SPH projectile on a finite-element target).
 """
 
 from typing import Literal, Optional
@@ -21,7 +23,7 @@ from ..values import (Direction, ExistingFile, Position, PositiveLength, Section
                       UpperPosition, VelocityVector, integer, name_of, quantity, real,
                       reference_to)
 from ..scope import dimension
-from .shapes import Region
+from .shapes import PrismKeys, Region
 
 #: Elements of a generated block or a file, by dimension.
 SOLID_ELEMENTS = {3: "hex8", 2: "quad4"}
@@ -44,6 +46,21 @@ class BlockMesh(Section):
             raise problem(f"divisions has {len(self.divisions)} entries in a {dim}D deck",
                           f"give {dim} element counts, one per axis")
         return self
+
+
+class PrismMesh(PrismKeys):
+    """[mesh.prism]: a polygon extruded along an axis, meshed by a grid of hexahedra
+    (3D; quadrilaterals of the polygon in 2D): an I-, T- or L-section member.
+
+    The elements of the grid over the polygon's bounding box whose centres
+    lie in the polygon; with element_size equal to a prism body's dx (and
+    the polygon's extents multiples of it) the element centres are that
+    body's particles, so an SPH model and its FEM reference share the
+    geometry (thesis 6.1)."""
+
+    element_size: PositiveLength = Field(
+        description="Element edge: each direction gets the nearest whole number of "
+                    "equal elements.")
 
 
 class LineMesh(Section):
@@ -131,6 +148,16 @@ class PenaltyKeys(Section):
                          "V^(1/d).")
 
 
+class Contact(PenaltyKeys):
+    """[mesh.contact]: the particles of every body meet the mesh's exterior faces
+    by penalty (an SPH projectile or impactor on a finite-element target).
+
+    Particles are slave nodes, the element faces the master surface, which
+    follows erosion (the faces an eroded element exposes take part); the
+    debris of [mesh.erosion] meets the mesh through it too.
+    """
+
+
 class Convert(PenaltyKeys):
     """[mesh.convert]: elements of a region become SPH particles, coupled to the rest.
 
@@ -202,8 +229,9 @@ class MeshErosion(PenaltyKeys):
     ``to = "particles"``: each eroded element becomes SPH particles with its
     mass, momentum, energy, stress and history (thesis 5.3), in a body named
     ``<mesh>_debris`` (updated-Lagrangian, the [sph] settings), which meets the
-    remaining elements through a penalty coupling (the [mesh.convert]
-    penalty coupling if there is one). ``to = "nothing"``: LS-DYNA's plain
+    remaining elements through a penalty coupling (that of [mesh.contact] or
+    the [mesh.convert] penalty coupling if there is one: then this table's
+    penalty keys are not used). ``to = "nothing"``: LS-DYNA's plain
     erosion; the mass and energy lost are in the history.
     """
 
@@ -238,6 +266,8 @@ class Mesh(Section):
                           "[[mesh.group]]). Required unless groups cover the file.")
     block: Optional[BlockMesh] = Field(None, description="A generated block of solid "
                                                          "elements.")
+    prism: Optional[PrismMesh] = Field(
+        None, description="A generated prism (I-, T-, L-section) of solid elements.")
     line: Optional[LineMesh] = Field(None, description="A generated line of beams or "
                                                        "trusses.")
     file: Optional[ExistingFile] = Field(
@@ -278,6 +308,9 @@ class Mesh(Section):
         None, description="A region of elements replaced by SPH particles.")
     erosion: Optional[MeshErosion] = Field(
         None, description="Elements erode during the run ([mesh.erosion]).")
+    contact: Optional[Contact] = Field(
+        None, description="Particles of every body meet this mesh's faces by penalty "
+                          "([mesh.contact]; solid meshes).")
     embed: Optional[reference_to("mesh")] = Field(
         None, description="A bar embedded in this solid mesh: each node moves with "
                           "the element it lies in (perfect bond, LS-DYNA's "
@@ -288,12 +321,13 @@ class Mesh(Section):
 
     @model_validator(mode="after")
     def _one_source(self):
-        given = [k for k in ("block", "line", "file") if getattr(self, k) is not None]
+        given = [k for k in ("block", "prism", "line", "file") if getattr(self, k) is not None]
         if len(given) != 1:
             raise problem(
                 "a mesh needs exactly one source" + (
                     f" (got {', '.join(given)})" if given else ""),
-                "give one of [mesh.block], [mesh.line] or file = \"part.msh\"")
+                "give one of [mesh.block], [mesh.prism], [mesh.line] or "
+                "file = \"part.msh\"")
         if self.line is not None:
             if self.element is None or self.section is None:
                 raise problem("a [mesh.line] needs element and [mesh.section]",
@@ -305,6 +339,9 @@ class Mesh(Section):
             if self.erosion is not None:
                 raise problem("only solid elements erode",
                               "remove [mesh.erosion] from the line mesh")
+            if self.contact is not None:
+                raise problem("particles meet the faces of solid elements",
+                              "remove [mesh.contact] from the line mesh")
         elif self.sublayer is not None or self.embed is not None:
             raise problem("a sublayer or an embedding couples bars (a [mesh.line] of "
                           "beams or trusses)", "remove [mesh.sublayer] and embed, or make "
@@ -323,6 +360,18 @@ class Mesh(Section):
                           "remove [[mesh.group]] or read the mesh from a file")
         if self.material is None and not self.group:
             raise problem("the mesh has no material", "add material = \"<name>\"")
+        if (self.contact is not None and self.convert is not None
+                and self.convert.coupling == "penalty"):
+            raise problem("[mesh.convert]'s penalty coupling already makes every particle "
+                          "meet the mesh's faces", "remove [mesh.contact] (give its keys "
+                          "in [mesh.convert])")
+        if self.contact is not None and self.erosion is not None:
+            given = [k for k in PenaltyKeys.model_fields
+                     if getattr(self.erosion, k) != PenaltyKeys.model_fields[k].default]
+            if given:
+                raise problem(f"erosion's {', '.join(given)}: the debris meets the mesh "
+                              "through [mesh.contact]", f"give {', '.join(given)} in "
+                              "[mesh.contact] and remove them from [mesh.erosion]")
         if (self.erosion is not None and self.erosion.to == "particles"
                 and self.convert is not None and self.convert.coupling in ("tied", "hybrid")):
             raise problem(f"erosion into particles with coupling = "

@@ -69,6 +69,12 @@ class Boundary(Section):
         "linear", description="Ramp shape: linear, or smooth (s - sin(2 pi s)/(2 pi) "
                               "with s = t/ramp_time: a displacement starts and ends "
                               "at rest, less ringing).")
+    components: tuple[Literal["x", "y", "z"], ...] = Field(
+        ("x", "y", "z"), description="The directions the condition holds; the others "
+                                     "stay free (a roller support: components = "
+                                     "[\"z\"]; LS-DYNA's SPC DOFX/DOFY/DOFZ). "
+                                     "Conditions on different components of the same "
+                                     "set combine.")
     rotations: Literal["free", "fixed"] = Field(
         "free", description="Beam nodes: also fix their rotations (a clamped or "
                             "rotation-free moved end).")
@@ -94,7 +100,25 @@ class Boundary(Section):
                           "displacement)")
         if self.type == "fixed" and self.ramp_time != 0.0:
             raise problem("a fixed boundary has no ramp", "remove ramp_time")
+        if not self.components or len(set(self.components)) != len(self.components):
+            raise problem(f"components {list(self.components)} must name each direction "
+                          "at most once, and at least one",
+                          "give e.g. components = [\"z\"] or leave it out (all three)")
+        value = self.velocity if self.type == "velocity" else self.displacement
+        if value is not None:
+            free = [c for k, c in enumerate("xyz") if value[k] != 0.0
+                    and c not in self.components]
+            if free:
+                raise problem(f"the {self.type} has a {' and '.join(free)} component, but "
+                              f"components = {list(self.components)} leaves "
+                              f"{' and '.join(free)} free",
+                              f"add {' and '.join(free)} to components, or give 0 there")
         return self
+
+    @property
+    def axes(self) -> tuple[int, ...]:
+        """The held components as axis indices."""
+        return tuple(sorted("xyz".index(c) for c in self.components))
 
 
 class Load(Section):

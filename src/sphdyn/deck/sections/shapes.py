@@ -125,11 +125,9 @@ def _simple_polygon(points: tuple) -> tuple:
     return points
 
 
-class Prism(Section):
-    """A polygon extruded along an axis (the polygon itself in 2D): an
-    L-specimen, an I- or T-section."""
+class PrismKeys(Section):
+    """The keys of a prism: a polygon, its plane and the extrusion."""
 
-    shape: Literal["prism"] = Field(description="Kind of shape.")
     points: Annotated[tuple[tuple[quantity(LENGTH), quantity(LENGTH)], ...],
                       AfterValidator(_simple_polygon)] = Field(
         description="Polygon vertices [u, v] in order (either sense), in the plane "
@@ -142,6 +140,13 @@ class Prism(Section):
     length: AxialLength = Field(
         None, validate_default=True,
         description="Length of the extrusion; required in 3D, not allowed in 2D.")
+
+
+class Prism(PrismKeys):
+    """A polygon extruded along an axis (the polygon itself in 2D): an
+    L-specimen, an I- or T-section."""
+
+    shape: Literal["prism"] = Field(description="Kind of shape.")
 
 
 Geometry = Annotated[Union[Box, Cylinder, Ring, Sphere, Prism],

@@ -457,12 +457,3 @@ def mass_damping(v, m, damping, a, power):
             a[i, 1] -= damping * v[i, 1]
             a[i, 2] -= damping * v[i, 2]
             power[i] += damping * m[i] * (v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2)
-
-
-@njit(cache=True, error_model="numpy")
-def ordered_sum(values):
-    """Sum of ``values`` (N,) in index order (the same bits on any thread count)."""
-    s = 0.0
-    for i in range(values.shape[0]):
-        s += values[i]
-    return s

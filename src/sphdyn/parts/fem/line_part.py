@@ -66,14 +66,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...integrate import drift
+from ...integrate import drift, ordered_sum
 from ...materials import get_model
 from ...state import Elements, MaterialPoints, Nodes
 from ...state.store import STATE
 from ..base import register_part
 from .beam import (N_RES, RES_L, RES_MY_A, RES_MY_B, RES_MZ_A, RES_MZ_B, RES_N, RES_T,
                    RES_VY, RES_VZ, beam_forces, beam_stable_dt, drift_rotations,
-                   lateral_ratio, lateral_secant, mass_damping, ordered_sum,
+                   lateral_ratio, lateral_secant, mass_damping,
                    truss_forces, truss_gradient, truss_kinematics, truss_stable_dt)
 from .gather import gather_loads, node_element_list
 

@@ -23,8 +23,8 @@ import numpy as np
 
 from ...geometry.mesh import MESH_KINDS
 from ...geometry.shapes import gauss_derivatives, hourglass_vectors, volume_table
-from ...integrate import drift
-from ...materials import MaterialGroup
+from ...integrate import drift, internal_energies, ordered_sum
+from ...materials import MaterialGroup, history_layout
 from ...fields import von_mises
 from ...state import BC_FIXED, STATE, Elements, MaterialPoints, Nodes
 from ..base import register_part
@@ -108,8 +108,8 @@ class SolidPart:
             elements.add("xl", (nen, 3))
             elements.add("g", (nen, 3))
         ne = elements.n
-        n_hist = max([len(m.history_names) for m, _ in materials.values()] + [0])
-        pts = self.pts = MaterialPoints(ne * self.ngp, n_hist)
+        names, first = history_layout([m for m, _ in materials.values()])
+        pts = self.pts = MaterialPoints(ne * self.ngp, len(names))
         pts.elem = np.repeat(np.arange(ne), self.ngp)
         pts.mat = elements.mat[pts.elem]
         if self.reduced:
@@ -119,12 +119,9 @@ class SolidPart:
         for k, (model, params) in sorted(materials.items()):
             idx = np.flatnonzero(pts.mat == k).astype(np.int64)
             if idx.size:
-                self.groups.append(MaterialGroup(f"{name}:{k}", model, params, idx, k))
-        layouts = {g.model.history_names for g in self.groups} - {()}
-        if len(layouts) > 1:
-            raise ValueError(f"part {name!r}: materials with different history variables "
-                             "cannot share a part; split the mesh into parts")
-        pts.hist_names = list(next(iter(layouts), ()))
+                self.groups.append(MaterialGroup(f"{name}:{k}", model, params, idx, k,
+                                                 first[model.history_names]))
+        pts.hist_names = names
         self.offsets, self.slots = node_element_list(elements.conn, nodes.n)
         self._element_geometry()  # vol at x
         elements.vol0 = elements.vol
@@ -139,7 +136,7 @@ class SolidPart:
             pts.c[g.idx] = g.model.wave_speed(g.params, rho0)
             h0 = g.model.initial_history(g.params)
             if len(h0):
-                pts.hist[np.ix_(g.idx, np.arange(len(h0)))] = h0
+                pts.hist[np.ix_(g.idx, g.column + np.arange(len(h0)))] = h0
         # element mass: the points' densities times their share of the volume
         rho_el = pts.rho0.reshape(ne, self.ngp).mean(axis=1)
         elements.m = rho_el * elements.vol0
@@ -224,20 +221,22 @@ class SolidPart:
         p = self.pts
         self._geometry(dt)
         for g in self.groups:
-            g.model.update(g.idx, p.L, dt, p.rho, p.sig, p.e, p.c, p.damage, p.hist,
-                           g.params, p.size)
+            g.model.update(g.idx, p.L, dt, p.rho, p.sig, p.e, p.c, p.damage,
+                           g.history(p.hist), g.params, p.size)
         self._forces(dt)
 
     def energies(self) -> tuple[float, float]:
         """Internal energy (material work, bulk viscosity, hourglass) and its
         bulk-viscosity part [J] (J/m in 2D): the points' masses (``pts.m``,
-        their element's shared evenly) times their specific energies."""
+        their element's shared evenly) times their specific energies, summed
+        in index order (the same bits with any BLAS or thread count)."""
         p = self.pts
-        return float(p.m @ p.e) + self.hourglass_energy(), float(p.m @ p.e_av)
+        u, u_av = internal_energies(p.m, p.e, p.e_av)
+        return u + self.hourglass_energy(), u_av
 
     def hourglass_energy(self) -> float:
-        """Work done against the hourglass forces [J]."""
-        return float(np.sum(self.el.e_hg))
+        """Work done against the hourglass forces [J] (summed in index order)."""
+        return ordered_sum(self.el.e_hg)
 
     def columns(self) -> dict[str, float]:
         """``<name>_E_hourglass``: the hourglass work [J]."""

@@ -222,8 +222,8 @@ class SPHPart:
     def internal_forces(self, t: float, dt: float) -> None:
         p = self.p
         for g in self.groups:
-            g.model.update(g.idx, p.L, dt, p.rho, p.sig, p.e, p.c, p.damage, p.hist,
-                           g.params, p.size)
+            g.model.update(g.idx, p.L, dt, p.rho, p.sig, p.e, p.c, p.damage,
+                           g.history(p.hist), g.params, p.size)
         self._accelerations()
         add_heat(p.e, p.e_av, p.dedt_av, dt)
 
