@@ -236,3 +236,27 @@ def test_bar_particles_take_the_concretes_density():
     rows = np.flatnonzero(p.body == 1)
     assert np.all(p.rho0[rows] == 2400.0) and np.all(p.rho[rows] == 2400.0)
     assert np.allclose(p.vol0[rows], p.m[rows] / 2400.0, rtol=1e-15)
+
+
+def test_sublayer_without_stiffness_carries_no_stress_and_still_transfers_the_pull(tmp_path):
+    """[mesh.sublayer] stiffness = "none": the bar's particles are in no
+    material group (stress and wave speed stay zero) and still pass the pull
+    to the concrete: the grip's, the bond's and the plate's forces agree
+    (1e-3, as with the material's stiffness). Without the particles' own steel
+    (a second bar of 0.5 x 7850/2400 = 1.6 times the bar's area through the
+    kernel) the same 0.2 mm pull needs less force."""
+    grips = {}
+    for stiffness in ("material", "none"):
+        text = deck_text(ratio=f'0.5\nstiffness = "{stiffness}"')
+        sim = Simulation.from_deck(loads_deck(text), tmp_path / stiffness)
+        sim.run()
+        h = read_history_csv(tmp_path / stiffness / "history.csv")
+        grip = grips[stiffness] = h["grip_reaction_x"][-1]
+        assert h["F_bar_sublayer_x"][-1] == pytest.approx(-grip, rel=1e-3)
+        assert h["plate_reaction_x"][-1] == pytest.approx(-grip, rel=1e-3)
+        sph = sim.stepper.part("sph")
+        rows = np.flatnonzero(sph.p.body == 1)
+        if stiffness == "none":
+            assert np.all(sph.p.sig[rows] == 0.0) and np.all(sph.p.c[rows] == 0.0)
+            assert all(np.intersect1d(g.idx, rows).size == 0 for g in sph.groups)
+    assert 5e3 < grips["none"] < 0.9 * grips["material"]

@@ -7,7 +7,7 @@ interactions below it see settings, arrays and scalars only.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -273,6 +273,13 @@ def build_model(deck) -> Model:
         particles.h0[:n_bodies] = particles.h[:n_bodies]
 
     groups, factor = _material_groups(deck, particles, models, params, first)
+    # sublayer particles without a stiffness of their own: in no material group
+    # (their stress stays zero, their wave speed 0)
+    inert = np.flatnonzero(np.isin(particles.body, [
+        body_names.index(f"{mm.name}_sublayer") for mm in sublayer_meshes(meshes)
+        if mm.spec.sublayer.stiffness == "none"]))
+    if inert.size:
+        groups = [replace(g, idx=np.setdiff1d(g.idx, inert)) for g in groups]
     have = {g.material for g in groups}
     for k in sorted({int(k) for mm in debris_meshes(meshes) for k in np.unique(mm.mat)}
                     - have):  # an empty group for the debris of each eroding material

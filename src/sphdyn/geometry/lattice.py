@@ -327,6 +327,22 @@ def polygon_contains(poly: np.ndarray, pts: np.ndarray, tol: float) -> np.ndarra
     return inside | (d2.min(axis=1) <= tol * tol)
 
 
+def prism_section(points, dim: int, axis, length) -> tuple[np.ndarray, int]:
+    """A prism's polygon (k, 2) float64 and its axis index, checked: three or
+    more [u, v] vertices; in 2D the axis "z" and no length."""
+    poly = np.asarray(points, dtype=np.float64)
+    if poly.ndim != 2 or poly.shape[1] != 2 or poly.shape[0] < 3:
+        raise ValueError(f"points must be three or more [u, v] pairs, got shape {poly.shape}")
+    ax = _axis_index(axis)
+    if dim == 2:
+        if ax != 2:
+            raise ValueError(f"in 2D the axis must be 'z' (a polygon in the x-y plane), "
+                             f"got {axis!r}")
+        if length is not None:
+            raise ValueError("a prism in 2D takes no length")
+    return poly, ax
+
+
 def prism_lattice(points, dx: float, dim: int, axis="z", base: float = 0.0,
                   length=None) -> np.ndarray:
     """Particles filling a straight prism: a simple polygon extruded along an
@@ -359,16 +375,7 @@ def prism_lattice(points, dx: float, dim: int, axis="z", base: float = 0.0,
     """
     dim = _check_dim(dim)
     dx = _positive("dx", dx)
-    poly = np.asarray(points, dtype=np.float64)
-    if poly.ndim != 2 or poly.shape[1] != 2 or poly.shape[0] < 3:
-        raise ValueError(f"points must be three or more [u, v] pairs, got shape {poly.shape}")
-    ax = _axis_index(axis)
-    if dim == 2:
-        if ax != 2:
-            raise ValueError(f"in 2D the axis must be 'z' (a polygon in the x-y plane), "
-                             f"got {axis!r}")
-        if length is not None:
-            raise ValueError("a prism in 2D takes no length")
+    poly, ax = prism_section(points, dim, axis, length)
     lo, hi = poly.min(axis=0), poly.max(axis=0)
     offsets = [np.zeros(1), np.zeros(1), np.zeros(1)]
     pu, pv = PRISM_PLANES[ax]

@@ -33,8 +33,8 @@ from pathlib import Path
 import meshio
 import numpy as np
 
-from .lattice import (PRISM_PLANES, _RTOL, _axis_index, _check_dim, _count, _point,
-                      _positive, polygon_contains)
+from .lattice import (PRISM_PLANES, _RTOL, _check_dim, _count, _point, _positive,
+                      polygon_contains, prism_section)
 from .shapes import corner_signs, shape_derivatives
 
 __all__ = [
@@ -379,12 +379,7 @@ def prism_mesh(points, element_size: float, dim: int, axis="z", base: float = 0.
     """
     dim = _check_dim(dim)
     size = _positive("element_size", element_size)
-    poly = np.asarray(points, dtype=np.float64)
-    if poly.ndim != 2 or poly.shape[1] != 2 or poly.shape[0] < 3:
-        raise ValueError(f"points must be three or more [u, v] pairs, got shape {poly.shape}")
-    ax = _axis_index(axis)
-    if dim == 2 and (ax != 2 or length is not None):
-        raise ValueError("a 2D prism mesh is the polygon in the x-y plane: axis 'z', no length")
+    poly, ax = prism_section(points, dim, axis, length)
     pu, pv = PRISM_PLANES[ax]
     lo, hi, n = np.zeros(3), np.zeros(3), [1, 1, 1]
     (lo[pu], lo[pv]), (hi[pu], hi[pv]) = poly.min(axis=0), poly.max(axis=0)

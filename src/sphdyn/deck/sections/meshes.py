@@ -221,6 +221,12 @@ class Sublayer(Section):
     body: Optional[reference_to("body")] = Field(
         None, description="The concrete body the bar lies in (default: any): every "
                           "node must have one of its particles within its support.")
+    stiffness: Literal["material", "none"] = Field(
+        "material", description="material: the particles carry their material's "
+        "stress, so the bar's stiffness also acts through the kernel (each line of "
+        "particles is a second bar of area mass_ratio A rho_steel / rho_concrete); "
+        "none: coupling only, the particles carry no stress and the bar's stiffness "
+        "is counted once, in the elements (docs/examples.md, \"igirder\").")
 
 
 class MeshErosion(PenaltyKeys):
