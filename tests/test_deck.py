@@ -380,6 +380,7 @@ ERROR_CASES = [
     (lambda d: d["wall"].append(dict(d["wall"][0])), "wall[1].name",
      ["'floor' is used by 2", "different name"]),
     (_set(["body", 0, "name"], " "), "body[0].name", ["empty"]),
+    (_set(["wall", 0, "name"], "4 mm/K"), "wall[0].name", ["has a slash", "'_'"]),
     # elastic constants
     (_set(["material", 0, "K"], 1e9), "material[0]",
      ["mix", "either E and nu, or K and G, not both"]),

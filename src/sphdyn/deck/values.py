@@ -109,7 +109,8 @@ class Reference:
 
 @dataclass(frozen=True)
 class UniqueName:
-    """After-validator: a non-empty name, unique among its ``[[section]]``."""
+    """After-validator: a non-empty name without slashes, unique among its
+    ``[[section]]``."""
 
     section: str
 
@@ -117,6 +118,10 @@ class UniqueName:
         if not name.strip():
             raise problem("the name is empty",
                           f"give each [[{self.section}]] a non-empty name")
+        if "/" in name or "\\" in name:
+            raise problem(f"the name '{name}' has a slash (names become output groups, "
+                          "folders and history columns)",
+                          "use letters, digits, '_' or '-'")
         scope = SCOPE.get()
         count = scope.names.get(self.section, []).count(name) if scope else 1
         if count > 1:
