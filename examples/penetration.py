@@ -78,6 +78,8 @@ def depths(out: Path) -> list[tuple[float, float, str, Path]]:
 
     rows = []
     for d in sorted(out.glob("sample_*")):
+        if not (d / "result.json").exists():  # not run yet
+            continue
         rec = json.loads((d / "result.json").read_text())
         v = -float(rec["vary"]["body.projectile.velocity.2"])
         h = read_history_csv(d / "history.csv")
@@ -132,6 +134,8 @@ def main() -> None:
     ax.legend()
     ax.grid(alpha=0.3)
     for k, (model, label) in enumerate(MODELS.items()):
+        if not results[model]:
+            continue
         fast = max(results[model], key=lambda r: r[0])
         ce, de, xp, dp = mid_section(fast[3])
         sub = fig.add_subplot(grid[1, k])
@@ -152,11 +156,12 @@ def main() -> None:
     print("| striking velocity [m/s] | NDRC [mm] | " +
           " | ".join(f"{label} [mm]" for label in MODELS.values()) + " |")
     print("|---|---|" + "---|" * len(MODELS))
-    for i, v in enumerate(VELOCITIES):
+    for v in VELOCITIES:
         cells = []
         for model in MODELS:
-            r = results[model][i]
-            cells.append(f"{1e3 * r[1]:.1f}" + ("" if r[2] == "completed" else f" ({r[2]})"))
+            r = next((r for r in results[model] if r[0] == v), None)
+            cells.append("not run" if r is None else f"{1e3 * r[1]:.1f}"
+                         + ("" if r[2] == "completed" else f" ({r[2]})"))
         print(f"| {v} | {1e3 * ndrc_depth(v):.1f} | " + " | ".join(cells) + " |")
 
 
