@@ -245,7 +245,6 @@ def build_model(deck) -> Model:
         p.h[:] = deck.sph.h_factor * body.dx
         p.h0[:] = p.h
         p.body[:] = b
-        p.hist_names = hist_names
         parts.append(p)
     body_names = [b.name for b in deck.body]
     for mm in meshes:
@@ -262,7 +261,7 @@ def build_model(deck) -> Model:
         body_names.append(_extra_name(mm, body_names, "debris"))
     particles = (Particles.concatenate(parts) if parts
                  else Particles.allocate(0, dim, n_hist))
-    particles.hist_names = list(hist_names)
+    particles.hist_names = hist_names  # the joined parts' columns (history_layout)
     hs = deck.sph.smoothing_length
     if hs.initial == "adaptive" and n_bodies > dim:
         # support sized by the local spacing (geometry.spacing); a bar's
