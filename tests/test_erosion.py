@@ -350,7 +350,9 @@ def test_restart_across_a_conversion_is_bitwise():
 def test_a_particle_born_inside_the_contact_thickness_keeps_that_penetration_free():
     """LS-DYNA's IGNORE = 2 for born particles: a particle appearing 3 mm deep
     in a face's 5 mm contact thickness feels nothing there; pushed 1 mm deeper
-    it feels the spring of 1 mm (a = alpha 1 mm / dt^2, paper eq. 8, 1e-12);
+    it feels the spring of 1 mm (a = alpha 1 mm / dt^2 times m_f / m_p,
+    paper eq. 8 with the face point's mass m_f = 4 m_node (N_a = 1/4 at the
+    face's centre) = 1.2 g, half the particle's 2.4 g; 1e-12);
     moving out shrinks the allowance to the smallest penetration seen.
     Particles present from the start have no allowance."""
     x, cells = block([0, 0, 0], [0.01, 0.01, 0.01], (1, 1, 1), 3)
@@ -373,10 +375,12 @@ def test_a_particle_born_inside_the_contact_thickness_keeps_that_penetration_fre
         cp.forces(0.0, dt, a)
         return a[0, 2]
 
+    m_f = 4.0 * solid.nodes.m[0]
+    assert m_f == pytest.approx(0.5 * p.m[0], rel=1e-12)
     assert accel(0.012) == 0.0
-    assert accel(0.011) == pytest.approx(0.1 * 0.001 / dt ** 2, rel=1e-9)
+    assert accel(0.011) == pytest.approx(0.1 * 0.001 / dt ** 2 * 0.5, rel=1e-9)
     assert accel(0.013) == 0.0  # 2 mm deep: the allowance is now 2 mm
-    assert accel(0.0125) == pytest.approx(0.1 * 0.0005 / dt ** 2, rel=1e-9)
+    assert accel(0.0125) == pytest.approx(0.1 * 0.0005 / dt ** 2 * 0.5, rel=1e-9)
     assert cp.pen0[0] == pytest.approx(0.002, rel=1e-12)
 
 
@@ -434,3 +438,58 @@ def test_particles_of_an_element_sit_at_its_octants_with_its_mass():
     assert np.allclose(p.rho, m_e / a ** 3, rtol=1e-12)
     assert np.allclose(p.vol0, p.m / RHO, rtol=1e-12)
     assert np.allclose(p.h, 1.2 * a / 2, rtol=1e-12)
+
+
+def test_cscm_debris_carries_compressive_pressure_only():
+    """Particles born from failed CSCM elements are eroded CSCM points
+    (``debris_history``): flagged eroded, their stored stress the compressive
+    mean of the stress they carried (damaged, so it does not jump; a tensile
+    mean gives 0), shear dropped. Then, through the CSCM kernel: a volumetric
+    compression adds K tr(d eps) to the mean stress (1e-12), a stretch leaves
+    no stress, and the wave speed is the undamaged sqrt(K / rho) (not the
+    damaged one, which went to ~0 and let debris particles slide into each
+    other). Through the event: a CSCM block whose elements erode hands the
+    state to its particles."""
+    from sphdyn.materials.cscm import H_ERODED, H_SVP, P_K
+
+    model = get_model("cscm")
+    params = model.pack(dict(density=RHO, fc=40e6, aggregate_size=0.016))
+    K = params[P_K]
+    sig = np.zeros((2, 3, 3))
+    sig[0] = np.diag([-5e6, -3e6, -1e6])
+    sig[0, 0, 1] = sig[0, 1, 0] = 2e6
+    sig[1] = np.diag([2e6, -1e6, 0.5e6])  # tensile mean
+    hist = np.tile(model.initial_history(params), (2, 1))
+    model.debris_history(hist, sig)
+    assert hist[:, H_ERODED].tolist() == [1.0, 1.0]
+    assert np.allclose(hist[0, H_SVP:H_SVP + 6], [-3e6] * 3 + [0.0] * 3, rtol=1e-14)
+    assert not hist[1, H_SVP:H_SVP + 6].any()
+    # the kernel: compress (tr d eps = -3e-4) and stretch, one step
+    n, dt, rate = 2, 1e-6, 100.0
+    L = np.zeros((n, 3, 3))
+    L[0] = -rate * np.eye(3)
+    L[1] = rate * np.eye(3)
+    s = sig.copy()
+    rho, e, c, dmg = np.full(n, RHO), np.zeros(n), np.zeros(n), np.zeros(n)
+    model.update(np.arange(n, dtype=np.int64), L, dt, rho, s, e, c, dmg, hist, params,
+                 np.full(n, 0.002))
+    expect = -3e6 - K * 3 * rate * dt
+    assert np.allclose(s[0], expect * np.eye(3), rtol=1e-12, atol=1e-12 * abs(expect))
+    assert not s[1].any()
+    assert np.allclose(c, np.sqrt(K / RHO), rtol=1e-12)
+    # through the event: the block's CSCM state passes to the particles
+    x, cells = block([0, 0, 0], [0.03, 0.03, 0.03], (2, 2, 2), 3)
+    solid = part(x, cells, 3, mat=(model, params))
+    sph = empty_sph(3, (model, params), n_hist=model.n_history)
+    sph.p.hist_names = list(model.history_names)
+    st = Stepper([solid, sph])
+    solid.nodes.v[:] = -200.0 * (solid.nodes.x - 0.015)  # squeezed from all sides
+    for _ in range(2):  # (it rebounds within 4)
+        st.step()
+    ev = ElementErosion("e", solid, {0: ErosionRules(min_time_step=1.0)}, sph=sph)
+    ev.apply(st)
+    p = sph.p
+    assert p.n == 8 and np.all(p.hist[:, H_ERODED] == 1.0)
+    mean = np.minimum(np.trace(p.sig, axis1=1, axis2=2) / 3.0, 0.0)
+    assert mean.max() < 0.0  # the squeeze left a compressive pressure to keep
+    assert np.allclose(p.hist[:, H_SVP], mean, rtol=1e-14)

@@ -9,7 +9,8 @@ What is pinned here, with its tolerance:
   areas), the closest point on a warped face against a brute-force search;
 * the spring: a particle at a given penetration gets exactly eq. 8 or eq. 9
   (1e-12) and the face nodes get the shares N_a(xi, eta) of the opposite
-  force (1e-12);
+  force (1e-12); eq. 8 takes the smaller of the particle's mass and the face
+  point's (a heavy particle on a light corner: omega dt <= sqrt(2 alpha));
 * particles pressed into a block stay out of it (no centre crosses the
   surface, 2D and 3D);
 * an oblique impact with friction conserves linear momentum to 1e-10 of the
@@ -236,7 +237,9 @@ def test_particle_at_a_penetration_gets_the_paper_spring_split_by_the_shape_func
     # A particle (dx = 1 mm, t_p = 0.5 mm; its body's other one far away)
     # placed over a top face of a tilted 2x2(x2) block at parametric point (0.3, -0.6) with penetration
     # delta = 0.2 mm along the face normal. Expected, written out:
-    #   mass (eq. 8): F = alpha m delta / dt^2;
+    #   mass (eq. 8): F = alpha min(m, m_f) delta / dt^2 with the face
+    #     point's mass 1/m_f = sum N_a^2 / m_a (here m < m_f: the paper's
+    #     alpha m delta / dt^2; the other case in the next test);
     #   bulk (eq. 9): F = m alpha K V^((d-2)/d) delta / (rho0 V), K = E/(3(1-2nu)).
     # The face nodes take -N_a(0.3, -0.6) F (bilinear or linear N_a), which sum
     # to -F. Tolerance 1e-12 (round-off).
@@ -277,8 +280,9 @@ def test_particle_at_a_penetration_gets_the_paper_spring_split_by_the_shape_func
     m, vol = sph.p.m[0], dx ** dim
     assert m == pytest.approx(RHO * vol, rel=1e-14)
     if stiffness == "mass":
+        assert 1.0 / np.sum(Na ** 2 / solid.nodes.m[top]) > m
         F = alpha * m * delta / dt ** 2
-        assert cp.stable_dt() == np.inf  # omega dt = sqrt(alpha (1 + m/m_node)): set by alpha
+        assert cp.stable_dt() == np.inf  # omega dt <= sqrt(2 alpha): set by alpha
     else:
         k = alpha * K_BULK * vol ** ((dim - 2.0) / dim)
         F = m * k * delta / (RHO * vol)
@@ -336,6 +340,7 @@ def test_edge_contact_and_a_subset_of_faces():
         return cp, sph.p.m[:, None] * sph.p.a_ext, solid.nodes.m[:, None] * solid.nodes.a_ext
 
     d = np.hypot(0.3e-3, 0.3e-3)
+    assert solid.nodes.m[corner] >= m  # eq. 8 with the particle's mass (equal here)
     f_corner = alpha * m * (0.5e-3 - d) / dt ** 2 * np.array([1.0, 1.0, 0.0]) / np.sqrt(2.0)
     cp, fp, fn = forces(top)
     assert cp.count == 1 and not fp[0].any()
@@ -347,6 +352,47 @@ def test_edge_contact_and_a_subset_of_faces():
     assert cp.count == 2
     assert fp[0] == pytest.approx([f_side, 0.0, 0.0], rel=1e-12, abs=1e-12 * f_side)
     assert np.abs(fn.sum(axis=0) + fp.sum(axis=0)).max() < 1e-12 * f_side
+
+
+@pytest.mark.parametrize("tied", [False, True])
+def test_heavy_particle_on_a_light_face_takes_the_face_mass(tied):
+    # Eq. 8 with the spring's mass min(m_p, m_f), 1/m_f = sum N_a^2 / m_a
+    # (LS-DYNA SOFT = 1's smaller mass): a particle 40 times heavier than its
+    # face's corner node (a steel projectile on the last element of an eroded
+    # crater) pressed 0.1 mm into the corner (2D, the face's N = (0, 1)) gets
+    # F = alpha m_node delta / dt^2 (1e-12), so the two-mass spring has
+    # omega^2 dt^2 = alpha (1 + m_node / m_p) (1e-12), under 2 alpha; the
+    # particle's own mass would give alpha (1 + 40) = 4.1: unstable. The
+    # same for a tied particle moved by 0.1 mm along the face normal.
+    from sphdyn.interactions.penalty_geometry import faces_on_nodes
+    dx, dt, alpha = 1e-3, 1e-7, 0.1
+    sph = sph_part(2, [0, 0, 0], [2 * dx, dx, 0], dx)
+    solid = concrete_block([0, 0, 0], [0.004, 0.004, 0], (2, 2), 2)
+    corner = np.flatnonzero((solid.nodes.x[:, 0] > 0.004 - 1e-12)
+                            & (solid.nodes.x[:, 1] > 0.004 - 1e-12))[0]
+    top_nodes = np.flatnonzero(solid.nodes.x[:, 1] > 0.004 - 1e-12)
+    top = faces_on_nodes(exterior_faces(solid.el.conn), top_nodes)
+    m_node = solid.nodes.m[corner]
+    sph.p.m[0] = 40.0 * m_node
+    sph.p.x[1] = [1.0, 1.0, 0.0]
+    delta = 0.1e-3
+    if tied:
+        sph.p.x[0] = [4e-3, 4.4e-3, 0.0]  # 0.4 mm over the corner: tied there
+        cp = PenaltyCoupling("c", sph, solid, faces=top, alpha=alpha, tie_factor=1.0)
+        assert cp.tied.tolist() == [0]
+        sph.p.x[0, 1] -= delta
+    else:
+        sph.p.x[0] = [4e-3, 4.4e-3, 0.0]  # 0.5 mm thickness: delta = 0.1 mm
+        cp = PenaltyCoupling("c", sph, solid, faces=top, alpha=alpha)
+    sph.p.a_ext[:] = 0.0
+    solid.nodes.a_ext[:] = 0.0
+    cp.forces(0.0, dt, sph.p.a_ext)
+    F = sph.p.m[0] * sph.p.a_ext[0, 1]
+    assert F == pytest.approx(alpha * m_node * delta / dt ** 2, rel=1e-12)
+    assert solid.nodes.m[corner] * solid.nodes.a_ext[corner, 1] == pytest.approx(-F, rel=1e-12)
+    k = F / delta
+    w2dt2 = k * (1 / sph.p.m[0] + 1 / m_node) * dt ** 2
+    assert w2dt2 == pytest.approx(alpha * (1 + 1 / 40), rel=1e-12)
 
 
 def test_candidate_list_is_rebuilt_when_the_skin_is_used_up():
@@ -614,7 +660,8 @@ def test_tied_particle_is_pulled_back_to_its_anchor_in_every_direction(dim, stif
     # A particle 0.4 mm (0.4 of its size, under tie_factor 1) above a top face
     # of a tilted 2x2(x2) block at (0.3, -0.6) is tied there: no force at the
     # start; moved by u (out of the face: tension, and along it: shear) it gets
-    # F = -m kappa u with kappa = alpha / dt^2 (eq. 8) or alpha K V^((d-2)/d)
+    # F = -m kappa u with kappa = alpha / dt^2 (eq. 8; the face is heavier
+    # than the particle) or alpha K V^((d-2)/d)
     # / (rho0 V) (eq. 9) and the face nodes -N_a F (1e-12); when the block
     # then moves by the same u (a rigid translation) the force is gone again
     # (the anchor moves with the face; 1e-9 of F: the anchor is recomputed).
@@ -655,6 +702,7 @@ def test_tied_particle_is_pulled_back_to_its_anchor_in_every_direction(dim, stif
         return sph.p.m[0] * sph.p.a_ext[0], solid.nodes.m[:, None] * solid.nodes.a_ext
 
     m, vol = sph.p.m[0], dx ** dim
+    assert 1.0 / np.sum(Na ** 2 / solid.nodes.m[top]) > m
     kappa = (alpha / dt ** 2 if stiffness == "mass"
              else alpha * K_BULK * vol ** ((dim - 2.0) / dim) / (RHO * vol))
     f_p, f_n = forces()

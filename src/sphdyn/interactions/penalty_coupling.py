@@ -24,12 +24,26 @@ thickness :math:`t_p = f_t V_p^{1/d}` (as at the rigid wall,
   with the first case); no contact when it is on the boundary and behind.
 
 If :math:`g < 0` the penetration :math:`\delta = -g` gives the particle the
-normal acceleration of the wall's spring, :func:`~.wall_contact.spring_acceleration`
-(Hušek et al. 2017, eq. 8: :math:`k = \alpha m/\Delta t^2`, or eq. 9:
-:math:`k = \alpha K A/L` on the nominal inertia :math:`\rho_0 V`), and the
-force
+normal force of the wall's spring, :func:`~.wall_contact.spring_acceleration`
+(Hušek et al. 2017, eq. 9: :math:`k = \alpha K A/L` on the nominal inertia
+:math:`\rho_0 V`, :math:`F_n = m_p a_n`; or eq. 8, :math:`k = \alpha
+m/\Delta t^2`, with :math:`m` the smaller of the particle's mass and the mass
+the face opposes at the contact point,
 
-.. math:: \mathbf F_p = m_p a_n \hat{\mathbf e} + \mathbf F_t,\qquad
+.. math:: m = \min(m_p, m_f),\qquad \frac{1}{m_f} = \sum_a \frac{N_a^2}{m_a},
+          \qquad F_n = \alpha\,\frac{m}{\Delta t^2}\,\delta,
+
+as LS-DYNA's SOFT = 1 takes the smaller of the slave's and the master's
+masses: eq. 8 itself against a face at least as heavy as the particle (a
+rigid wall: :math:`m_f \to \infty`), and for the two-mass spring
+:math:`\omega^2\Delta t^2 = \alpha\,(1 + m_{min}/m_{max}) \le 2\alpha` whatever
+the masses. With :math:`m_p` alone a heavy particle on the light corner node
+of a mesh left by erosion, :math:`m_p/m_f \approx 26`, gives :math:`\omega
+\Delta t = \sqrt{\alpha(1 + 26)} = 1.6` at :math:`\alpha = 0.1`, near the
+central difference's limit of 2 (it pumped energy into the penetration
+runs)), and the force
+
+.. math:: \mathbf F_p = F_n \hat{\mathbf e} + \mathbf F_t,\qquad
           \mathbf F_a = -N_a(\xi, \eta)\,\mathbf F_p \quad (a \in \text{face}),
 
 so the face nodes take the equal and opposite force shared with the face's
@@ -75,10 +89,25 @@ from .base import InteractionBase
 from .penalty_geometry import (candidate_pairs, closest_point, exterior_faces,
                                face_anchors, face_point, face_shapes)
 from .wall import STIFFNESS
-from .wall_contact import STIFFNESS_BULK, contact_thickness, spring_acceleration
+from .wall_contact import (STIFFNESS_BULK, STIFFNESS_MASS, contact_thickness,
+                           spring_acceleration)
 
 #: relative lateral offset under which a clamped closest point counts as inside the face
 _INSIDE_RTOL = 1e-9
+
+
+@njit(cache=True, error_model="numpy")
+def spring_mass(m_p, mn, face, N):
+    r"""The mass of eq. 8's spring, :math:`\min(m_p, m_f)` with :math:`1/m_f =
+    \sum_a N_a^2/m_a` [kg]: a particle of mass ``m_p`` [kg] on the point of
+    ``face`` (nf,) with shape values ``N`` (4,) (module docstring); nodes
+    without mass (``mn`` (M,) [kg]) take no force and do not count."""
+    inv = 0.0
+    for a in range(face.shape[0]):
+        node = face[a]
+        if mn[node] > 0.0:
+            inv += N[a] * N[a] / mn[node]
+    return m_p if inv * m_p <= 1.0 else 1.0 / inv
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
@@ -188,7 +217,8 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
             a_p[i, 2] += an * e2
             continue
         N = face_shapes(xi, eta, nf)
-        fn = mp[i] * an
+        fn = an * (spring_mass(mp[i], mn, faces[bf], N) if method == STIFFNESS_MASS
+                   else mp[i])
         f0 = fn * e0
         f1 = fn * e1
         f2 = fn * e2
@@ -252,7 +282,9 @@ def tie_forces(tied, tie_face, tie_xi, tie_eta, tie_offset, xp, mp, vol0, rho0, 
     and the spring of the contact law (:func:`~.wall_contact.spring_acceleration`,
     eq. 8 or 9, linear in the stretch) pulls it back in every direction:
     :math:`\mathbf F_p = -m_p\,\kappa\,(\mathbf x_p - \mathbf x_A)`,
-    :math:`\kappa` the acceleration per metre of the law, and the face nodes take
+    :math:`\kappa` the acceleration per metre of the law (for eq. 8 with the
+    spring's mass :math:`\min(m_p, m_f)` of :func:`penalty_coupling_forces`,
+    :math:`\kappa = \alpha \min(m_p, m_f)/(m_p\Delta t^2)`), and the face nodes take
     :math:`-N_a\mathbf F_p` (momentum conserved exactly; LS-DYNA's
     TIED_NODES_TO_SURFACE_OFFSET penalty option does the same with its own
     stiffness).
@@ -284,6 +316,9 @@ def tie_forces(tied, tie_face, tie_xi, tie_eta, tie_offset, xp, mp, vol0, rho0, 
         d1 = xp[i, 1] - (cy + tie_offset[k] * ny)
         d2 = xp[i, 2] - (cz + tie_offset[k] * nz)
         kappa = spring_acceleration(1.0, method, alpha, dt, kbulk[i], vol0[i], rho0[i], dim)
+        N = face_shapes(tie_xi[k], tie_eta[k], nf)
+        if method == STIFFNESS_MASS and mp[i] > 0.0:  # eq. 8 on the spring's mass
+            kappa *= spring_mass(mp[i], mn, faces[f], N) / mp[i]
         a_p[i, 0] -= kappa * d0
         a_p[i, 1] -= kappa * d1
         a_p[i, 2] -= kappa * d2
@@ -293,7 +328,6 @@ def tie_forces(tied, tie_face, tie_xi, tie_eta, tie_offset, xp, mp, vol0, rho0, 
         force[k, 0] = f0
         force[k, 1] = f1
         force[k, 2] = f2
-        N = face_shapes(tie_xi[k], tie_eta[k], nf)
         for a in range(4):
             shares[k, a, 0] = -N[a] * f0
             shares[k, a, 1] = -N[a] * f1
