@@ -192,6 +192,42 @@ def test_pull_out_transfers_the_force_and_closes_the_books(tmp_path):
     assert gaps.max() / gaps.min() < 1.01  # the bar's particles do not clump
 
 
+def test_split_stiffness_divides_the_bar_as_its_mass():
+    """[mesh.sublayer] stiffness = "split" (r = 0.25): the elements carry
+    (1 - r) of the steel's moduli with (1 - r) of its density (the bar's wave
+    speed unchanged, 1e-12); the particles form a group of their own whose
+    moduli are the steel's times rho_c / rho_s, so that their SPH volumes
+    m / rho_c carry the steel's stress over r A L: elements and particles
+    together are the bar once (1e-12), and the particles' wave speed is the
+    steel's (their moduli at the concrete's density)."""
+    r, E, nu, rho_s, rho_c = 0.25, 200e9, 0.3, 7850.0, 2400.0
+    st = build_stepper(loads_deck(deck_text(ratio=f'{r}\nstiffness = "split"', sets="")))
+    bar, sph = st.part("bar"), st.part("sph")
+    p = sph.p
+    rows = np.flatnonzero(p.body == 1)
+    assert bar.E == pytest.approx((1 - r) * E, rel=1e-12)
+    assert bar.c_bar == pytest.approx(np.sqrt(E / rho_s), rel=1e-12)
+    own = [g for g in sph.groups if np.intersect1d(g.idx, rows).size]
+    assert [g.name for g in own] == ["steel@bar"] and np.array_equal(own[0].idx, rows)
+    K, G = own[0].params[1], own[0].params[2]  # elastic: [density, K, G]
+    s = rho_c / rho_s
+    assert 9 * K * G / (3 * K + G) == pytest.approx(s * E, rel=1e-12)
+    M = E * (1 - nu) / ((1 + nu) * (1 - 2 * nu))  # the steel's P-wave modulus
+    assert np.allclose(p.c[rows], np.sqrt(M / rho_s), rtol=1e-12)
+    # stiffness x volume: elements (1 - r) E A L, particles sum(m / rho_c) s E
+    A, L = np.pi * 0.005 ** 2, 0.12
+    total = bar.E * A * L + np.sum(p.m[rows] / p.rho0[rows]) * s * E
+    assert total == pytest.approx(E * A * L, rel=1e-12)
+
+
+def test_split_stiffness_is_refused_for_a_bar_material_it_cannot_scale(tmp_path, capsys):
+    text = deck_text(ratio='0.5\nstiffness = "split"', sets="").replace(
+        'model = "elastic"\ndensity = 7850.0\nE = "200 GPa"\nnu = 0.3',
+        'model = "cscm"\ndensity = 7850.0\nfc = "30 MPa"\naggregate_size = "10 mm"')
+    assert 'model = "cscm"\ndensity = 7850.0' in text
+    _bad(tmp_path, text, "mesh[0] 'bar'.sublayer.stiffness", ["elastic or j2"], capsys)
+
+
 def test_bar_outside_the_concrete_is_refused(tmp_path, capsys):
     text = deck_text(sets="").replace('end = ["125 mm", "30 mm", "30 mm"]',
                                       'end = ["125 mm", "30 mm", "300 mm"]')

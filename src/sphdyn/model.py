@@ -272,13 +272,8 @@ def build_model(deck) -> Model:
         particles.h0[:n_bodies] = particles.h[:n_bodies]
 
     groups, factor = _material_groups(deck, particles, models, params, first)
-    # sublayer particles without a stiffness of their own: in no material group
-    # (their stress stays zero, their wave speed 0)
-    inert = np.flatnonzero(np.isin(particles.body, [
-        body_names.index(f"{mm.name}_sublayer") for mm in sublayer_meshes(meshes)
-        if mm.spec.sublayer.stiffness == "none"]))
-    if inert.size:
-        groups = [replace(g, idx=np.setdiff1d(g.idx, inert)) for g in groups]
+    _seat_sublayers(deck, meshes, particles, body_names)
+    groups = _sublayer_groups(deck, meshes, particles, body_names, groups, models, first)
     have = {g.material for g in groups}
     for k in sorted({int(k) for mm in debris_meshes(meshes) for k in np.unique(mm.mat)}
                     - have):  # an empty group for the debris of each eroding material
@@ -287,7 +282,6 @@ def build_model(deck) -> Model:
                                     np.zeros(0, np.int64), k,
                                     first[models[m.name].history_names]))
 
-    _seat_sublayers(deck, meshes, particles, body_names)
     for g in groups:
         if not g.idx.size:  # a debris group, filled during the run
             continue
@@ -432,6 +426,41 @@ def _seat_sublayers(deck, meshes, particles: Particles, body_names: list[str]) -
         particles.rho[rows] = rho
         particles.rho0[rows] = rho
         particles.vol0[rows] = particles.m[rows] / rho
+
+
+def _sublayer_groups(deck, meshes, particles: Particles, body_names: list[str],
+                     groups: list, models: dict, first: dict) -> list:
+    r"""The material groups with each bar's sublayer particles as its
+    [mesh.sublayer] ``stiffness`` says (:mod:`sphdyn.interactions.sublayer`):
+
+    * ``"material"``: in their material's group, as built;
+    * ``"none"``: in no group (no stress, wave speed 0: coupling only);
+    * ``"split"``: in a group of their own, ``<material>@<mesh>``, the
+      material with its stresses times :math:`\rho_c/\rho_s` (the seated
+      density over the steel's): a particle of SPH volume :math:`m_s/\rho_c =
+      r A L_n \rho_s/\rho_c` then acts through the kernel as the steel volume
+      :math:`r A L_n`, the bar's share ``mass_ratio`` = r, and the elements
+      carry the rest (:func:`sphdyn.mesh_assembly.mesh_part`). The particles'
+      wave speed is the steel's, :math:`\sqrt{(\rho_c/\rho_s) M/\rho_c}`.
+    """
+    from .mesh_assembly import check_split_model
+
+    for mm in sublayer_meshes(meshes):
+        stiffness = mm.spec.sublayer.stiffness
+        if stiffness == "material":
+            continue
+        rows = np.flatnonzero(particles.body == body_names.index(f"{mm.name}_sublayer"))
+        groups = [replace(g, idx=np.setdiff1d(g.idx, rows)) for g in groups]
+        if stiffness == "split":
+            k = int(mm.mat[0])
+            mat = deck.material[k]
+            model = models[mat.name]
+            check_split_model(mm, model.name)
+            values = mat.stress_scaled(float(particles.rho0[rows[0]]) / mat.density)
+            groups.append(MaterialGroup(f"{mat.name}@{mm.name}", model, model.pack(values),
+                                        rows.astype(np.int64), k,
+                                        first[model.history_names]))
+    return groups
 
 
 def _converted_name(mm: MeshModel, taken: list[str]) -> str:

@@ -10,10 +10,10 @@ from typing import ClassVar, Optional
 
 from pydantic import Field, model_validator
 
-from ..introspect import strip_optional
+from ..introspect import field_annotation, metadata, strip_optional
 from ..messages import problem
-from ..units import DENSITY, TIME
-from ..values import Section, name_of, quantity, real
+from ..units import DENSITY, PRESSURE, TIME
+from ..values import Quantity, Section, name_of, quantity, real
 from .bodies import Variation
 
 #: Mass density of a material (required, > 0).
@@ -93,6 +93,23 @@ class MaterialSection(Section):
         but name, model, variation and erosion, absent (None) values left out."""
         return {key: v for key, v in self.model_dump().items()
                 if key not in ("name", "model", "variation", "erosion") and v is not None}
+
+    @classmethod
+    def stress_keys(cls) -> tuple[str, ...]:
+        """The parameters with the dimension of a stress (moduli, strengths)."""
+        return tuple(key for key, info in cls.model_fields.items()
+                     if any(isinstance(getattr(m, "func", m), Quantity)
+                            and getattr(m, "func", m).dim == PRESSURE
+                            for m in metadata(field_annotation(info))))
+
+    def stress_scaled(self, factor: float) -> dict:
+        r""":meth:`values` with every stress parameter times ``factor``: for a
+        model whose stress is homogeneous of degree one in them (elastic, J2:
+        :math:`\sigma(\varepsilon; f E, f\sigma_y, f H) = f\,\sigma(\varepsilon; E,
+        \sigma_y, H)`), the same material carrying ``factor`` of the stress at
+        every strain (the sublayer split, docs/theory.md)."""
+        keys = set(self.stress_keys())
+        return {k: (v * factor if k in keys else v) for k, v in self.values().items()}
 
 
 def parameter_clashes(materials) -> list[tuple[int, str]]:

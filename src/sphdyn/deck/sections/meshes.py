@@ -137,7 +137,8 @@ class PenaltyKeys(Section):
     against the element faces with the wall's spring."""
 
     stiffness: Literal["mass", "bulk"] = Field(
-        "mass", description="Penalty stiffness: mass: k = alpha m/dt^2 (paper eq. 8); "
+        "mass", description="Penalty stiffness: mass: k = alpha m/dt^2 (paper eq. 8, m "
+                            "the smaller of the particle's and the face point's mass); "
                             "bulk: k = alpha K A/L (eq. 9).")
     alpha: real("penalty factor", lo=0, lo_open=True) = Field(
         0.1, description="Penalty factor alpha.")
@@ -221,10 +222,13 @@ class Sublayer(Section):
     body: Optional[reference_to("body")] = Field(
         None, description="The concrete body the bar lies in (default: any): every "
                           "node must have one of its particles within its support.")
-    stiffness: Literal["material", "none"] = Field(
+    stiffness: Literal["material", "split", "none"] = Field(
         "material", description="material: the particles carry their material's "
         "stress, so the bar's stiffness also acts through the kernel (each line of "
         "particles is a second bar of area mass_ratio A rho_steel / rho_concrete); "
+        "split: the bar's stiffness and strength are split as its mass, the elements "
+        "carry 1 - mass_ratio of them and the particles mass_ratio (their stresses "
+        "scaled by rho_concrete / rho_steel), so the bar counts once; "
         "none: coupling only, the particles carry no stress and the bar's stiffness "
         "is counted once, in the elements (docs/examples.md, \"igirder\").")
 
