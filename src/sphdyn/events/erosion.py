@@ -16,9 +16,7 @@ the parent points :math:`\xi_o = \pm\tfrac12`, each with
   particles carry exactly the momentum :math:`\sum_I (m_e/n_{en})\mathbf
   v_I` the nodes lose;
 * the element's stress, damage and history (the mean of its integration
-  points; a model may then mark the state as failed,
-  ``MaterialModel.debris_history``: CSCM's eroded point, with no shear and
-  no tension, its compressive pressure following the bulk modulus), its density :math:`m_e/V_e`, the material's reference density
+  points), its density :math:`m_e/V_e`, the material's reference density
   and a nominal volume :math:`m/\rho_0`, smoothing length ``h_factor``
   times :math:`(V_e/n_p)^{1/d}`;
 * specific internal energy: the element's (its points' work and its
@@ -237,28 +235,9 @@ class ElementErosion:
         for col, name in enumerate(self.solid.pts.hist_names):
             p.hist[rows, p.hist_names.index(name)] = f["hist"][:, col]
         p.mat[rows] = f["mat"]
-        self._failed_state(rows)
         p.body[rows] = self.body
         p.notify_grown(rows.start, rows.stop)
         self.born += k
-
-    def _failed_state(self, rows: slice) -> None:
-        """The born particles' history as their model keeps a failed point
-        (``MaterialModel.debris_history``; CSCM: an eroded point, carrying
-        compressive pressure only), through each material's columns."""
-        p = self.sph.p
-        born = np.arange(rows.start, rows.stop)
-        done = set()
-        for g in self.sph.groups:  # (classes of a varied material share columns)
-            hook, nh = g.model.debris_history, g.model.n_history
-            sel = born[p.mat[born] == g.material]
-            if hook is None or not sel.size or g.material in done:
-                continue
-            done.add(g.material)
-            cols = slice(g.column, g.column + nh)
-            hist = p.hist[sel, cols]
-            hook(hist, p.sig[sel])
-            p.hist[sel, cols] = hist
 
     def columns(self, t: float) -> dict[str, float]:
         """``eroded_<mesh>``, per rule ``eroded_<mesh>_<rule>``, and

@@ -124,11 +124,6 @@ class MaterialModel:
         The model writes a scalar damage (0 intact, 1 failed) into
         ``damage``: only then may elements of it erode by damage
         (:mod:`sphdyn.parts.fem.erosion_criteria`).
-    debris_history : callable or None
-        ``debris_history(hist, sig)``: the state of points of a failed
-        element that become particles (:mod:`sphdyn.events.erosion`),
-        ``hist`` (k, nh) their history (edited in place), ``sig`` (k, 3, 3)
-        their stress [Pa]; None: the history is kept as it is.
     """
 
     name: str
@@ -139,7 +134,6 @@ class MaterialModel:
     schema: Any = None
     initial_stress: bool = False
     has_damage: bool = False
-    debris_history: Callable[[np.ndarray, np.ndarray], None] | None = None
 
     @property
     def n_history(self) -> int:

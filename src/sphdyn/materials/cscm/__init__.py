@@ -42,8 +42,6 @@ surface and invariants), :mod:`~.projection` (return to the surface),
 and group kernel). The names of all of them are available from this package.
 """
 
-import numpy as np
-
 from ..registry import MaterialModel, register
 from .damage import (DMAX, brittle_softening_c, ductile_softening_a, logistic_damage,
                      max_principal, transition)
@@ -61,32 +59,6 @@ from .surface import (cap_from_compaction, cap_function, invariants, j1_radius,
                       kappa_from_cap, meridian, meridian_radius, rubin_factor, rubin_q,
                       shear_surface, surface_radius, yield_function)
 
-
-def debris_history(hist: np.ndarray, sig: np.ndarray) -> None:
-    r"""Points of an element eroded into particles become eroded CSCM points.
-
-    LS-DYNA erodes a MAT_159 element that has failed (ERODE); the thesis
-    (sec. 5.3) keeps its mass as SPH particles that "go on carrying load in
-    compression". As in :func:`~.point.cscm_point` for a point that erodes
-    itself (notes sec. 1.9): no deviatoric and no tensile stress, the
-    compressive mean stress following the bulk modulus from here on,
-    :math:`\sigma_m \leftarrow \min(\sigma_m + K\,\mathrm{tr}\,\Delta\varepsilon, 0)`.
-    The start is the mean of the stress the points carry now,
-    :math:`\min(\tfrac13\mathrm{tr}\,\sigma, 0)` (damaged, so the stress does not
-    jump). Without this the failed points keep their damage near 1 on
-    pressure too (ductile damage is not recovered in compression), so
-    debris particles had no stiffness at all, slid into each other and
-    their densities diverged (the penetration runs at 400 m/s).
-
-    ``hist`` (k, nh) the points' CSCM history (edited in place), ``sig``
-    (k, 3, 3) their stress [Pa].
-    """
-    m = np.minimum(np.trace(sig, axis1=1, axis2=2) / 3.0, 0.0)
-    hist[:, H_ERODED] = 1.0
-    hist[:, H_SVP:H_SVP + 3] = m[:, None]
-    hist[:, H_SVP + 3:H_SVP + 6] = 0.0
-
-
 CSCM = register(MaterialModel(
     name="cscm",
     history_names=HISTORY_NAMES,
@@ -95,5 +67,4 @@ CSCM = register(MaterialModel(
     history_init=initial_history,
     schema=CscmParams,
     has_damage=True,
-    debris_history=debris_history,
 ))
