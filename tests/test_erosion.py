@@ -439,3 +439,34 @@ def test_particles_of_an_element_sit_at_its_octants_with_its_mass():
     assert np.allclose(p.vol0, p.m / RHO, rtol=1e-12)
     assert np.allclose(p.h, 1.2 * a / 2, rtol=1e-12)
 
+
+
+def test_particles_of_a_crushed_or_inverted_element_take_half_its_volume():
+    """An element crushed to a tenth of its volume, or inverted (V < 0), turns
+    into particles whose density and size are taken at MIN_VOLUME_RATIO = 0.5
+    of its initial volume (m / (0.5 V0) and h_factor (0.5 V0)^(1/3), 1e-12);
+    an intact one at its own volume. Before, m / V gave a negative or tenfold
+    density and a NaN size (the 800 m/s penetration stopped with an error in
+    the neighbour search instead of a diagnosis)."""
+    from sphdyn.events.erosion import MIN_VOLUME_RATIO
+
+    solid, mat = moving_block(3)
+    sph = empty_sph(3, mat)
+    st = Stepper([solid, sph])
+    st.step()
+    flagged = np.array([0, 4, 13])
+    v0 = solid.el.vol0[flagged].copy()
+    intact = solid.el.vol[13]
+    solid.el.vol[0] = 0.1 * v0[0]
+    solid.el.vol[4] = -0.2 * v0[1]
+    ev = ElementErosion("e", solid, {0: ErosionRules(min_time_step=1.0)}, sph=sph)
+    ev.rules[:, 3] = 0.0
+    ev.rules[flagged, 3] = np.inf
+    ev.apply(st)
+    p = sph.p
+    assert MIN_VOLUME_RATIO == 0.5 and p.n == 3
+    vol = np.array([0.5 * v0[0], 0.5 * v0[1], intact])
+    m_e = solid.el.m[flagged]
+    assert np.allclose(p.rho, m_e / vol, rtol=1e-12)
+    assert np.allclose(p.h, 1.2 * vol ** (1.0 / 3.0), rtol=1e-12)
+    assert np.all(np.isfinite(p.h)) and np.all(p.rho > 0)

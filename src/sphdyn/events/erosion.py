@@ -18,7 +18,9 @@ the parent points :math:`\xi_o = \pm\tfrac12`, each with
 * the element's stress, damage and history (the mean of its integration
   points), its density :math:`m_e/V_e`, the material's reference density
   and a nominal volume :math:`m/\rho_0`, smoothing length ``h_factor``
-  times :math:`(V_e/n_p)^{1/d}`;
+  times :math:`(V_e/n_p)^{1/d}`, with :math:`V_e` at least
+  :data:`MIN_VOLUME_RATIO` times its initial volume (a crushed or inverted
+  element);
 * specific internal energy: the element's (its points' work and its
   hourglass work per unit mass) plus the kinetic energy of the nodes'
   relative motion, :math:`\sum_I \tfrac12 \tfrac{m_e}{n_{en}}|\mathbf v_I|^2
@@ -57,6 +59,11 @@ from ..parts.fem.solid import block_scratch
 from ..state import BC_FREE
 
 TARGETS = ("particles", "nothing")
+#: the smallest volume ratio V/V0 a particle's density and size are taken at: an
+#: element crushed below half its volume (or inverted, V <= 0) is a numerical
+#: artefact (concrete compacts by a few per cent), and m/V of it gave debris
+#: particles a negative or huge density and a NaN size
+MIN_VOLUME_RATIO = 0.5
 
 
 @dataclass(frozen=True)
@@ -199,9 +206,10 @@ class ElementErosion:
         mean = lambda a: a[ip].mean(axis=1)  # noqa: E731
         e_el = (internal + relative) / m_el
         rep = lambda a: np.repeat(a, npp, axis=0)  # noqa: E731
+        vol = np.maximum(el.vol[new], MIN_VOLUME_RATIO * el.vol0[new])  # crushed or inverted
         return dict(x=x, v=v, a=acc, a_ext=acc_ext, m=rep(m_el / npp),
-                    rho=rep(m_el / el.vol[new]),
-                    rho0=rep(mean(pts.rho0)), size=rep((el.vol[new] / npp) ** (1.0 / dim)),
+                    rho=rep(m_el / vol),
+                    rho0=rep(mean(pts.rho0)), size=rep((vol / npp) ** (1.0 / dim)),
                     e=rep(e_el), e_av=rep(mean(pts.e_av)), sig=rep(mean(pts.sig)),
                     damage=rep(mean(pts.damage)), hist=rep(mean(pts.hist)),
                     c=rep(pts.c[ip].max(axis=1)), mat=rep(pts.mat[ip[:, 0]]))
