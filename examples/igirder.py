@@ -109,6 +109,18 @@ def side_damage(out: Path, model: str) -> np.ndarray:
     return img
 
 
+def table_row(model: str, out: Path, d: np.ndarray, f: np.ndarray) -> tuple:
+    """(model, peak force [N], its displacement [m], the tension trusses' largest
+    force [N], steps, wall [s], energy error) of one run with curve ``d, f``."""
+    from sphdyn.io import read_history_csv
+
+    h = read_history_csv(out / "history.csv")
+    bars = max(h[f"bar_{b}_axial_force_max"].max() for b in ("b1", "b2"))
+    summary = json.loads((out / "summary.json").read_text())
+    return (model, f.max(), d[np.argmax(f)], bars, summary["steps"],
+            summary["wall_seconds"], summary["energy_error_max_rel"])
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--reuse", action="store_true", help="reuse out/igirder_*")
@@ -120,8 +132,6 @@ def main() -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from sphdyn.io import read_history_csv
-
     fig = plt.figure(figsize=(12, 9), layout="constrained")
     grid = fig.add_gridspec(3, 1, height_ratios=[1, 1, 1.6])
     curves, rows = {}, []
@@ -132,26 +142,18 @@ def main() -> None:
         im = ax.imshow(img, origin="lower", cmap="inferno_r", vmin=0, vmax=1,
                        extent=(0, img.shape[1] * DX * 1e3, 0, img.shape[0] * DX * 1e3))
         ax.set_title({"fem": "pure FEM (hex8 CSCM, embedded truss bars)",
-                      "sph": "SPH concrete with sublayer bars (mass ratio 0.5, stiffness split)"}[model])
+                      "sph": "SPH concrete with sublayer bars (mass ratio 0.5, "
+                             "stiffness split)"}[model])
         ax.set_ylabel("z [mm]")
-        d, f = curves[model] = curve(out)
-        h = read_history_csv(out / "history.csv")
-        bars = max(h[f"bar_{b}_axial_force_max"].max() for b in ("b1", "b2"))
-        summary = json.loads((out / "summary.json").read_text())
-        rows.append((model, f.max(), d[np.argmax(f)], bars, summary["steps"],
-                     summary["wall_seconds"], summary["energy_error_max_rel"]))
+        curves[model] = curve(out)
+        rows.append(table_row(model, out, *curves[model]))
     fig.axes[-1].set_xlabel("x [mm]")
     fig.colorbar(im, ax=fig.axes[:2], shrink=0.8, label="damage (max across the width)")
     for name in VARIANTS:
         if a.variants or (ROOT / "out" / f"igirder_{name}" / "summary.json").exists():
             out = run(name, not a.variants or a.reuse)
             curves[name] = curve(out)
-            h = read_history_csv(out / "history.csv")
-            bars = max(h[f"bar_{b}_axial_force_max"].max() for b in ("b1", "b2"))
-            summary = json.loads((out / "summary.json").read_text())
-            d, f = curves[name]
-            rows.append((name, f.max(), d[np.argmax(f)], bars, summary["steps"],
-                         summary["wall_seconds"], summary["energy_error_max_rel"]))
+            rows.append(table_row(name, out, *curves[name]))
     ax = fig.add_subplot(grid[2])
     labels = {"fem": "pure FEM", "sph": "SPH + sublayer (split, ratio 0.5)",
               **{k: v[0] for k, v in VARIANTS.items()}}

@@ -220,6 +220,38 @@ def test_split_stiffness_divides_the_bar_as_its_mass():
     assert total == pytest.approx(E * A * L, rel=1e-12)
 
 
+def test_stress_scaled_j2_carries_the_same_fraction_of_the_stress_at_every_strain():
+    """The split's premise (docs/theory.md): a J2 material with every stress
+    parameter (E, yield stress, hardening modulus: ``stress_keys``) times f
+    gives f times the stress along any strain path, elastic and plastic
+    (1e-12); uniaxial strain to 2 % (yield at about 0.2 %) and back."""
+    from sphdyn.materials import get_model
+    from sphdyn.materials.j2 import J2Params
+
+    section = J2Params(name="s", model="j2", density=7850.0, E=200e9, nu=0.3,
+                       yield_stress=500e6, hardening_modulus=2e9)
+    assert set(J2Params.stress_keys()) == {"E", "K", "G", "yield_stress",
+                                           "hardening_modulus"}
+    model, f = get_model("j2"), 0.3
+    stresses = []
+    for values in (section.values(), section.stress_scaled(f)):
+        params = model.pack(values)
+        n, dt = 1, 1e-6
+        sig, hist = np.zeros((n, 3, 3)), np.zeros((n, model.n_history))
+        rho, e, c, dmg = np.full(n, 7850.0), np.zeros(n), np.zeros(n), np.zeros(n)
+        path = []
+        for k in range(400):  # 1e4 1/s: 2 % in 200 steps, then back
+            L = np.zeros((n, 3, 3))
+            L[0, 0, 0] = 1e4 if k < 200 else -1e4
+            model.update(np.arange(n, dtype=np.int64), L, dt, rho, sig, e, c, dmg, hist,
+                         params, np.full(n, 0.01))
+            path.append(sig[0].copy())
+        stresses.append(np.array(path))
+    full, scaled = stresses
+    assert np.abs(full[:, 0, 0]).max() > 500e6  # yielded
+    assert np.abs(scaled - f * full).max() < 1e-12 * np.abs(full).max()
+
+
 def test_split_stiffness_is_refused_for_a_bar_material_it_cannot_scale(tmp_path, capsys):
     text = deck_text(ratio='0.5\nstiffness = "split"', sets="").replace(
         'model = "elastic"\ndensity = 7850.0\nE = "200 GPa"\nnu = 0.3',

@@ -44,21 +44,6 @@ def section_of(spec) -> BeamSection:
             else BeamSection.circle(sec.diameter))
 
 
-#: bar materials whose stress is homogeneous of degree one in their stress
-#: parameters, so that [mesh.sublayer] stiffness = "split" can scale them
-SPLIT_MODELS = ("elastic", "j2")
-
-
-def check_split_model(mm: MeshModel, model: str) -> None:
-    """Refuse ``stiffness = "split"`` for a bar whose material cannot be scaled."""
-    if model not in SPLIT_MODELS:
-        raise DeckError([format_problem(
-            f"mesh[{mm.index}] '{mm.name}'.sublayer.stiffness",
-            f"\"split\" scales the bar material's stresses, which model '{model}' "
-            "does not allow", f"use a bar material of model {' or '.join(SPLIT_MODELS)}, "
-            "or stiffness = \"material\" or \"none\"")])
-
-
 def mesh_part(deck, mm: MeshModel):
     """The solid or line part of one mesh (initial velocity set)."""
     spec = mm.spec
@@ -77,8 +62,7 @@ def mesh_part(deck, mm: MeshModel):
             keep = 1.0 - spec.sublayer.mass_ratio
             mat = deck.material[int(mm.mat[0])]
             if spec.sublayer.stiffness == "split":  # ... and of its stiffness
-                check_split_model(mm, model.name)
-                values = mat.stress_scaled(keep)
+                values = mat.stress_scaled(keep)  # (model checked by build_model)
             else:
                 values = dict(mat.values())
             values["density"] *= keep

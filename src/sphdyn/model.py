@@ -428,6 +428,11 @@ def _seat_sublayers(deck, meshes, particles: Particles, body_names: list[str]) -
         particles.vol0[rows] = particles.m[rows] / rho
 
 
+#: bar materials whose stress is homogeneous of degree one in their stress
+#: parameters, so that [mesh.sublayer] stiffness = "split" can scale them
+SPLIT_MODELS = ("elastic", "j2")
+
+
 def _sublayer_groups(deck, meshes, particles: Particles, body_names: list[str],
                      groups: list, models: dict, first: dict) -> list:
     r"""The material groups with each bar's sublayer particles as its
@@ -443,8 +448,6 @@ def _sublayer_groups(deck, meshes, particles: Particles, body_names: list[str],
       carry the rest (:func:`sphdyn.mesh_assembly.mesh_part`). The particles'
       wave speed is the steel's, :math:`\sqrt{(\rho_c/\rho_s) M/\rho_c}`.
     """
-    from .mesh_assembly import check_split_model
-
     for mm in sublayer_meshes(meshes):
         stiffness = mm.spec.sublayer.stiffness
         if stiffness == "material":
@@ -455,7 +458,12 @@ def _sublayer_groups(deck, meshes, particles: Particles, body_names: list[str],
             k = int(mm.mat[0])
             mat = deck.material[k]
             model = models[mat.name]
-            check_split_model(mm, model.name)
+            if model.name not in SPLIT_MODELS:
+                raise DeckError([format_problem(
+                    f"mesh[{mm.index}] '{mm.name}'.sublayer.stiffness",
+                    f"\"split\" scales the bar material's stresses, which model "
+                    f"'{model.name}' does not allow", "use a bar material of model "
+                    f"{' or '.join(SPLIT_MODELS)}, or stiffness = \"material\" or \"none\"")])
             values = mat.stress_scaled(float(particles.rho0[rows[0]]) / mat.density)
             groups.append(MaterialGroup(f"{mat.name}@{mm.name}", model, model.pack(values),
                                         rows.astype(np.int64), k,

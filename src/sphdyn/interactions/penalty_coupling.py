@@ -97,17 +97,25 @@ _INSIDE_RTOL = 1e-9
 
 
 @njit(cache=True, error_model="numpy")
-def spring_mass(m_p, mn, face, N):
-    r"""The mass of eq. 8's spring, :math:`\min(m_p, m_f)` with :math:`1/m_f =
-    \sum_a N_a^2/m_a` [kg]: a particle of mass ``m_p`` [kg] on the point of
-    ``face`` (nf,) with shape values ``N`` (4,) (module docstring); nodes
-    without mass (``mn`` (M,) [kg]) take no force and do not count."""
+def face_inverse_mass(mn, face, N):
+    r""":math:`1/m_f = \sum_a N_a^2/m_a` [1/kg], the inverse of the mass the point
+    of ``face`` (nf,) with shape values ``N`` (4,) opposes to a force (module
+    docstring); nodes without mass (``mn`` (M,) [kg]) take no force and do not
+    count."""
     inv = 0.0
     for a in range(face.shape[0]):
         node = face[a]
         if mn[node] > 0.0:
             inv += N[a] * N[a] / mn[node]
-    return m_p if inv * m_p <= 1.0 else 1.0 / inv
+    return inv
+
+
+@njit(cache=True, error_model="numpy")
+def spring_mass(m_p, inv_f):
+    r"""The mass of eq. 8's spring, :math:`\min(m_p, m_f)` [kg], of a particle of
+    mass ``m_p`` [kg] on a face point of inverse mass ``inv_f``
+    (:func:`face_inverse_mass`)."""
+    return m_p if inv_f * m_p <= 1.0 else 1.0 / inv_f
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
@@ -217,8 +225,8 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
             a_p[i, 2] += an * e2
             continue
         N = face_shapes(xi, eta, nf)
-        fn = an * (spring_mass(mp[i], mn, faces[bf], N) if method == STIFFNESS_MASS
-                   else mp[i])
+        inv_f = face_inverse_mass(mn, faces[bf], N)
+        fn = an * (spring_mass(mp[i], inv_f) if method == STIFFNESS_MASS else mp[i])
         f0 = fn * e0
         f1 = fn * e1
         f2 = fn * e2
@@ -226,14 +234,12 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
             w0 = vp[i, 0]
             w1 = vp[i, 1]
             w2 = vp[i, 2]
-            inv_meff = 1.0 / mp[i]
+            inv_meff = 1.0 / mp[i] + inv_f
             for a in range(nf):
                 node = faces[bf, a]
                 w0 -= N[a] * vn[node, 0]
                 w1 -= N[a] * vn[node, 1]
                 w2 -= N[a] * vn[node, 2]
-                if mn[node] > 0.0:
-                    inv_meff += N[a] * N[a] / mn[node]
             wn = w0 * e0 + w1 * e1 + w2 * e2
             t0 = w0 - wn * e0
             t1 = w1 - wn * e1
@@ -318,7 +324,7 @@ def tie_forces(tied, tie_face, tie_xi, tie_eta, tie_offset, xp, mp, vol0, rho0, 
         kappa = spring_acceleration(1.0, method, alpha, dt, kbulk[i], vol0[i], rho0[i], dim)
         N = face_shapes(tie_xi[k], tie_eta[k], nf)
         if method == STIFFNESS_MASS and mp[i] > 0.0:  # eq. 8 on the spring's mass
-            kappa *= spring_mass(mp[i], mn, faces[f], N) / mp[i]
+            kappa *= spring_mass(mp[i], face_inverse_mass(mn, faces[f], N)) / mp[i]
         a_p[i, 0] -= kappa * d0
         a_p[i, 1] -= kappa * d1
         a_p[i, 2] -= kappa * d2
