@@ -212,6 +212,10 @@ def test_minimal_deck_is_converted_to_si_with_defaults():
     assert deck.sph.viscosity.alpha == 1.0 and deck.sph.viscosity.beta == 2.0
     assert deck.time.cfl == 0.3 and deck.time.dt_max is None
     assert deck.wall[0].stiffness == "mass" and deck.wall[0].alpha == 0.1
+    # Autodyn's SPH density factors; not parameters of the model
+    assert (rubber.min_density_factor, rubber.max_density_factor) == (0.2, 3.0)
+    assert "min_density_factor" not in rubber.values()
+    assert "max_density_factor" not in rubber.values()
     assert deck.set == () and deck.boundary == ()
     assert deck.output.every is None
     assert deck.frame_interval() == pytest.approx(1e-3 / 50)
@@ -347,6 +351,10 @@ ERROR_CASES = [
     # out of range
     (_set(["material", 0, "nu"], 0.6), "material[0].nu",
      ["0.6 is out of range (-1, 0.5)", "Fix: give a Poisson ratio below 0.5."]),
+    (_set(["material", 0, "min_density_factor"], 1.0), "material[0].min_density_factor",
+     ["out of range [0, 1)"]),
+    (_set(["material", 0, "max_density_factor"], 0.9), "material[0].max_density_factor",
+     ["out of range (1, inf)"]),
     (_set(["time"], {"cfl": 0}), "time.cfl", ["out of range (0, 1]"]),
     (_set(["body", 0, "dx"], -1e-3), "body[0].dx",
      ["out of range (0, inf)", "above 0"]),

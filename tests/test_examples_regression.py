@@ -23,8 +23,9 @@ from regression_cases import CASES, DATA, fresh_numba_env
 TOLERANCE: dict[str, float] = {}
 
 #: arrays the stored results predate: state the architecture added (the
-#: interaction part of the acceleration, the active flag of kinematics).
-NEW_KEYS = {"particle/a_ext", "particle/active"}
+#: interaction part of the acceleration, the active flag of kinematics), the
+#: history's count of particles held at a density limit.
+NEW_KEYS = {"particle/a_ext", "particle/active", "history/density_limited"}
 
 
 def _differences(name: str, got: dict, want: dict) -> list[str]:

@@ -13,17 +13,13 @@ from sphdyn.assembly import build_stepper
 from sphdyn.deck import DeckError, loads_deck
 from sphdyn.interactions.penalty_coupling import PenaltyCoupling
 
+from decks import STEEL
+
 DECK = """
 [run]
 dimension = 3
 t_end = "{t_end}"
-[[material]]
-name = "steel"
-model = "elastic"
-density = 7850.0
-E = "200 GPa"
-nu = 0.3
-[[body]]
+{steel}[[body]]
 name = "ball"
 material = "steel"
 dx = "2 mm"
@@ -42,7 +38,8 @@ vtk = false
 
 
 def _stepper(contact="[mesh.contact]\nalpha = 0.1", t_end="80 us"):
-    return build_stepper(loads_deck(DECK.format(contact=contact, t_end=t_end)))
+    return build_stepper(loads_deck(DECK.format(contact=contact, t_end=t_end,
+                                                steel=STEEL)))
 
 
 def _momentum(s):
@@ -82,4 +79,4 @@ def test_projectile_rebounds_from_the_block_keeping_the_momentum():
 ])
 def test_contact_with_a_second_coupling_of_the_particles_is_refused(contact, words):
     with pytest.raises(DeckError, match=words.replace("[", "\\[").replace("]", "\\]")):
-        loads_deck(DECK.format(contact=contact, t_end="1 us"))
+        loads_deck(DECK.format(contact=contact, t_end="1 us", steel=STEEL))

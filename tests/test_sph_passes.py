@@ -251,14 +251,46 @@ def test_density_and_benz_h_follow_uniform_expansion():
     rho = np.full(n, 2000.0)
     h0 = np.full(n, 1e-3)
     h = h0.copy()
+    none = (rho.copy(), np.zeros(n, np.int64), np.zeros((0, 2)))  # no density limits
     for _ in range(10):
-        update_density_and_h(L, dt, dim, True, h0, 0.5, 2.0, rho, h)
+        update_density_and_h(L, dt, dim, True, h0, 0.5, 2.0, rho, h, *none)
     assert np.allclose(rho, 2000.0 * np.exp(-3 * eps * 0.1), rtol=1e-12)
     assert np.allclose(h, 1e-3 * np.exp(eps * 0.1), rtol=1e-12)
     # bounds: strong expansion clips h at max_factor * h0
     for _ in range(1000):
-        update_density_and_h(L, dt, dim, True, h0, 0.5, 2.0, rho, h)
+        update_density_and_h(L, dt, dim, True, h0, 0.5, 2.0, rho, h, *none)
     assert np.allclose(h, 2e-3)
+    assert rho.max() < 2000.0 * 0.2 * 1e-3  # no limits: free to fall
+
+
+def test_density_kept_within_its_material_limits():
+    # [material] min/max_density_factor (Autodyn's SPH density factors): the
+    # continuity update rho exp(-dt tr L), then clamped to f_min rho0 and
+    # f_max rho0 of the particle's material. Two materials (0.2, 3) and
+    # (0.5, 1.5); particles 0-1 of the first, 2-3 of the second, each pair one
+    # expanding (tr L > 0) and one compressing. One step of tr L = +-ln(10)/dt
+    # moves rho by a factor 10, beyond every limit: each ends at its limit
+    # exactly; a step of +-ln(1.2)/dt stays inside both and is the exact
+    # exponential update (round-off).
+    dt, dim = 1e-3, 3
+    rho0 = np.array([2400.0, 2000.0, 1000.0, 7850.0])
+    mat = np.array([0, 0, 1, 1], np.int64)
+    limits = np.array([[0.2, 3.0], [0.5, 1.5]])
+    sign = np.array([1.0, -1.0, 1.0, -1.0])  # expand, compress
+    h0 = np.full(4, 1e-3)
+
+    def step(rate):
+        L = np.zeros((4, 3, 3))
+        for a in range(3):
+            L[:, a, a] = sign * rate / 3.0
+        rho, h = rho0.copy(), h0.copy()
+        update_density_and_h(L, dt, dim, False, h0, 0.5, 2.0, rho, h, rho0, mat, limits)
+        return rho
+
+    far = step(np.log(10.0) / dt)
+    assert np.array_equal(far, rho0 * np.array([0.2, 3.0, 0.5, 1.5]))
+    near = step(np.log(1.2) / dt)
+    assert np.allclose(near, rho0 * 1.2 ** -sign, rtol=1e-12)
 
 
 def test_xsph_leaves_uniform_velocity_unchanged_and_smooths():
@@ -339,3 +371,23 @@ def test_pair_stress_and_viscosity_match_their_formulas(alpha, beta, approach):
         expect = -m[1] * pi * F[0] * (x[0] - x[1])
         assert np.allclose(a[0], expect, rtol=1e-12, atol=0.0)
         assert heat > 0.0  # viscosity only heats
+
+
+def test_history_counts_particles_held_at_a_density_limit():
+    # the part takes each material's (min, max) factors from the deck and the
+    # history column density_limited counts the particles at either limit
+    from sphdyn.assembly import build_stepper
+    from sphdyn.deck import loads_deck
+
+    from decks import concrete_disc_2d
+
+    deck = loads_deck(concrete_disc_2d("5 mm", "1 us", "1 us", ["velocity"]).replace(
+        'aggregate_size = "8 mm"', 'aggregate_size = "8 mm"\nmin_density_factor = 0.5'))
+    part = next(q for q in build_stepper(deck).parts if q.name == "sph")
+    assert np.array_equal(part.density_limits, [[0.5, 3.0]])
+    p = part.p
+    assert part.columns()["density_limited"] == 0.0
+    p.rho[0] = 0.5 * p.rho0[0]
+    p.rho[1] = 3.0 * p.rho0[1]
+    p.rho[2] = 0.51 * p.rho0[2]  # inside
+    assert part.columns()["density_limited"] == 2.0

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .interactions import ParticleContact, Wall
+from .interactions import Gravity, ParticleContact, Wall
 from .mesh_assembly import erosion_events, mesh_interactions, mesh_part
 from .kernels import KernelContext
 from .model import Model, build_model, debris_meshes, sublayer_meshes
@@ -39,7 +39,9 @@ def sph_settings(deck, converted: int = 0, sublayer: int = 0,
         h_max_factor=sph.smoothing_length.max_factor,
         skin_factor=sph.neighbours.skin_factor, cfl=deck.time.cfl,
         stress_exponent=sph.artificial_stress.n, epsilon=eps, total_lagrangian=tl,
-        hourglass=sph.hourglass, reference_update_every=sph.reference_update_every)
+        hourglass=sph.hourglass, reference_update_every=sph.reference_update_every,
+        density_limits=tuple((m.min_density_factor, m.max_density_factor)
+                             for m in deck.material))
 
 
 def contact_on(deck, settings: SPHSettings) -> bool:
@@ -72,6 +74,8 @@ def build_stepper(deck, model: Model | None = None, events=(), monitors=()) -> S
     meshes = {mm.name: mesh_part(deck, mm) for mm in model.meshes}
     parts += meshes.values()
     interactions += mesh_interactions(deck, model, part, meshes)
+    if deck.run.gravity is not None and any(deck.run.gravity):
+        interactions += [Gravity(q, deck.run.gravity) for q in parts]
     events = list(events) + erosion_events(deck, model, part, meshes)
     dt_max = deck.time.dt_max if deck.time.dt_max is not None else np.inf
     return Stepper(parts, interactions, events, monitors, dt_max=dt_max)

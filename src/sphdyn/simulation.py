@@ -28,8 +28,9 @@ from .guards import SimulationFailed
 from .io import (FrameWriter, History, MeshFrame, atomic_write_text, particle_fields,
                  plot_history, read_checkpoint, write_checkpoint)
 from .analysis import window_mean_force
-from .io.plots import energy_columns, relative_drift
+from .io.plots import energy_columns, plot_gauges, relative_drift
 from .assembly import build_stepper
+from .gauges import GaugeRecorder, build_gauges
 from .model import Model, build_model
 from .interrupt import StopRequests
 from .monitors import (Checkpoints, FrameOutput, Guards, HistoryFlush, HistoryRecorder,
@@ -52,7 +53,8 @@ class Simulation:
     """
 
     def __init__(self, deck, outdir: Path, model: Model, stepper: Stepper,
-                 history: History, frames: FrameWriter, next_frame: float):
+                 history: History, frames: FrameWriter, next_frame: float,
+                 gauges: list | None = None):
         self.deck = deck
         self.outdir = Path(outdir)
         self.model = model
@@ -65,9 +67,11 @@ class Simulation:
         self.output = FrameOutput(self._write_frame, deck.frame_interval(), next_frame,
                                   deck.run.t_end)
         self.recorder = HistoryRecorder(history, out.history_every, self.model.probes)
+        self.gauges = GaugeRecorder(build_gauges(deck, stepper.parts) if gauges is None
+                                    else gauges)
         for monitor in (Guards(self.model.domain_lo, self.model.domain_hi,
                                deck.time.collapse_ratio, stepper.parts),
-                        self.recorder, self.output,
+                        self.recorder, self.gauges, self.output,
                         Checkpoints(self._checkpoint, out.checkpoint_every)):
             stepper.add_monitor(monitor)
 
@@ -87,10 +91,12 @@ class Simulation:
         outdir = Path(outdir)
         model = build_model(deck)
         stepper = build_stepper(deck, model, events=events)
+        gauges = build_gauges(deck, stepper.parts)  # (a point outside the model)
         outdir.mkdir(parents=True, exist_ok=True)
         dump_resolved(deck, outdir / RESOLVED)
         return cls(deck, outdir, model, stepper, History(),
-                   FrameWriter(outdir, vtk=deck.output.vtk), next_frame=0.0)
+                   FrameWriter(outdir, vtk=deck.output.vtk), next_frame=0.0,
+                   gauges=gauges)
 
     @classmethod
     def from_directory(cls, outdir, events=()) -> "Simulation":
@@ -112,8 +118,10 @@ class Simulation:
         history = History.from_csv(hist_path) if hist_path.exists() else History()
         history.truncate_after(np.nextafter(t, -np.inf))  # the next step records t
         frames = FrameWriter(outdir, vtk=deck.output.vtk, start_after=t)
-        return cls(deck, outdir, model, stepper, history, frames,
-                   next_frame=float(scalars["next_frame"]))
+        sim = cls(deck, outdir, model, stepper, history, frames,
+                  next_frame=float(scalars["next_frame"]))
+        sim.gauges.resume(outdir, t)
+        return sim
 
     # ------------------------------------------------------------------- run
     def run(self, t_end: float | None = None, max_steps: int | None = None,
@@ -203,6 +211,7 @@ class Simulation:
         if done:
             self.history.append(self.recorder.row(s, kinetic=s.kinetic_now(),
                                                   dt=s.dt_prev))
+            self.gauges.final(s)
         writes.append(self._flush_history)
         if failure is None:
             writes.append(self._checkpoint)
@@ -214,6 +223,8 @@ class Simulation:
         try:
             plot_history(self.outdir / "history.csv", self.outdir / "plots",
                          self.deck.output.force_window, self.deck.run.dimension, t_end)
+            plot_gauges(self.outdir / "gauges", self.outdir / "plots" / "gauges.png",
+                        self.deck.run.dimension)
         except Exception as exc:  # plots must never lose a run
             print(f"warning: plotting failed: {exc}")
 
@@ -236,6 +247,7 @@ class Simulation:
 
     def _flush_history(self):
         self.history.write_csv(self.outdir / "history.csv")
+        self.gauges.write(self.outdir)
 
     def _summary(self, start_step: int, failure, interrupted: str | None,
                  t_end: float) -> dict:

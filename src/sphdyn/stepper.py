@@ -155,6 +155,9 @@ class Stepper:
         self.kinetic, self.dt_step = ke, dt
         for inter in self.interactions:
             inter.after_kick(dt_kick)
+            w = inter.external_work()  # (gravity) external, not an interaction's
+            self.work_contact -= w
+            self.work_external += w
         for inter in self.interactions:
             inter.constrain(self.t, dt)
         self._notify("after_kick")

@@ -26,6 +26,7 @@ from .introspect import field_annotation, metadata, strip_optional, variants
 from .scope import SCOPE, scope_of
 from .sections.bodies import Body, Crack, MassField, Mesostructure, Variation
 from .messages import problem
+from .sections.gauges import Gauge
 from .sections.material import MaterialSection, parameter_clashes
 from .sections.output import Output, Probe
 from .sections.run import Domain, Run, Time
@@ -39,7 +40,7 @@ from .values import ExistingFile, NonEmpty, Section
 __all__ = [
     "BeamSection", "BlockMesh", "Body", "Boundary", "Convert", "LineMesh", "Load", "Mesh",
     "MeshGroup", "Contact", "Crack", "Deck", "DeckSections", "Domain",
-    "ExistingFile", "Geometry", "MassField", "MaterialSection", "Mesostructure",
+    "ExistingFile", "Gauge", "Geometry", "MassField", "MaterialSection", "Mesostructure",
     "Output", "ParticleSet", "Probe", "Region", "Run", "Section", "Sph", "Time",
     "Variation", "Wall", "deck_model", "field_annotation", "metadata",
     "strip_optional", "variants",
@@ -84,6 +85,8 @@ class DeckSections(Section):
     load: tuple[Load, ...] = Field((), description="Forces on sets.")
     probe: tuple[Probe, ...] = Field((), description="Time histories of "
                                                      "particle sets.")
+    gauge: tuple[Gauge, ...] = Field((), description="Strain, displacement and "
+                                     "section-force gauges at material points.")
     output: Output = Field(default_factory=Output, description="Output.")
 
     @model_validator(mode="wrap")

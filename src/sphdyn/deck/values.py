@@ -18,8 +18,8 @@ from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict,
 
 from .messages import problem, show, show_number, show_vector, suggest
 from .scope import SCOPE, dimension
-from .units import (LENGTH, PRESSURE, VELOCITY, Dimension, QuantityError, to_bytes,
-                    to_si)
+from .units import (ACCELERATION, LENGTH, PRESSURE, VELOCITY, Dimension, QuantityError,
+                    to_bytes, to_si)
 
 
 class Section(BaseModel):
@@ -247,6 +247,7 @@ Position = vector(quantity(LENGTH))
 #: A point whose z may be non-zero in 2D (corners of selection boxes).
 Corner = vector(quantity(LENGTH), planar=False)
 VelocityVector = vector(quantity(VELOCITY))
+AccelerationVector = vector(quantity(ACCELERATION))
 Direction = Annotated[vector(real()), AfterValidator(unit_vector)]
 PositiveLength = quantity(LENGTH, lo=0, lo_open=True)
 PositivePressure = quantity(PRESSURE, lo=0, lo_open=True)

@@ -11,6 +11,9 @@ couplings, prescribed motion, loads and damping. The :class:`~sphdyn.stepper.Ste
   ``a_ext`` of the part it acts on (``dt`` is the stable step, which
   mass-based penalty springs use); it also refreshes what it reports;
 * ``after_kick(dt_kick)``: bookkeeping over the kick (impulses);
+* ``external_work()``: the part of its forces' work over the last kick that
+  is external work (gravity), which the stepper books in ``W_external``
+  instead of with the interactions' (``E_contact``);
 * ``constrain(t, dt)``: after the kick of the step [t, t + dt], the
   tied and hybrid couplings set their slaves' positions and velocities
   from their masters';
@@ -32,6 +35,7 @@ class Interaction(Protocol):
     def update_geometry(self, t: float) -> None: ...
     def forces(self, t: float, dt: float, a_out: np.ndarray) -> None: ...
     def after_kick(self, dt_kick: float) -> None: ...
+    def external_work(self) -> float: ...
     def constrain(self, t: float, dt: float) -> None: ...
     def columns(self, t: float) -> dict[str, float]: ...
     def state(self) -> tuple[dict, dict[str, np.ndarray]]: ...
@@ -52,6 +56,9 @@ class InteractionBase:
 
     def after_kick(self, dt_kick: float) -> None:
         return None
+
+    def external_work(self) -> float:
+        return 0.0
 
     def constrain(self, t: float, dt: float) -> None:
         return None

@@ -28,8 +28,22 @@ class ParticleContact(InteractionBase):
         self.part = part
         self.alpha, self.distance_factor = alpha, distance_factor
         self.count = 0
+        n = part.p.n
+        self.allow = np.zeros(n)  # overlap allowances [m] (particle_contact)
+        self.over = np.zeros(n)  # scratch: each particle's deepest raw overlap
         self._build()
-        part.p.on_grow(lambda n_old, n_new: self._build())
+        part.p.on_grow(self._grown)
+
+    def _grown(self, n_old: int, n_new: int) -> None:
+        """New particles keep the overlap they are born with (no force from it)."""
+        self._build()
+        p = self.part.p
+        self.over = np.zeros(n_new)
+        scratch = np.zeros((n_new, 3))
+        particle_contact(p.x, p.m, p.size, p.bulk_modulus, p.body, p.dim, self.nl.offsets,
+                         self.nl.idx, self.alpha, self.distance_factor,
+                         np.full(n_new, np.inf), self.over, scratch)
+        self.allow = np.concatenate([self.allow[:n_old], self.over[n_old:n_new]])
 
     def _build(self) -> None:
         p, part = self.part.p, self.part
@@ -54,7 +68,8 @@ class ParticleContact(InteractionBase):
         p = self.part.p
         self.count = int(particle_contact(
             p.x, p.m, p.size, p.bulk_modulus, p.body, p.dim, self.nl.offsets,
-            self.nl.idx, self.alpha, self.distance_factor, a_out))
+            self.nl.idx, self.alpha, self.distance_factor, self.allow, self.over, a_out))
+        np.minimum(self.allow, self.over, out=self.allow)  # allowances only shrink
 
     def columns(self, t: float) -> dict[str, float]:
         return {"contacts_bodies": float(self.count)}
@@ -62,7 +77,7 @@ class ParticleContact(InteractionBase):
     def state(self) -> tuple[dict, dict[str, np.ndarray]]:
         nl = self.nl
         return {}, {"nl_offsets": nl.offsets, "nl_idx": nl.idx, "nl_x_ref": nl.x_ref,
-                    "nl_h_ref": nl.h_ref}
+                    "nl_h_ref": nl.h_ref, "allow": self.allow}
 
     def restore(self, scalars: dict, arrays: dict) -> None:
         nl = self.nl
@@ -70,3 +85,6 @@ class ParticleContact(InteractionBase):
         nl.idx = arrays["nl_idx"].copy()
         nl.x_ref = arrays["nl_x_ref"].copy()
         nl.h_ref = arrays["nl_h_ref"].copy()
+        if "allow" in arrays:  # (checkpoints written before the allowances: none)
+            self.allow = arrays["allow"].copy()
+            self.over = np.zeros(self.allow.size)

@@ -260,3 +260,31 @@ def history_figures(data: dict[str, np.ndarray], title: str = "",
         _finish_axes(ax, f"Time step ({title})")
         figures["dt"] = fig
     return figures
+
+
+#: units of the gauges' columns (:mod:`sphdyn.gauges`)
+GAUGE_UNITS = {"strain": "-", "displacement": "m", "velocity": "m/s", "force": "N"}
+
+
+def plot_gauges(gauge_dir: str | os.PathLike, out_path: str | os.PathLike,
+                dimension: int | None = None) -> Path | None:
+    """One panel per gauge CSV of ``gauge_dir`` (``gauges/<name>.csv``), its
+    columns against time, into ``out_path``; None without gauge files.
+    Forces are per metre of depth in 2D (``dimension``)."""
+    files = sorted(Path(gauge_dir).glob("*.csv"))
+    if not files:
+        return None
+    data = [read_history_csv(f) for f in files]
+    t_max = max((float(np.max(d["time"])) for d in data if d["time"].size), default=0.0)
+    tf, tu = time_unit(t_max)
+    fig, axes = _figure(len(files), 3.0)
+    for ax, f, d in zip(axes, files, data):
+        cols = [c for c in d if c != "time"]
+        for c in cols:
+            ax.plot(d["time"] * tf, d[c], label=c)
+        kind = cols[0].rsplit("_", 1)[0] if cols else ""
+        unit = GAUGE_UNITS.get(kind, "")
+        ax.set_ylabel(per_depth(unit, dimension) if kind == "force" else unit)
+        _finish_axes(ax, f"gauge {f.stem}")
+    axes[-1].set_xlabel(f"time [{tu}]")
+    return save_figure(fig, out_path, 120)

@@ -16,6 +16,10 @@ from ..units import DENSITY, PRESSURE, TIME
 from ..values import Quantity, Section, name_of, quantity, real
 from .bodies import Variation
 
+#: Keys of every material that are not parameters of its model (the SPH part
+#: reads them: :class:`sphdyn.parts.sph.part.SPHSettings`).
+NOT_PARAMETERS = ("min_density_factor", "max_density_factor")
+
 #: Mass density of a material (required, > 0).
 Density = quantity(DENSITY, lo=0, lo_open=True)
 
@@ -69,13 +73,26 @@ class MaterialSection(Section):
     erosion: Optional[MaterialErosion] = Field(
         None, description="Erosion rules of elements of this material "
                           "([material.erosion]).")
+    min_density_factor: real("minimum density factor", lo=0, hi=1, hi_open=True) = Field(
+        0.2, description="Particles of this material keep a density of at least this "
+                         "times their initial density (Autodyn's SPH minimum density "
+                         "factor; 0: no limit). A safeguard for sparse particles, such as "
+                         "the debris of eroded elements, whose density from the "
+                         "continuity equation can otherwise run away; a sound solid never "
+                         "reaches it. The history counts the particles held at a limit "
+                         "(density_limited).")
+    max_density_factor: real("maximum density factor", lo=1, lo_open=True) = Field(
+        3.0, description="Particles of this material keep a density of at most this "
+                         "times their initial density (Autodyn's SPH maximum density "
+                         "factor).")
 
     @model_validator(mode="after")
     def _varied_parameter(self):
         var = self.variation
         if var is None:
             return self
-        fixed = {"name", "model", "density", "variation", "erosion", *self.unvaried}
+        fixed = {"name", "model", "density", "variation", "erosion", *NOT_PARAMETERS,
+                 *self.unvaried}
         numeric = [k for k, f in type(self).model_fields.items() if k not in fixed
                    and strip_optional(f.annotation) is float]
         if var.parameter not in numeric:
@@ -90,9 +107,11 @@ class MaterialSection(Section):
 
     def values(self) -> dict:
         """The model's parameters in SI units, as ``pack`` takes them: every key
-        but name, model, variation and erosion, absent (None) values left out."""
+        but name, model, variation, erosion and the density limits, absent (None)
+        values left out."""
         return {key: v for key, v in self.model_dump().items()
-                if key not in ("name", "model", "variation", "erosion") and v is not None}
+                if key not in ("name", "model", "variation", "erosion", *NOT_PARAMETERS)
+                and v is not None}
 
     @classmethod
     def stress_keys(cls) -> tuple[str, ...]:

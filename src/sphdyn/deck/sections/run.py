@@ -5,8 +5,8 @@ from typing import Annotated, Literal, Optional
 from pydantic import AfterValidator, BeforeValidator, Field, StrictStr
 
 from ..units import TIME
-from ..values import (Bounds, Position, Section, UpperPosition, integer, memory_size,
-                      quantity, real)
+from ..values import (AccelerationVector, Bounds, Position, Section, UpperPosition,
+                      integer, memory_size, quantity, real)
 
 
 class Run(Section):
@@ -19,6 +19,13 @@ class Run(Section):
                     "kg/m); 3 = three-dimensional.")
     t_end: quantity(TIME, "end time", lo=0, lo_open=True) = Field(
         description="Simulated end time.")
+    gravity: Optional[AccelerationVector] = Field(
+        None, description="Acceleration of gravity, a body load on every particle and "
+                          "node with mass, e.g. [0, 0, \"-9.81 m/s^2\"] (absent: none). "
+                          "Its work is external work (W_external, and W_gravity in the "
+                          "history); no initial stress from it is computed: the bodies "
+                          "start unloaded and settle (add mesh damping for a static "
+                          "start).")
     seed: integer("seed", lo=0) = Field(
         0, description="Seed of the random number generator (lattice "
                        "jitter, random material properties).")

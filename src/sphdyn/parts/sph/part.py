@@ -68,6 +68,9 @@ class SPHSettings:
     total_lagrangian: tuple  # per body
     hourglass: float  # total-Lagrangian hourglass coefficient
     reference_update_every: int  # total-Lagrangian reference update (0: never)
+    #: (min, max) density factors per material index (``particles.mat``): the
+    #: updated-Lagrangian density is kept within them times ``rho0``; () no limits
+    density_limits: tuple = ()
 
 
 @register_part("sph")
@@ -112,6 +115,8 @@ class SPHPart:
             p.add("Q", (3, 3))
         if settings.xsph > 0:
             p.add("vs", (3,))
+        #: (n_materials, 2) density factors of :func:`update_density_and_h`
+        self.density_limits = np.array(settings.density_limits, float).reshape(-1, 2)
         self.F = np.zeros(0)  # pair gradient factors of the current list
         #: callables run after every pass of :meth:`_gradients` (before the
         #: stress divergence): a coupling may zero pair factors ``F`` there
@@ -215,7 +220,8 @@ class SPHPart:
         self._gradients()
         if self.has_ul:
             update_density_and_h(p.L, dt, self.dim, s.benz, p.h0, s.h_min_factor,
-                                 s.h_max_factor, p.rho, p.h)
+                                 s.h_max_factor, p.rho, p.h, p.rho0, p.mat,
+                                 self.density_limits)
         if self.tl is not None:
             self.tl.density(p)
 
@@ -232,9 +238,23 @@ class SPHPart:
         return internal_energies(self.p.m, self.p.e, self.p.e_av)
 
     def columns(self) -> dict[str, float]:
-        """``swegle_unstable``: particles flagged by the Swegle criterion now."""
+        """``swegle_unstable``: particles flagged by the Swegle criterion now;
+        ``density_limited``: updated-Lagrangian particles held at a density limit."""
         self.swegle_field()
-        return {"swegle_unstable": float(self.swegle_unstable)}
+        return {"swegle_unstable": float(self.swegle_unstable),
+                "density_limited": float(self.density_limited())}
+
+    def density_limited(self) -> int:
+        """Updated-Lagrangian particles whose density sits at a limit of their
+        material ([material] min_density_factor, max_density_factor)."""
+        p, lim = self.p, self.density_limits
+        if not len(lim) or not p.n:
+            return 0
+        ul = ~p.tl
+        f = lim[p.mat[ul]]
+        rho, rho0 = p.rho[ul], p.rho0[ul]
+        return int(np.count_nonzero((rho <= f[:, 0] * rho0 * (1 + 1e-12))
+                                    | (rho >= f[:, 1] * rho0 * (1 - 1e-12))))
 
     def fields(self) -> dict:
         """Output fields the part evaluates on demand (for ``particle_fields``)."""

@@ -386,7 +386,8 @@ def xsph_velocity(x, v, m, rho, h, offsets, idx, kid, sigma, dim, support_scale,
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def update_density_and_h(L, dt, dim, benz, h0, hmin_factor, hmax_factor, rho, h):
+def update_density_and_h(L, dt, dim, benz, h0, hmin_factor, hmax_factor, rho, h, rho0,
+                         mat, limits):
     r"""Continuity equation and Benz smoothing-length evolution.
 
     .. math::
@@ -395,15 +396,33 @@ def update_density_and_h(L, dt, dim, benz, h0, hmin_factor, hmax_factor, rho, h)
         \quad\text{(Benz 1989; paper eq. 7)}
 
     integrated exactly for constant :math:`\operatorname{tr} L` over the step
-    (exponential update, keeps both positive). With ``benz`` False ``h`` is
-    unchanged; otherwise it is clipped to ``[hmin_factor, hmax_factor] * h0``.
-    ``rho``, ``h`` (N,) updated in place.
+    (exponential update, keeps both positive), the density then kept within
+    ``limits[mat_i] * rho0_i`` (Autodyn's SPH minimum and maximum density
+    factors). The rate :math:`\dot\rho_i = -\rho_i \operatorname{tr} L_i =
+    \sum_j m_j (\mathbf v_i - \mathbf v_j)\cdot\mathbf g_{ij}` does not scale
+    with :math:`\rho_i`: a sparse particle that keeps expanding (the debris of
+    eroded elements) falls to nearly no density, and a compression after that
+    multiplies it by :math:`e^{\Delta t \dot\rho_i/\rho_i}`, which overflows
+    (1e-9 then 9e38 kg/m^3 in the 400 m/s penetration, docs/examples.md).
+    With ``benz`` False ``h`` is unchanged; otherwise it is clipped to
+    ``[hmin_factor, hmax_factor] * h0``. ``rho``, ``h`` (N,) updated in place;
+    ``rho0`` (N,) initial density [kg/m^3], ``mat`` (N,) material index,
+    ``limits`` (n_materials, 2) the (min, max) factors, or (0, 2) for none.
     """
     n = rho.shape[0]
     inv_d = 1.0 / dim
+    limited = limits.shape[0] > 0
     for i in prange(n):
         div = L[i, 0, 0] + L[i, 1, 1] + L[i, 2, 2]
-        rho[i] *= np.exp(-dt * div)
+        r = rho[i] * np.exp(-dt * div)
+        if limited:
+            lo = limits[mat[i], 0] * rho0[i]
+            hi = limits[mat[i], 1] * rho0[i]
+            if r < lo:
+                r = lo
+            elif r > hi:
+                r = hi
+        rho[i] = r
         if benz:
             hn = h[i] * np.exp(dt * div * inv_d)
             lo = hmin_factor * h0[i]

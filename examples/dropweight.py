@@ -1,0 +1,133 @@
+"""Thesis ch. 8 (Figs. 8.3-8.5): a 500 kg ram dropped 0.95 m on an RC beam.
+
+Runs examples/dropweight_coarse.toml (dx 12 mm) without and with the CSCM
+rate effects into out/dropweight_coarse and out/dropweight_coarse_rate
+(``--full``: also examples/dropweight.toml, dx 6 mm, into out/dropweight;
+``--reuse`` only reads), and writes
+
+* docs/figures/dropweight.png: the gauges over time, the longitudinal strain
+  on the top surface beside the ram (Fig. 8.3) and the vertical
+  displacement at mid-span, mid-height (Fig. 8.4), of every run found; the
+  damage at the end of the first run (Fig. 8.5), the largest damage across
+  the beam's width at each point of its side;
+* a table (stdout, markdown): the peak displacement and strain, when they
+  occur, the ram's peak contact force, steps, wall time, energy error.
+
+    python examples/dropweight.py [--reuse] [--full]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+#: run name: (deck, overrides, label)
+RUNS = {
+    "dropweight_coarse": ("dropweight_coarse.toml", [], "dx 12 mm, no rate effects"),
+    "dropweight_coarse_rate": ("dropweight_coarse.toml", ["material.0.rate_effects=true"],
+                               "dx 12 mm, rate effects"),
+    "dropweight": ("dropweight.toml", [], "dx 6 mm, no rate effects"),
+}
+
+
+def run(name: str, reuse: bool) -> Path:
+    """Run one model (unless ``reuse`` finds its output); its output folder."""
+    from sphdyn.simulation import run_deck
+
+    deck, overrides, _ = RUNS[name]
+    out = ROOT / "out" / name
+    if not (reuse and (out / "summary.json").exists()):
+        run_deck(ROOT / "examples" / deck, out, overrides=overrides, progress=True)
+    return out
+
+
+def side_damage(out: Path) -> tuple[np.ndarray, float]:
+    """(nz, nx) largest damage of the concrete across the width at each point of
+    the side at the last frame, and the lattice spacing [m]."""
+    import h5py
+
+    last = sorted((out / "frames").glob("frame_*.h5"))[-1]
+    with h5py.File(last, "r") as f:
+        x0 = f["position"][:] - f["displacement"][:]
+        d = f["damage"][:]
+        concrete = f["material"][:] == 0  # not the bars' sublayer particles
+    x0, d = x0[concrete], d[concrete]
+    dx = float(np.min(np.diff(np.unique(np.round(x0[:, 2], 6)))))
+    ix = np.floor(x0[:, 0] / dx).astype(int)  # the centres are mid-cell: no ties
+    iz = np.floor(x0[:, 2] / dx).astype(int)
+    img = np.full((iz.max() + 1, ix.max() + 1), np.nan)
+    np.fmax.at(img, (iz, ix), d)
+    return img, dx
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--reuse", action="store_true", help="only read out/dropweight*")
+    ap.add_argument("--full", action="store_true", help="also run the dx 6 mm deck")
+    a = ap.parse_args()
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from sphdyn.io import read_history_csv
+
+    names = [n for n in RUNS if n != "dropweight" or a.full
+             or (ROOT / "out" / n / "summary.json").exists()]
+    outs = {n: run(n, a.reuse or (n == "dropweight" and not a.full)) for n in names}
+    fig = plt.figure(figsize=(11, 10), layout="constrained")
+    grid = fig.add_gridspec(3, 1, height_ratios=[1, 1, 0.9])
+    ax_s, ax_d = fig.add_subplot(grid[0]), fig.add_subplot(grid[1])
+    rows = []
+    for name, out in outs.items():
+        strain = read_history_csv(out / "gauges" / "top_strain.csv")
+        disp = read_history_csv(out / "gauges" / "midspan.csv")
+        label = RUNS[name][2]
+        ax_s.plot(1e3 * strain["time"], 1e6 * strain["strain"], label=label)
+        ax_d.plot(1e3 * disp["time"], 1e3 * disp["displacement_z"], label=label)
+        h = read_history_csv(out / "history.csv")
+        summary = json.loads((out / "summary.json").read_text())
+        k, j = np.argmin(disp["displacement_z"]), np.argmin(strain["strain"])
+        rows.append((label, disp["displacement_z"][k], disp["time"][k],
+                     strain["strain"][j], strain["time"][j], h["F_ram_contact"].max(),
+                     summary["steps"], summary["wall_seconds"],
+                     summary["energy_error_max_rel"], summary["status"]))
+    ax_s.set_ylabel("top-surface strain [µm/m]")
+    ax_s.set_title("Longitudinal strain on the top surface, x = 550-650 mm (thesis Fig. 8.3)")
+    ax_d.set_ylabel("displacement [mm]")
+    ax_d.set_xlabel("time [ms]")
+    ax_d.set_title("Vertical displacement at mid-span, mid-height (thesis Fig. 8.4)")
+    for ax in (ax_s, ax_d):
+        ax.grid(alpha=0.3)
+        ax.legend()
+    first = next(iter(outs))
+    img, dx = side_damage(outs[first])
+    ax = fig.add_subplot(grid[2])
+    im = ax.imshow(img, origin="lower", cmap="inferno_r", vmin=0, vmax=1,
+                   extent=(0, img.shape[1] * dx * 1e3, 0, img.shape[0] * dx * 1e3))
+    ax.set_title(f"Damage at the end, {RUNS[first][2]} (thesis Fig. 8.5; max across "
+                 "the width)")
+    ax.set_xlabel("x [mm]")
+    ax.set_ylabel("z [mm]")
+    fig.colorbar(im, ax=ax, shrink=0.8, label="damage")
+    fig.suptitle("500 kg ram dropped 0.95 m (4.32 m/s) on an RC beam (thesis ch. 8)")
+    figures = ROOT / "docs" / "figures"
+    figures.mkdir(parents=True, exist_ok=True)
+    fig.savefig(figures / "dropweight.png", dpi=110)
+
+    print("| model | peak displacement [mm] | at [ms] | peak top strain [µm/m] | at [ms] "
+          "| ram force max [kN] | steps | wall [s] | energy error (max, rel.) | status |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for label, d, td, e, te, f, steps, wall, err, status in rows:
+        print(f"| {label} | {1e3 * d:.2f} | {1e3 * td:.2f} | {1e6 * e:.0f} | "
+              f"{1e3 * te:.2f} | {1e-3 * f:.1f} | {steps} | {wall:.0f} | {err:.4f} | "
+              f"{status} |")
+
+
+if __name__ == "__main__":
+    main()
