@@ -74,9 +74,10 @@ CASES: dict[str, tuple[int, list[str]]] = {
                                'body.projectile.dx="5 mm"']),
     "penetration_sph": (60, ["mesh.target.block.divisions=[10, 10, 6]",
                              'body.projectile.dx="5 mm"']),
-    # about 1,200 particles at 36 mm (the bars' sublayer at their element length)
-    "dropweight_coarse": (40, ['body.beam.dx="36 mm"']),
-    "dropweight": (40, ['body.beam.dx="36 mm"'] + [
+    # about 1,300 particles: beam and ram head at 36 and 25 mm, the bars'
+    # sublayer at their element length
+    "dropweight_coarse": (40, ['body.beam.dx="36 mm"', 'body.ram.dx="25 mm"']),
+    "dropweight": (40, ['body.beam.dx="36 mm"', 'body.ram.dx="25 mm"'] + [
         f'mesh.{b}.line.element_length="36 mm"' for b in ("bar_b1", "bar_b2", "bar_t1",
                                                          "bar_t2")]),
 }

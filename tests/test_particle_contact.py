@@ -8,6 +8,7 @@ from sphdyn.neighbours import build_neighbours, update_neighbours
 
 
 NO = np.zeros(2)  # no overlap allowance
+TL = np.array([True, False])  # one total-Lagrangian particle: contact applies
 over = np.zeros(2)  # scratch: the deepest raw overlap
 
 
@@ -22,15 +23,21 @@ def test_pair_force_is_antisymmetric_and_only_between_bodies():
     x, m, size, kb, body = _pair(-0.1e-3)
     nl = build_neighbours(x, size, 1.0, 0.0, 2)
     a = np.zeros((2, 3))
-    n = particle_contact(x, m, size, kb, body, 2, nl.offsets, nl.idx, 0.5, 1.0, NO, over, a)
+    n = particle_contact(x, m, size, kb, body, TL, 2, nl.offsets, nl.idx, 0.5, 1.0, NO,
+                         over, a)
     assert n == 2
     assert np.allclose(m[0] * a[0] + m[1] * a[1], 0.0, atol=1e-15 * abs(m[0] * a[0, 0]))
     # spring k = alpha * mean(K) * s^(d-2) = 0.5 * 2e9 * 1 in 2D, penetration 0.1 mm
     assert np.isclose(m[1] * a[1, 0], 0.5 * 2e9 * 0.1e-3)
     assert a[0, 0] < 0 < a[1, 0]  # pushed apart
     a[:] = 0
+    # two updated-Lagrangian particles meet through the kernel: no contact
+    assert particle_contact(x, m, size, kb, body, np.zeros(2, bool), 2, nl.offsets,
+                            nl.idx, 0.5, 1.0, NO, over, a) == 0
+    assert np.all(a == 0)
     body[:] = 0  # same body: no contact
-    assert particle_contact(x, m, size, kb, body, 2, nl.offsets, nl.idx, 0.5, 1.0, NO, over, a) == 0
+    assert particle_contact(x, m, size, kb, body, TL, 2, nl.offsets, nl.idx, 0.5, 1.0, NO,
+                         over, a) == 0
     assert np.all(a == 0)
 
 
@@ -50,7 +57,8 @@ def test_head_on_bounce_is_elastic():
     for k in range(4000):
         a[:] = 0.0
         nl = update_neighbours(nl, x, size, 2)
-        particle_contact(x, m, size, kb, body, 2, nl.offsets, nl.idx, 0.5, 1.0, NO, over, a)
+        particle_contact(x, m, size, kb, body, TL, 2, nl.offsets, nl.idx, 0.5, 1.0, NO,
+                         over, a)
         kick(v, a, zero, m, bc, zero, 0.5 * dt if k == 0 else dt, vm, kick_scratch(2))
         drift(x, v, dt)
     rel = v[1, 0] - v[0, 0]
@@ -68,13 +76,13 @@ def test_overlap_allowance_pushes_only_beyond_it_and_shrinks():
     nl = build_neighbours(x, size, 1.0, 0.0, 2)
     a = np.zeros((2, 3))
     over = np.zeros(2)
-    particle_contact(x, m, size, kb, body, 2, nl.offsets, nl.idx, 0.5, 1.0,
+    particle_contact(x, m, size, kb, body, TL, 2, nl.offsets, nl.idx, 0.5, 1.0,
                      np.array([0.0, 0.2e-3]), over, a)
     assert np.isclose(m[1] * a[1, 0], 0.5 * 2e9 * 0.1e-3, rtol=1e-12)
     assert np.isclose(m[0] * a[0, 0], -m[1] * a[1, 0], rtol=1e-14)
     assert np.allclose(over, 0.3e-3, rtol=1e-12)
     a[:] = 0.0
-    particle_contact(x, m, size, kb, body, 2, nl.offsets, nl.idx, 0.5, 1.0,
+    particle_contact(x, m, size, kb, body, TL, 2, nl.offsets, nl.idx, 0.5, 1.0,
                      np.array([0.3e-3, 0.0]), over, a)
     assert np.all(a == 0.0)
 

@@ -40,8 +40,8 @@ class ParticleContact(InteractionBase):
         p = self.part.p
         self.over = np.zeros(n_new)
         scratch = np.zeros((n_new, 3))
-        particle_contact(p.x, p.m, p.size, p.bulk_modulus, p.body, p.dim, self.nl.offsets,
-                         self.nl.idx, self.alpha, self.distance_factor,
+        particle_contact(p.x, p.m, p.size, p.bulk_modulus, p.body, p.tl, p.dim,
+                         self.nl.offsets, self.nl.idx, self.alpha, self.distance_factor,
                          np.full(n_new, np.inf), self.over, scratch)
         self.allow = np.concatenate([self.allow[:n_old], self.over[n_old:n_new]])
 
@@ -67,7 +67,7 @@ class ParticleContact(InteractionBase):
     def forces(self, t: float, dt: float, a_out: np.ndarray) -> None:
         p = self.part.p
         self.count = int(particle_contact(
-            p.x, p.m, p.size, p.bulk_modulus, p.body, p.dim, self.nl.offsets,
+            p.x, p.m, p.size, p.bulk_modulus, p.body, p.tl, p.dim, self.nl.offsets,
             self.nl.idx, self.alpha, self.distance_factor, self.allow, self.over, a_out))
         np.minimum(self.allow, self.over, out=self.allow)  # allowances only shrink
 

@@ -3,7 +3,8 @@ r"""Penalty contact between particles of different bodies.
 Bodies discretised with the total-Lagrangian kernel never see each other
 through the SPH sums (their neighbour lists are fixed in the reference
 configuration), so they need a contact algorithm (thesis sec. 3.2). Two
-particles of different bodies are in contact when their distance is below
+particles of different bodies, one of them at least total-Lagrangian
+(updated-Lagrangian bodies meet through the kernel), are in contact when their distance is below
 :math:`d_{ij} = f_c (s_i + s_j)/2` with the particle size
 :math:`s = V_0^{1/d}` and ``f_c`` the contact distance factor (1 = touching
 cells). The pair force is a linear spring along the centre line,
@@ -33,14 +34,17 @@ from numba import njit, prange
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def particle_contact(x, m, size, kbulk, body, dim, offsets, idx, alpha, dist_factor,
+def particle_contact(x, m, size, kbulk, body, tl, dim, offsets, idx, alpha, dist_factor,
                      allow, over, a_contact):
     r"""Add inter-body contact accelerations to ``a_contact`` (N, 3) [m/s^2].
 
     ``offsets``, ``idx``: a current-configuration neighbour list whose pair
     radius covers ``dist_factor * (s_i + s_j) / 2``; pairs within one body are
-    skipped. ``size`` (N,) particle sizes [m], ``kbulk`` (N,) bulk moduli
-    [Pa], ``body`` (N,) body ids. Zero-mass particles take part with no
+    skipped, and so are pairs of two updated-Lagrangian particles (``tl`` (N,)
+    bool: total-Lagrangian), which meet through the kernel already (a bar's
+    sublayer particles inside the concrete would be pushed out). ``size``
+    (N,) particle sizes [m], ``kbulk`` (N,) bulk moduli [Pa], ``body`` (N,)
+    body ids. Zero-mass particles take part with no
     force of their own (they carry no momentum) but push their partners.
 
     ``allow`` (N,) [m]: each particle's overlap allowance (LS-DYNA's IGNORE):
@@ -55,12 +59,15 @@ def particle_contact(x, m, size, kbulk, body, dim, offsets, idx, alpha, dist_fac
     count = 0
     for i in prange(n):
         bi = body[i]
+        tli = tl[i]
         a0 = a1 = a2 = 0.0
         touching = 0
         deepest = 0.0
         for k in range(offsets[i], offsets[i + 1]):
             j = idx[k]
             if body[j] == bi:
+                continue
+            if tli == 0 and tl[j] == 0:
                 continue
             d0 = x[i, 0] - x[j, 0]
             d1 = x[i, 1] - x[j, 1]

@@ -111,9 +111,11 @@ class Contact(Section):
     """[contact]: penalty contact between particles of different bodies."""
 
     enabled: Optional[StrictBool] = Field(
-        None, description="Particle-particle contact between bodies; default: "
-        "on when the model has two or more bodies and one of them is "
-        "total-Lagrangian (those see no other body through the SPH sums).")
+        None, description="Particle-particle contact between bodies, for pairs with "
+        "a total-Lagrangian particle (those see no other body through the SPH "
+        "sums; updated-Lagrangian bodies meet through the kernel); default: on "
+        "when the model has two or more bodies and one of them is "
+        "total-Lagrangian.")
     distance_factor: real("contact distance factor", lo=0, lo_open=True) = Field(
         1.0, description="Particles of different bodies touch below "
         "distance_factor * (s_i + s_j)/2, s = initial particle size V0^(1/dim).")
