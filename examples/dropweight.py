@@ -53,6 +53,8 @@ def side_damage(out: Path) -> tuple[np.ndarray, float]:
     the side at the last frame, and the lattice spacing [m]."""
     import h5py
 
+    from sphdyn.analysis import side_view_max
+
     last = sorted((out / "frames").glob("frame_*.h5"))[-1]
     with h5py.File(last, "r") as f:
         x0 = f["position"][:] - f["displacement"][:]
@@ -60,11 +62,7 @@ def side_damage(out: Path) -> tuple[np.ndarray, float]:
         concrete = f["material"][:] == 0  # not the bars' sublayer particles
     x0, d = x0[concrete], d[concrete]
     dx = float(np.min(np.diff(np.unique(np.round(x0[:, 2], 6)))))
-    ix = np.floor(x0[:, 0] / dx).astype(int)  # the centres are mid-cell: no ties
-    iz = np.floor(x0[:, 2] / dx).astype(int)
-    img = np.full((iz.max() + 1, ix.max() + 1), np.nan)
-    np.fmax.at(img, (iz, ix), d)
-    return img, dx
+    return side_view_max(x0, d, dx), dx
 
 
 def main() -> None:

@@ -88,6 +88,7 @@ def side_damage(out: Path, model: str) -> np.ndarray:
     """(nz, nx) largest damage across the width at each point of the side, last frame."""
     import h5py
 
+    from sphdyn.analysis import side_view_max
     from sphdyn.io import read_frame_meshes
 
     last = sorted((out / "frames").glob("frame_*.h5"))[-1]
@@ -101,12 +102,7 @@ def side_damage(out: Path, model: str) -> np.ndarray:
             d = f["damage"][:]
             concrete = f["material"][:] == 0  # not the bars' sublayer particles
         x0, d = x0[concrete], d[concrete]
-    ix = np.floor(x0[:, 0] / DX).astype(int)  # the centres are mid-cell: no ties
-    iz = np.floor(x0[:, 2] / DX).astype(int)
-    img = np.full((iz.max() + 1, ix.max() + 1), np.nan)
-    for i, k, v in zip(iz, ix, d):
-        img[i, k] = v if np.isnan(img[i, k]) else max(img[i, k], v)
-    return img
+    return side_view_max(x0, d, DX)
 
 
 def table_row(model: str, out: Path, d: np.ndarray, f: np.ndarray) -> tuple:

@@ -472,3 +472,15 @@ geometry = {{ shape = "box", lo = [0, 0, 0], hi = [0.1, 0.1, 0.01] }}
     side = np.max(hi_b - lo_b)
     assert np.allclose(lo_b - model.domain_lo, side, rtol=1e-12, atol=0)
     assert np.allclose(model.domain_hi - hi_b, side, rtol=1e-12, atol=0)
+
+
+def test_side_view_takes_the_largest_value_across_the_width():
+    # cells of 10 mm: two particles in cell (x 0, z 1) at different y keep the
+    # larger value, an empty cell is NaN, and the image is (nz, nx)
+    from sphdyn.analysis import side_view_max
+
+    x0 = np.array([[0.005, 0.005, 0.015], [0.005, 0.025, 0.015], [0.015, 0.0, 0.005]])
+    img = side_view_max(x0, np.array([0.2, 0.7, 1.0]), 0.01)
+    assert img.shape == (2, 2)
+    assert img[1, 0] == 0.7 and img[0, 1] == 1.0
+    assert np.isnan(img[0, 0]) and np.isnan(img[1, 1])

@@ -127,3 +127,20 @@ def window_mean_force(time, impulse, window: float) -> np.ndarray:
     impulse = np.asarray(impulse, dtype=float)
     before = np.interp(time - window, time, impulse, left=0.0)
     return (impulse - before) / window
+
+
+def side_view_max(x0, values, dx: float) -> np.ndarray:
+    """A side view (x-z plane) of a lattice body: the largest of ``values`` over
+    the width (y) at each point of the side, as an image.
+
+    ``x0`` (N, 3) the particles' initial positions (cell centres of a lattice
+    of spacing ``dx`` [m] from the origin, or element centres), ``values``
+    (N,). Returns (nz, nx) with ``img[k, i]`` the largest value of the
+    particles in cell ``(floor(x/dx), floor(z/dx)) = (i, k)``, NaN where none
+    (the damage pictures of examples/igirder.py and dropweight.py).
+    """
+    ix = np.floor(x0[:, 0] / dx).astype(int)  # the centres are mid-cell: no ties
+    iz = np.floor(x0[:, 2] / dx).astype(int)
+    img = np.full((iz.max() + 1, ix.max() + 1), np.nan)
+    np.fmax.at(img, (iz, ix), values)
+    return img
