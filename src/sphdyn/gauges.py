@@ -38,6 +38,7 @@ import numpy as np
 from .deck import DeckError
 from .deck.errors import format_problem
 from .io.history import History
+from .monitors import next_multiple
 from .state import BC_SLAVE
 
 
@@ -165,11 +166,6 @@ def build_gauges(deck, parts) -> list[Gauge]:
     return gauges
 
 
-def _after(t: float, every: float) -> float:
-    """The first multiple of ``every`` after the one ``t`` is at or past."""
-    return (math.floor(t / every + 1e-9) + 1) * every
-
-
 class GaugeRecorder:
     """The monitor that samples the gauges: at the kick's time, each gauge
     whose next sample time has come (kept once the step has passed the
@@ -186,7 +182,7 @@ class GaugeRecorder:
                 row = {"time": s.t}
                 row.update(g.values(s.parts))
                 self._rows.append((g, row))
-                g.next_time = _after(s.t, g.every)
+                g.next_time = next_multiple(s.t, g.every)
 
     def after_step(self, s) -> None:
         for g, row in self._rows:
@@ -217,4 +213,4 @@ class GaugeRecorder:
                 g.history = History.from_csv(path)
                 g.history.truncate_after(np.nextafter(t, -np.inf))
             if len(g.history):  # the next sample as the run would have taken it
-                g.next_time = _after(g.history.as_arrays()["time"][-1], g.every)
+                g.next_time = next_multiple(g.history.as_arrays()["time"][-1], g.every)

@@ -85,6 +85,12 @@ class HistoryFlush:
             self._last = done
 
 
+def next_multiple(t: float, every: float) -> float:
+    """The first multiple of ``every`` after the one ``t`` [s] is at or past
+    (round-off below a multiple counts as reaching it)."""
+    return (math.floor(t / every + 1e-9) + 1) * every
+
+
 class FrameOutput:
     """Write a frame whenever the time passes the next multiple of ``every``."""
 
@@ -96,7 +102,7 @@ class FrameOutput:
         return t >= self.next_frame - 1e-12 * self.t_end
 
     def written(self, t: float) -> None:
-        self.next_frame = (math.floor(t / self.every + 1e-9) + 1) * self.every
+        self.next_frame = next_multiple(t, self.every)
 
     def after_step(self, s) -> None:
         if self.due(s.t):

@@ -155,10 +155,7 @@ class Stepper:
         self.kinetic, self.dt_step = ke, dt
         for inter in self.interactions:
             inter.after_kick(dt_kick)
-            # (gravity) external work, not an interaction's; an interaction
-            # without the hook (written to the protocol before it) has none
-            external = getattr(inter, "external_work", None)
-            w = external() if external is not None else 0.0
+            w = inter.external_work()  # (gravity) external, not an interaction's
             self.work_contact -= w
             self.work_external += w
         for inter in self.interactions:

@@ -279,12 +279,14 @@ def plot_gauges(gauge_dir: str | os.PathLike, out_path: str | os.PathLike,
     tf, tu = time_unit(t_max)
     fig, axes = _figure(len(files), 3.0)
     for ax, f, d in zip(axes, files, data):
-        cols = [c for c in d if c != "time"]
-        for c in cols:
+        units = []
+        for c in (c for c in d if c != "time"):
             ax.plot(d["time"] * tf, d[c], label=c)
-        kind = cols[0].rsplit("_", 1)[0] if cols else ""
-        unit = GAUGE_UNITS.get(kind, "")
-        ax.set_ylabel(per_depth(unit, dimension) if kind == "force" else unit)
+            kind = c.rsplit("_", 1)[0]  # strain, displacement_z, force_x, ...
+            unit = GAUGE_UNITS.get(kind, "")
+            unit = per_depth(unit, dimension) if kind == "force" else unit
+            units += [unit] if unit not in units else []
+        ax.set_ylabel(", ".join(units))  # a point gauge may mix m and m/s
         _finish_axes(ax, f"gauge {f.stem}")
     axes[-1].set_xlabel(f"time [{tu}]")
     return save_figure(fig, out_path, 120)

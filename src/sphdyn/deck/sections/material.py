@@ -16,9 +16,11 @@ from ..units import DENSITY, PRESSURE, TIME
 from ..values import Quantity, Section, name_of, quantity, real
 from .bodies import Variation
 
-#: Keys of every material that are not parameters of its model (the SPH part
-#: reads them: :class:`sphdyn.parts.sph.part.SPHSettings`).
-NOT_PARAMETERS = ("min_density_factor", "max_density_factor")
+#: Keys of every material that are not parameters of its model: what it is
+#: and how it varies or erodes, and the density limits the SPH part reads
+#: (:class:`sphdyn.parts.sph.part.SPHSettings`).
+NOT_PARAMETERS = ("name", "model", "variation", "erosion", "min_density_factor",
+                  "max_density_factor")
 
 #: Mass density of a material (required, > 0).
 Density = quantity(DENSITY, lo=0, lo_open=True)
@@ -91,8 +93,7 @@ class MaterialSection(Section):
         var = self.variation
         if var is None:
             return self
-        fixed = {"name", "model", "density", "variation", "erosion", *NOT_PARAMETERS,
-                 *self.unvaried}
+        fixed = {"density", *NOT_PARAMETERS, *self.unvaried}
         numeric = [k for k, f in type(self).model_fields.items() if k not in fixed
                    and strip_optional(f.annotation) is float]
         if var.parameter not in numeric:
@@ -110,8 +111,7 @@ class MaterialSection(Section):
         but name, model, variation, erosion and the density limits, absent (None)
         values left out."""
         return {key: v for key, v in self.model_dump().items()
-                if key not in ("name", "model", "variation", "erosion", *NOT_PARAMETERS)
-                and v is not None}
+                if key not in NOT_PARAMETERS and v is not None}
 
     @classmethod
     def stress_keys(cls) -> tuple[str, ...]:
