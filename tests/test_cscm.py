@@ -389,13 +389,74 @@ def test_group_kernel_matches_point_function_and_wave_speed():
     assert c[2] == pytest.approx(math.sqrt((K + 4 * G / 3) / 2400), rel=1e-12)
 
 
+@pytest.mark.parametrize("bhat", [-math.pi / 6, 0.1, math.pi / 6])
+def test_meridian_slope_is_the_derivative_of_the_meridian(bhat):
+    # meridian_radius_slope: the value bit for bit that of meridian_radius,
+    # the slope against a central difference (step 1e-4 of |J1| + alpha:
+    # truncation ~h^2 F''', round-off ~eps F / h, both below 1e-6 of the
+    # slope scale) on the tensile part (Rubin ratios held, J1 < 0), the shear
+    # part (J1 in (0, L)) and the cap (L, X), with a hardened cap.
+    p = packed()
+    kappa = 60e6
+    m = cscm.meridian(bhat, kappa, p)
+    L, X = m[2], m[3]
+    apex = p[cscm.P_J1APEX]
+    points = np.concatenate([np.linspace(apex, 0, 12)[1:-1], np.linspace(0, L, 12)[1:-1],
+                             np.linspace(L, X, 12)[1:-2]])
+    scale = cscm.shear_surface(0.0, p) / abs(apex)
+    for J1 in points:
+        F, dF = cscm.meridian_radius_slope(J1, m, p)
+        assert F == cscm.meridian_radius(J1, m, p)
+        h = 1e-4 * (abs(J1) + p[cscm.P_ALPHA])
+        fd = (cscm.meridian_radius(J1 + h, m, p) - cscm.meridian_radius(J1 - h, m, p)) / (2 * h)
+        assert dF == pytest.approx(fd, rel=1e-6, abs=1e-6 * scale)
+    assert cscm.meridian_radius_slope(apex - 1.0, m, p) == (0.0, 0.0)
+    assert cscm.meridian_radius_slope(X + 1.0, m, p) == (0.0, 0.0)
+
+
+def test_sure_elastic_test_never_passes_a_yielding_stress():
+    # surely_elastic() skips the full yield check. Its bound needs the Rubin
+    # factor >= min(Q1, Q2, 1) at every Lode angle: checked on a grid of
+    # angles over the fits' Q1, Q2 from J1 = -10 to 300 MPa. Then 20,000
+    # random stresses (pressures from tension beyond the apex to beyond the
+    # cap, deviators up to 1.5 x the surface, initial and hardened caps):
+    # whenever it says elastic, yield_function() <= 0; and it does say so
+    # for most states well inside (a test that cannot pass by saying False).
+    p = packed()
+    beta = np.linspace(-math.pi / 6, math.pi / 6, 61)
+    for J1 in np.linspace(-10e6, 300e6, 40):
+        q1, q2 = cscm.rubin_q(J1, p)
+        rub = [cscm.rubin_factor(q1, q2, b) for b in beta]
+        assert min(rub) >= min(q1, q2, 1.0) * (1 - 1e-12)
+    rng = np.random.default_rng(11)
+    said = inside = 0
+    for kappa in (cscm.kappa0(p), 60e6):
+        X = cscm.cap_function(0.0, kappa, p)[1]
+        for _ in range(10000):
+            J1 = rng.uniform(p[cscm.P_J1APEX] - 5e6, X + 10e6)
+            dev = rng.normal(size=6)
+            dev[:3] -= dev[:3].mean()
+            nrm = math.sqrt(0.5 * (dev[:3] @ dev[:3]) + dev[3:] @ dev[3:])
+            r = rng.uniform(0.0, 1.5) * cscm.shear_surface(max(J1, 0.0), p)
+            s = tuple(dev * r / nrm - np.array([J1 / 3] * 3 + [0.0] * 3))
+            f = cscm.yield_function(s, kappa, p)
+            if cscm.surely_elastic(s, kappa, p):
+                said += 1
+                assert f <= 0.0
+            if f < -0.3 * cscm.shear_surface(max(J1, 0.0), p) ** 2 and 0 < J1 < kappa:
+                inside += 1
+    assert inside > 500 and said > 0.8 * inside
+
+
 def test_fast_return_equals_global_closest_point():
     # project() takes a local bracketing path when the trial lies above the
-    # meridian; it must find the same closest point as the global scan +
-    # golden-section search of project_global() (and never a worse one).
-    # 1500 random trials: tension, shear, compression up to beyond the cap,
-    # three Lode angles, initial and hardened caps. Tolerance 1e-6 of the
-    # surface extent in J1 (the golden bracket + refinement reach ~1e-9).
+    # meridian or in tension beyond the apex; it must find the same closest
+    # point as the global scan + golden-section search of project_global()
+    # (and never a worse one). 1500 random trials: tension (a third beyond
+    # the apex, down to 30 MPa below it: the disc's tensile failures reach
+    # 20 MPa), shear, compression up to beyond the cap, three Lode angles,
+    # initial and hardened caps. Tolerance 1e-6 of the surface extent in J1
+    # (the golden bracket + refinement reach ~1e-9).
     p = packed()
     K, G = p[cscm.P_K], p[cscm.P_G]
     rng = np.random.default_rng(7)
@@ -406,8 +467,12 @@ def test_fast_return_equals_global_closest_point():
         ext = X - p[cscm.P_J1APEX]
         for _ in range(500):
             J1t = rng.uniform(p[cscm.P_J1APEX] - 5e6, X + 20e6)
+            if checked % 3 == 0:
+                J1t = p[cscm.P_J1APEX] - rng.uniform(0.0, 30e6)
             bhat = rng.choice([-math.pi / 6, 0.0, math.pi / 6]) * rng.uniform(0.2, 1.0)
             rt = rng.uniform(0.0, 2.0) * cscm.shear_surface(max(J1t, 0.0), p)
+            if J1t < p[cscm.P_J1APEX]:
+                rt = rng.uniform(0.0, 3.0) * cscm.shear_surface(0.0, p)
             fast = cscm.project(J1t, rt, bhat, kappa, K, G, p)
             glob = cscm.project_global(J1t, rt, bhat, kappa, K, G, p)
             phi = [(j - J1t) ** 2 / (9 * K) + (r - rt) ** 2 / G for j, r in (fast, glob)]

@@ -7,6 +7,16 @@ before the parts/interactions/events architecture. The comparison is
 bitwise: the reshaping moved code, not arithmetic. A case may be given a
 relative tolerance in ``TOLERANCE`` only where the order of a floating-point
 reduction had to change, with the reason next to it.
+
+Rewritten on purpose (``python tests/regression_cases.py``):
+2026-11-26, the speed work of issue 17: the CSCM return uses the exact
+meridian slope instead of a difference quotient (a deliberate numerical
+choice, docs/cscm.md: returned points move by ~1e-7 of the return
+distance), and the SPH force pass sums ``(P_i + P_j) g`` with
+``P = sigma B / rho^2`` formed once per particle (round-off).
+The 22 decks whose results changed were rewritten; the others are bitwise
+as before. BENCHMARKS.md gives the effect on the coarse drop-weight's
+history.
 """
 
 import subprocess

@@ -221,6 +221,21 @@ def test_cli_bench_hex3d(capsys):
     assert "--elements" in capsys.readouterr().err
 
 
+def test_cli_bench_hvi_projects_the_event_time(capsys):
+    """The drop-weight benchmark (coarse deck, 3 steps: the first steps need no
+    contact yet): the projected event time is t_end / dt steps at the measured
+    rate; --coarse is refused for the other cases."""
+    assert main(["bench", "hvi", "--coarse", "--steps", "3"]) == 0
+    rec = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert rec["case"] == "hvi" and rec["deck"].endswith("dropweight_coarse.toml")
+    assert rec["particles"] == 35397 and rec["t_end"] == 0.02
+    assert rec["event_steps"] == pytest.approx(rec["t_end"] / rec["dt"], rel=1e-12)
+    assert rec["projected_event_seconds"] == pytest.approx(
+        rec["event_steps"] * rec["seconds"] / rec["steps"], rel=1e-12)
+    assert main(["bench", "block3d", "--coarse"]) == 2
+    assert "--coarse" in capsys.readouterr().err
+
+
 EXAMPLES = sorted(Path(__file__).parent.parent.glob("examples/*.toml"))
 
 

@@ -6,7 +6,7 @@ import pytest
 from sphdyn import kernels
 from sphdyn.geometry import box_lattice
 from sphdyn.neighbours import build_neighbours
-from sphdyn.parts.sph.passes import (forces, scaled_stress,
+from sphdyn.parts.sph.passes import (forces, stress_terms,
                                update_density_and_h, velocity_gradient, xsph_velocity)
 
 
@@ -44,9 +44,10 @@ def _grad(c, v, correct, with_factors=False):
     B = np.zeros((n, 3, 3))
     nl = c["nl"]
     F = np.zeros(nl.idx.size)
+    count = np.zeros(n, np.int32)
     velocity_gradient(c["x"], v, c["h"], c["m"], c["rho"], nl.offsets, nl.idx, c["kid"], c["sigma"],
-                      c["dim"], 1.0, correct, F, L, B)
-    return (L, B, F) if with_factors else (L, B)
+                      c["dim"], 1.0, correct, F, L, B, count)
+    return (L, B, F, count) if with_factors else (L, B)
 
 
 def _linear_field(dim, seed=1):
@@ -102,15 +103,71 @@ def test_boundary_gradient_is_wrong_without_correction(dim):
 def _forces(c, sig, v=None, correct=False, alpha=0.0, beta=0.0, cs=1000.0):
     n = c["x"].shape[0]
     v = np.zeros((n, 3)) if v is None else v
-    L, B, F = _grad(c, v, correct, with_factors=True)
+    L, B, F, count = _grad(c, v, correct, with_factors=True)
     a = np.zeros((n, 3))
     dedt = np.zeros(n)
     nl = c["nl"]
-    S = np.zeros((n, 3, 3))
-    scaled_stress(sig, c["rho"], S)
-    forces(c["x"], v, c["m"], c["rho"], c["h"], np.full(n, cs), S, B, F,
-           nl.offsets, nl.idx, c["dim"], 1.0, correct, alpha, beta, a, dedt)
+    P = np.zeros((n, 3, 3))
+    stress_terms(sig, c["rho"], B, P)
+    forces(c["x"], v, c["m"], c["rho"], c["h"], np.full(n, cs), P, F,
+           nl.offsets, count, nl.idx, c["dim"], 1.0, alpha, beta, a, dedt)
     return a, dedt
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_rows_hold_the_pairs_within_the_support_first(dim):
+    # A jittered cloud with a Verlet skin (half the support): each row keeps
+    # its neighbours, with the count[i] pairs inside the support at its head
+    # in their former order (F != 0 there) and the skin's pairs after them
+    # (F = 0, r >= support); L is the same as from the sorted rows (to
+    # round-off: only zero terms moved) and bitwise the same on a second
+    # call (the head's order is kept). The forces pass visits only the head:
+    # the same accelerations as over whole rows (count = row length).
+    c = _cloud(dim, n_side=8, jitter=0.3)
+    x, h = c["x"], c["h"]
+    q = kernels.support(c["kid"])
+    c["nl"] = nl = build_neighbours(x, h, q, 0.5 * q * h.max(), dim)
+    before = nl.idx.copy()
+    v = np.random.default_rng(4).normal(size=(x.shape[0], 3))
+    L, B, F, count = _grad(c, v, True, with_factors=True)
+    inside_any = 0
+    for i in range(x.shape[0]):
+        lo, hi = nl.offsets[i], nl.offsets[i + 1]
+        row, old = nl.idx[lo:hi], before[lo:hi]
+        assert sorted(row) == sorted(old)
+        r = np.linalg.norm(x[i] - x[row], axis=1)
+        inside = r < q * 0.5 * (h[i] + h[row])
+        k = count[i]
+        assert inside[:k].all() and not inside[k:].any()
+        assert np.all(F[lo:lo + k] != 0.0) and np.all(F[lo + k:hi] == 0.0)
+        assert list(row[:k]) == [j for j in old if j in set(row[:k])]
+        inside_any += k < hi - lo
+    assert inside_any > 0.5 * x.shape[0]  # the skin held pairs in most rows
+    L2, _ = _grad(c, v, True)
+    assert np.array_equal(L, L2)
+    c_sorted = dict(c, nl=build_neighbours(x, h, q, 0.5 * q * h.max(), dim))
+    L0, _ = _grad(c_sorted, v, True)
+    assert np.allclose(L, L0, rtol=0.0, atol=1e-13 * np.abs(L0).max())
+    sig = np.random.default_rng(5).normal(scale=1e6, size=(x.shape[0], 3, 3))
+    sig = 0.5 * (sig + sig.transpose(0, 2, 1))
+    a_head, heat_head = _forces(c, sig, v=v, correct=True, alpha=1.0, beta=2.0)
+    P = np.zeros_like(sig)
+    stress_terms(sig, c["rho"], B, P)
+    a_all, heat_all = np.zeros_like(a_head), np.zeros_like(heat_head)
+    forces(x, v, c["m"], c["rho"], h, np.full(x.shape[0], 1000.0), P, F, nl.offsets,
+           np.diff(nl.offsets).astype(np.int32), nl.idx, dim, 1.0, 1.0, 2.0, a_all, heat_all)
+    assert np.array_equal(a_head, a_all) and np.array_equal(heat_head, heat_all)
+
+
+def test_stress_terms_are_the_stress_times_the_correction_over_rho_squared():
+    rng = np.random.default_rng(6)
+    sig = rng.normal(scale=1e6, size=(5, 3, 3))
+    B = np.eye(3) + 0.2 * rng.normal(size=(5, 3, 3))
+    rho = rng.uniform(1000.0, 8000.0, 5)
+    P = np.zeros((5, 3, 3))
+    stress_terms(sig, rho, B, P)
+    expect = np.einsum("nab,nbc->nac", sig, B) / rho[:, None, None] ** 2
+    assert np.allclose(P, expect, rtol=1e-14, atol=1e-14 * np.abs(expect).max())
 
 
 @pytest.mark.parametrize("dim", [2, 3])
@@ -214,7 +271,7 @@ def test_continuity_is_the_summation_form_at_a_density_jump(dim):
     v = rng.normal(size=(n, 3))
     if dim == 2:
         v[:, 2] = 0.0
-    L, _, F = _grad(c, v, False, with_factors=True)
+    L, _, F, _ = _grad(c, v, False, with_factors=True)
     nl = c["nl"]
     direct = np.zeros(n)
     for i in range(n):
@@ -348,14 +405,16 @@ def test_pair_stress_and_viscosity_match_their_formulas(alpha, beta, approach):
     sig = rng.normal(scale=1e6, size=(2, 3, 3))
     sig = 0.5 * (sig + sig.transpose(0, 2, 1))
     B = np.eye(3) + 0.1 * rng.normal(size=(2, 3, 3))
-    S = np.zeros((2, 3, 3))
-    scaled_stress(sig, rho, S)
+    S = sig / rho[:, None, None] ** 2
+    P = np.zeros((2, 3, 3))
+    stress_terms(sig, rho, B, P)
     support_scale = 1.2
     F = np.array([-4e9, -4e9])  # the pair factor of both rows (a symmetric pair)
     offsets, idx = np.array([0, 1, 2]), np.array([1, 0], dtype=np.int32)
+    count = np.ones(2, np.int32)
     a = np.zeros((2, 3))
     dedt = np.zeros(2)
-    forces(x, v, m, rho, h, c, S, B, F, offsets, idx, 3, support_scale, True, alpha, beta,
+    forces(x, v, m, rho, h, c, P, F, offsets, count, idx, 3, support_scale, alpha, beta,
            a, dedt)
     acc, heat, pi = _pair_acceleration(x, v, m, rho, h, c, S, B, F[0], support_scale,
                                        alpha, beta)
@@ -366,8 +425,8 @@ def test_pair_stress_and_viscosity_match_their_formulas(alpha, beta, approach):
     if approach:
         # the viscous part alone, separately: with zero stress the
         # acceleration is -m_j Pi_ij g_ij exactly
-        forces(x, v, m, rho, h, c, np.zeros_like(S), B, F, offsets, idx, 3, support_scale,
-               True, alpha, beta, a, dedt)
+        forces(x, v, m, rho, h, c, np.zeros_like(P), F, offsets, count, idx, 3,
+               support_scale, alpha, beta, a, dedt)
         expect = -m[1] * pi * F[0] * (x[0] - x[1])
         assert np.allclose(a[0], expect, rtol=1e-12, atol=0.0)
         assert heat > 0.0  # viscosity only heats

@@ -27,7 +27,8 @@ def _body(dim, n_side=8, dx=0.01, jitter=0.0, seed=0):
     w = np.zeros(nl.idx.size)
     B0 = np.zeros((n, 3, 3))
     gsum = np.zeros((n, 3))
-    reference_gradients(X, h0, vol, nl.offsets, nl.idx, kid, sigma, dim, 1.0, fac, w, B0, gsum)
+    reference_gradients(np.arange(X.shape[0]), X, h0, vol, nl.offsets, nl.idx, kid, sigma, dim,
+                        1.0, fac, w, B0, gsum)
     return dict(X=X, n=n, dim=dim, m=m, rho0=rho0, vol=vol, nl=nl, w=w, B0=B0, fac=fac,
                 gsum=gsum)
 

@@ -310,8 +310,10 @@ def cmd_bench(args) -> int:
     if args.elements is not None and args.case != "hex3d":
         raise ValueError(f"--elements: the case {args.case} has no elements. Fix: use it "
                          "with hex3d")
+    if args.coarse and args.case != "hvi":
+        raise ValueError("--coarse: only the hvi case has a coarse deck. Fix: drop --coarse")
     print(main_json(case=args.case, steps=args.steps, threads=args.threads,
-                    particles=args.particles, elements=args.elements))
+                    particles=args.particles, elements=args.elements, coarse=args.coarse))
     return 0
 
 
@@ -514,12 +516,14 @@ def build_parser() -> argparse.ArgumentParser:
     i.set_defaults(func=cmd_info)
 
     b = sub.add_parser("bench", help="run a built-in benchmark, print one JSON line")
-    b.add_argument("case", choices=("rings2d", "rings2d_tl", "block3d", "hex3d"))
+    b.add_argument("case", choices=("rings2d", "rings2d_tl", "block3d", "hex3d", "hvi"))
     b.add_argument("--steps", type=_whole(1), default=1000)
     b.add_argument("--threads", type=_whole(1), default=None, help="Numba threads (default: automatic)")
     b.add_argument("--particles", type=_whole(8), help="block3d: approximate particle "
                    "count (the rings cases have a fixed count)")
     b.add_argument("--elements", type=_whole(1), help="hex3d: approximate element count")
+    b.add_argument("--coarse", action="store_true", help="hvi: the coarse drop-weight deck "
+                   "(dx 12 mm) instead of the full one (dx 6 mm)")
     b.set_defaults(func=cmd_bench)
     mt = sub.add_parser("material-test", help="drive one material point along a load "
                         "path; CSV + plot into --out")

@@ -56,8 +56,9 @@ from .projection import (NGOLDEN, NSCAN, project, project_global, project_on_mer
                          yield_fraction)
 from .schema import CscmParams
 from .surface import (cap_from_compaction, cap_function, invariants, j1_radius,
-                      kappa_from_cap, meridian, meridian_radius, rubin_factor, rubin_q,
-                      shear_surface, surface_radius, yield_function)
+                      kappa_from_cap, meridian, meridian_radius, meridian_radius_slope,
+                      rubin_factor, rubin_q,
+                      shear_surface, surely_elastic, surface_radius, yield_function)
 
 CSCM = register(MaterialModel(
     name="cscm",

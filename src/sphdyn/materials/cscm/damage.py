@@ -77,7 +77,7 @@ def max_principal(e):
         return m
     j3 = (d0 * (d1 * d2 - e[4] * e[4]) - e[3] * (e[3] * d2 - e[4] * e[5])
           + e[5] * (e[3] * e[4] - d1 * e[5]))
-    x = 1.5 * math.sqrt(3.0) * j3 / j2 ** 1.5
+    x = 1.5 * math.sqrt(3.0) * j3 / (j2 * math.sqrt(j2))  # j2^(3/2) without a pow()
     x = min(1.0, max(-1.0, x))
     th = math.asin(x) / 3.0   # in [-pi/6, pi/6]; largest eigenvalue:
     return m + 2.0 * math.sqrt(j2 / 3.0) * math.cos(math.pi / 6.0 - th)

@@ -23,7 +23,7 @@ from .layout import (H_DB, H_DD, H_EPS, H_ERODED, H_EV, H_KAPPA, H_R0C, H_R0T, H
                      P_RECOV_VOL, P_REPOW, P_RETRACT, P_SRATE)
 from .projection import project_on_meridian, yield_fraction
 from .surface import (cap_from_compaction, invariants, j1_radius, kappa_from_cap, meridian,
-                      meridian_radius)
+                      meridian_radius, surely_elastic)
 
 N_STRIPES = 64  # interleaved work stripes of the group kernel (load balance)
 
@@ -97,12 +97,16 @@ def cscm_point(h, deps, dt, p, size):
         trial = elastic_increment(svp, de, K, G)
         kappa = h[H_KAPPA]
         # yield check f = J2' - F^2 <= tol (as yield_function, with the
-        # invariants and meridian constants reused by the return)
-        J1t, rt, bhat, dev = invariants(trial)
-        mer = meridian(bhat, kappa, p)
-        ft = meridian_radius(J1t, mer, p)
-        if (p[P_J1APEX] <= J1t <= mer[3]
-                and rt * rt - ft * ft <= 1e-12 * (p[P_ALPHA] ** 2)):
+        # invariants and meridian constants reused by the return), after a
+        # cheaper sufficient test that most elastic points pass
+        elastic = surely_elastic(trial, kappa, p)
+        if not elastic:
+            J1t, rt, bhat, dev = invariants(trial)
+            mer = meridian(bhat, kappa, p)
+            ft = meridian_radius(J1t, mer, p)
+            elastic = (p[P_J1APEX] <= J1t <= mer[3]
+                       and rt * rt - ft * ft <= 1e-12 * (p[P_ALPHA] ** 2))
+        if elastic:
             svp = trial
         else:
             J1p, rp = project_on_meridian(J1t, rt, mer, K, G, p)

@@ -10,7 +10,7 @@ import math
 from numba import njit
 
 from .layout import P_ALPHA, P_J1APEX
-from .surface import meridian_radius, meridian, yield_function
+from .surface import meridian, meridian_radius, meridian_radius_slope, yield_function
 
 NSCAN = 32  # coarse scan of the projection (see project)
 NGOLDEN = 30  # golden-section iterations of the projection (bracket 5e-7 of a scan cell)
@@ -46,66 +46,126 @@ def project(J1t, rt, bhat, kappa, K, G, p):
 
 @njit(cache=True, error_model="numpy")
 def project_on_meridian(J1t, rt, m, K, G, p):
-    """:func:`project` with the meridian constants ``m`` of :func:`meridian`."""
+    """:func:`project` with the meridian constants ``m`` of :func:`meridian`.
+
+    Besides the fast path of :func:`project` (trial above the meridian), a
+    trial in tension beyond the apex (``J1t <= J1_apex``, the usual tensile
+    failure) has a fast path of its own. The meridian is concave on
+    ``[J1_apex, 0]`` and on ``[0, X]`` but has a convex kink at ``J1 = 0``,
+    where the Rubin ratios start to vary (:func:`rubin_q`), so ``phi`` may
+    have a local minimum on each piece: each piece's is found by
+    :func:`_piece_minimum` and the nearer one returned.
+    """
     X = m[3]
     apex = p[P_J1APEX]
     if apex < J1t < X:
-        Ft = meridian_radius(J1t, m, p)
+        Ft, dF = meridian_radius_slope(J1t, m, p)
         if rt > Ft > 0.0:
-            g0, dF = _dphi_slope(J1t, J1t, rt, m, K, G, p)
+            g0 = (Ft - rt) * dF / G  # _dphi at J1t
             if g0 == 0.0:
                 return J1t, Ft
-            sgn = 1.0 if g0 < 0.0 else -1.0
-            # first step: the Newton step with dphi''/2 ~ 1/(9K) + F'^2/G,
-            # which underestimates the curvature where F < rt and F'' < 0,
-            # so it usually overshoots the root and brackets it at once
-            step = abs(g0) / (1.0 / (9.0 * K) + dF * dF / G)
-            step = max(step, 1e-9 * (X - apex))
-            x0, gx0 = J1t, g0
-            for _ in range(40):
-                x1 = J1t + sgn * step
-                if x1 <= apex or x1 >= X:
-                    break
-                g1 = _dphi(x1, J1t, rt, m, K, G, p)
-                if (g1 > 0.0) != (gx0 > 0.0):
-                    if sgn > 0.0:
-                        J1 = _refine(x0, x1, gx0, g1, J1t, rt, m, K, G, p)
-                    else:
-                        J1 = _refine(x1, x0, g1, gx0, J1t, rt, m, K, G, p)
-                    return J1, meridian_radius(J1, m, p)
-                x0, gx0 = x1, g1
-                step *= 2.0
+            J1 = _bracket(J1t, g0, dF, apex, X, J1t, rt, m, K, G, p)
+            if J1 == J1:  # not NaN: found
+                return J1, meridian_radius(J1, m, p)
+    elif J1t <= apex and rt > 0.0:
+        J1 = _piece_minimum(apex, min(X, 0.0) if apex < 0.0 else X, J1t, rt, m, K, G, p)
+        F = meridian_radius(J1, m, p)
+        if apex < 0.0 < X:
+            J1b = _piece_minimum(0.0, X, J1t, rt, m, K, G, p)
+            Fb = meridian_radius(J1b, m, p)
+            if ((J1b - J1t) ** 2 / (9.0 * K) + (Fb - rt) ** 2 / G
+                    < (J1 - J1t) ** 2 / (9.0 * K) + (F - rt) ** 2 / G):
+                return J1b, Fb
+        return J1, F
     return _project_global(J1t, rt, m, K, G, p)
 
 
 @njit(cache=True, error_model="numpy")
-def _refine(lo, hi, gl, gh, J1t, rt, m, K, G, p):
-    """Root of ``dphi/dJ1`` in ``[lo, hi]`` with ``gl < 0 < gh`` (Illinois regula falsi).
+def _piece_minimum(a, b, J1t, rt, m, K, G, p):
+    """Minimiser of ``phi`` on a piece ``[a, b]`` of the meridian on which it
+    is concave, for a trial left of the piece (``J1t < a``): ``dphi/dJ1``
+    increases from ``a`` up to the first ``F >= rt``, and points beyond that
+    are farther, so the minimiser is the root of ``dphi/dJ1`` stepping right
+    from ``a`` (:func:`_bracket`), ``a`` itself if ``dphi/dJ1 >= 0`` there,
+    or ``b`` if no root comes first. The ends are taken ``1e-9 (X - J1_apex)``
+    inside the piece."""
+    eps = 1e-9 * (m[3] - p[P_J1APEX])
+    x0 = a + eps
+    F0, dF = meridian_radius_slope(x0, m, p)
+    g0 = (x0 - J1t) / (9.0 * K) + (F0 - rt) * dF / G
+    if g0 >= 0.0:
+        return x0
+    J1 = _bracket(x0, g0, dF, a, b, J1t, rt, m, K, G, p)
+    return J1 if J1 == J1 else b - eps
 
-    Superlinear bracketing iteration (Dowell & Jarratt 1971); stops at a
-    bracket of ``1e-11 (|J1t| + alpha)`` (about 1e-4 Pa) or after 60
-    iterations.
+
+@njit(cache=True, error_model="numpy")
+def _bracket(x0, g0, dF, lo, hi, J1t, rt, m, K, G, p):
+    """Root of ``dphi/dJ1`` beyond ``x0`` (``g0 = dphi(x0) != 0``, ``dF`` the
+    meridian slope there), on the side where ``dphi`` falls, within
+    ``(lo, hi)``: steps that double until the sign changes, then
+    :func:`_refine`. NaN if an end comes first.
+
+    The first step is the Newton step with ``dphi''/2 ~ 1/(9K) + F'^2/G``,
+    which underestimates the curvature where ``F < rt`` and ``F'' < 0``, so
+    it usually overshoots the root and brackets it at once.
+    """
+    sgn = 1.0 if g0 < 0.0 else -1.0
+    step = abs(g0) / (1.0 / (9.0 * K) + dF * dF / G)
+    step = max(step, 1e-9 * (m[3] - p[P_J1APEX]))
+    gx0 = g0
+    for _ in range(40):
+        x1 = x0 + sgn * step
+        if x1 <= lo or x1 >= hi:
+            break
+        g1 = _dphi(x1, J1t, rt, m, K, G, p)
+        if (g1 > 0.0) != (gx0 > 0.0):
+            if sgn > 0.0:
+                return _refine(x0, x1, gx0, g1, J1t, rt, m, K, G, p)
+            return _refine(x1, x0, g1, gx0, J1t, rt, m, K, G, p)
+        x0, gx0 = x1, g1
+        step *= 2.0
+    return math.nan
+
+
+@njit(cache=True, error_model="numpy")
+def _refine(lo, hi, gl, gh, J1t, rt, m, K, G, p):
+    """Root of ``dphi/dJ1`` in ``[lo, hi]`` with ``gl < 0 < gh``.
+
+    Regula falsi with the Anderson-Bjoerck modification (Anderson & Bjoerck
+    1973; Galdino 2011 compares it with Illinois): when the same end of the
+    bracket is kept twice, its value is scaled by ``1 - g_new/g_old`` (by
+    1/2 if that is not positive), which keeps superlinear convergence.
+    Stops when the new point moves by less than ``1e-11 (|J1t| + alpha)``
+    (about 1e-4 Pa) from the last, when the bracket is that narrow, or after
+    60 iterations.
     """
     tol = 1e-11 * (abs(J1t) + abs(p[P_ALPHA]))
     side = 0
     mid = 0.5 * (lo + hi)
+    prev = lo if gh < -gl else hi
     for _ in range(60):
         mid = (lo * gh - hi * gl) / (gh - gl)
         gm = _dphi(mid, J1t, rt, m, K, G, p)
         if gm < 0.0:
-            lo, gl = mid, gm
             if side == -1:
-                gh *= 0.5
+                f = 1.0 - gm / gl
+                gh *= f if f > 0.0 else 0.5
+            lo, gl = mid, gm
             side = -1
         elif gm > 0.0:
-            hi, gh = mid, gm
             if side == 1:
-                gl *= 0.5
+                f = 1.0 - gm / gh
+                gl *= f if f > 0.0 else 0.5
+            hi, gh = mid, gm
             side = 1
         else:
             return mid
         if hi - lo <= tol:
             return 0.5 * (lo + hi)
+        if abs(mid - prev) <= tol:
+            return mid
+        prev = mid
     return mid
 
 
@@ -178,25 +238,12 @@ def _project_global(J1t, rt, m, K, G, p):
 
 
 @njit(cache=True, error_model="numpy")
-def _dphi_slope(J1, J1t, rt, m, K, G, p):
-    """Half the derivative of the projection distance ``phi`` (see
-    :func:`project`), ``(J1 - J1t)/(9K) + (F - rt) F'/G``, and the meridian
-    slope ``F' = dF/dJ1`` (one-sided difference, step ``h = 1e-7 (|J1| +
-    alpha)``, backward within ``h`` of the cap end X; the O(h F'') error
-    moves the returned point by ~1e-7 of the return distance)."""
-    h = 1e-7 * (abs(J1) + abs(p[P_ALPHA]))
-    F = meridian_radius(J1, m, p)
-    if J1 + h < m[3]:
-        dF = (meridian_radius(J1 + h, m, p) - F) / h
-    else:
-        dF = (F - meridian_radius(J1 - h, m, p)) / h
-    return (J1 - J1t) / (9.0 * K) + (F - rt) * dF / G, dF
-
-
-@njit(cache=True, error_model="numpy")
 def _dphi(J1, J1t, rt, m, K, G, p):
-    """Half the derivative of the projection distance ``phi`` (see :func:`project`)."""
-    return _dphi_slope(J1, J1t, rt, m, K, G, p)[0]
+    """Half the derivative of the projection distance ``phi`` (see
+    :func:`project`), ``(J1 - J1t)/(9K) + (F - rt) F'/G``, with the exact
+    meridian slope ``F'`` of :func:`meridian_radius_slope`."""
+    F, dF = meridian_radius_slope(J1, m, p)
+    return (J1 - J1t) / (9.0 * K) + (F - rt) * dF / G
 
 
 @njit(cache=True, error_model="numpy")

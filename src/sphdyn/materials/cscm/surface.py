@@ -121,7 +121,8 @@ def invariants(s):
     m = (s[0] + s[1] + s[2]) / 3.0
     dev = (s[0] - m, s[1] - m, s[2] - m, s[3], s[4], s[5])
     J2, J3 = _j2_j3(dev)
-    r = math.sqrt(J2)
+    sq = math.sqrt(J2)
+    r = sq
     if J2 <= 1e-200:
         # J2'^(3/2) would underflow (a 1e-110 Pa deviator at first contact)
         # and sqrt(J2') may be 0 for a non-zero deviator: the ratio is
@@ -132,8 +133,9 @@ def invariants(s):
             return -3.0 * m, 0.0, 0.0, dev
         J2, J3 = _j2_j3((dev[0] / big, dev[1] / big, dev[2] / big, dev[3] / big,
                          dev[4] / big, dev[5] / big))
-        r = big * math.sqrt(J2)
-    x = 1.5 * math.sqrt(3.0) * J3 / J2 ** 1.5
+        sq = math.sqrt(J2)
+        r = big * sq
+    x = 1.5 * math.sqrt(3.0) * J3 / (J2 * sq)  # J2'^(3/2) without a pow()
     x = min(1.0, max(-1.0, x))
     bhat = -math.asin(x) / 3.0
     return -3.0 * m, r, bhat, dev
@@ -235,6 +237,78 @@ def meridian_radius(J1, m, p):
 
 
 @njit(cache=True, error_model="numpy")
+def meridian_radius_slope(J1, m, p):
+    r""":func:`meridian_radius` ``F(J1)`` (the same value, bit for bit) and its
+    exact slope ``F' = dF/dJ1`` [-], by the chain rule through
+    :math:`F = \Re(Q_1, Q_2, \hat\beta)\, F_f\, \sqrt{F_c}`:
+
+    .. math::
+        F_f' = \lambda\beta e^{-\beta J_1} + \theta,\quad
+        Q_i' = \lambda_i\beta_i e^{-\beta_i J_1} + \theta_i\ (J_1 > 0,\ 0\ \text{else}),
+        \quad (\sqrt{F_c})' = -\frac{t}{(X - L)\sqrt{1 - t^2}},\
+        t = \frac{J_1 - L}{X - L},
+
+    and :math:`\Re' ` through every intermediate of :func:`rubin_factor`
+    (``a``, ``b``, ``b0``, ``b1``, ``b2``; forward-mode differentiation
+    written out). Zero outside ``(J1_apex, X)`` and where ``Ff <= 0``, like
+    the value; :math:`-\infty`-like at the cap's end ``X``. Used by the
+    return (:mod:`.projection`): one evaluation per iteration instead of the
+    two of a difference quotient. Notes sec. 1.4-1.7.
+    """
+    cb, sb, L, X = m
+    if J1 <= p[P_J1APEX] or J1 >= X:
+        return 0.0, 0.0
+    e = math.exp(-p[P_BETA] * J1)
+    ff = p[P_ALPHA] - p[P_LAMDA] * e + p[P_THETA] * J1
+    if ff <= 0.0:
+        return 0.0, 0.0
+    dff = p[P_LAMDA] * p[P_BETA] * e + p[P_THETA]
+    x = J1 if J1 > 0.0 else 0.0
+    e1 = math.exp(-p[P_B1] * x)
+    e2 = math.exp(-p[P_B2] * x)
+    q1 = p[P_A1] - p[P_L1] * e1 + p[P_T1] * x
+    q2 = p[P_A2] - p[P_L2] * e2 + p[P_T2] * x
+    dq1 = p[P_L1] * p[P_B1] * e1 + p[P_T1] if J1 > 0.0 else 0.0
+    dq2 = p[P_L2] * p[P_B2] * e2 + p[P_T2] if J1 > 0.0 else 0.0
+    # Rubin factor (as _rubin_cs) with the derivative of each intermediate
+    a0 = 2.0 * q1 * q1 * (q2 - 1.0)
+    da0 = 4.0 * q1 * dq1 * (q2 - 1.0) + 2.0 * q1 * q1 * dq2
+    a1 = math.sqrt(3.0) * q2 + 2.0 * q1 * (q2 - 1.0)
+    da1 = math.sqrt(3.0) * dq2 + 2.0 * dq1 * (q2 - 1.0) + 2.0 * q1 * dq2
+    a2 = q2
+    da2 = dq2
+    disc = a1 * a1 - 4.0 * a2 * a0
+    sq = math.sqrt(max(disc, 0.0))
+    dsq = (a1 * da1 - 2.0 * (da2 * a0 + a2 * da0)) / sq if disc > 0.0 else 0.0
+    a = (-a1 + sq) / (2.0 * a2)
+    da = (-da1 + dsq - 2.0 * da2 * a) / (2.0 * a2)
+    b = (2.0 * q1 + a) ** 2 - 3.0
+    db = 2.0 * (2.0 * q1 + a) * (2.0 * dq1 + da)
+    b0 = -(3.0 + b - a * a) / 4.0
+    db0 = -(db - 2.0 * a * da) / 4.0
+    cs = cb - a * sb
+    dcs = -da * sb
+    b1 = a * cs
+    db1 = da * cs + a * dcs
+    b2 = cs * cs + b * sb * sb
+    db2 = 2.0 * cs * dcs + db * sb * sb
+    disc = b1 * b1 - 4.0 * b2 * b0
+    sq = math.sqrt(max(disc, 0.0))
+    dsq = (b1 * db1 - 2.0 * (db2 * b0 + b2 * db0)) / sq if disc > 0.0 else 0.0
+    rub = (-b1 + sq) / (2.0 * b2)
+    drub = (-db1 + dsq - 2.0 * db2 * rub) / (2.0 * b2)
+    r = rub * ff
+    dr = drub * ff + rub * dff
+    if J1 <= L:
+        return r, dr
+    t = (J1 - L) / (X - L)
+    c = math.sqrt(max(1.0 - t * t, 0.0))
+    if c <= 0.0:
+        return 0.0, -1e300
+    return r * c, dr * c - r * t / ((X - L) * c)
+
+
+@njit(cache=True, error_model="numpy")
 def yield_function(s, kappa, p):
     """``f = J2' - Rub^2 Ff^2 Fc`` of a tension-positive stress 6-tuple [Pa^2].
 
@@ -247,6 +321,29 @@ def yield_function(s, kappa, p):
         return r * r + (J1 - min(max(J1, p[P_J1APEX]), X)) ** 2 + 1.0
     F = surface_radius(J1, bhat, kappa, p)
     return r * r - F * F
+
+
+@njit(cache=True, error_model="numpy")
+def surely_elastic(s, kappa, p):
+    r"""True if the stress 6-tuple ``s`` lies inside the yield surface by a
+    bound that needs neither the Lode angle nor the cap: for ``J1_apex <
+    J1 <= L`` (left of the cap, ``Fc = 1``),
+
+    .. math:: F = \Re\,F_f \ge \min(Q_1, Q_2, 1)\,F_f,
+
+    since the Rubin factor runs between ``Q2`` (TXE), ``Q1`` (TOR) and 1
+    (TXC) (tested over the fits' range), so ``sqrt(J2') < min(Q1, Q2, 1) Ff``
+    (with a 1e-9 margin for round-off) is elastic. False means "check
+    fully" (:func:`yield_function`), not "plastic". Saves the Lode angle,
+    its cosine and sine and the cap for most elastic points.
+    """
+    J1, r = j1_radius(s)
+    L = kappa if kappa > p[P_KAPPA0] else p[P_KAPPA0]
+    if not (p[P_J1APEX] < J1 <= L):
+        return False
+    ff = shear_surface(J1, p)
+    q1, q2 = rubin_q(J1, p)
+    return r < min(q1, q2, 1.0) * ff * (1.0 - 1e-9)
 
 
 @njit(cache=True, error_model="numpy")

@@ -40,8 +40,8 @@ from ...neighbours import build_neighbours, mean_neighbours, update_neighbours
 from ...state import Particles
 from ..base import register_part
 from .artificial_stress import artificial_stress_forces, artificial_stress_tensor
-from .passes import (forces, scaled_stress, update_density_and_h,
-                     velocity_gradient, xsph_velocity)
+from .passes import (forces, stress_terms, update_density_and_h, velocity_gradient,
+                     xsph_velocity)
 from .swegle import FLAG_FRACTION, REL_STRESS_TOL, count_unstable, stress_scale, swegle_indicator
 from .tl_scheme import TotalLagrangian
 
@@ -103,11 +103,13 @@ class SPHPart:
             p.phase = phase
         if variation is not None:
             p.variation = variation
+        # S: sigma B / rho^2 of stress_terms
         for name, tail in (("B", (3, 3)), ("dedt_av", ()), ("S", (3, 3)),
                            ("size", ()), ("bulk_modulus", ()), ("young", ()),
                            ("as_eps", ()), ("swegle", ())):
             p.add(name, tail)
         p.add("tl", (), np.bool_, fill=False)
+        p.add("n_support", (), np.int32)  # pairs within the support (velocity_gradient)
         self.as_on = any(e > 0 for e, tl in zip(settings.epsilon, settings.total_lagrangian)
                          if not tl)
         if self.as_on:
@@ -299,7 +301,7 @@ class SPHPart:
         if self.has_ul:
             velocity_gradient(p.x, p.v, p.h, p.m, p.rho, nl.offsets, nl.idx, k.kid, k.sigma,
                               self.dim, k.support_scale, self.s.correction, self.F, p.L,
-                              p.B)
+                              p.B, p.n_support)
         if self.tl is not None:
             self.tl.velocity_gradient(p)
         for f in self.pair_filters:
@@ -313,10 +315,9 @@ class SPHPart:
         """
         p, nl, k, s = self.p, self.nl, self.kernel, self.s
         if self.has_ul:
-            scaled_stress(p.sig, p.rho, p.S)
-            forces(p.x, p.v, p.m, p.rho, p.h, p.c, p.S, p.B, self.F, nl.offsets, nl.idx,
-                   self.dim, k.support_scale, s.correction, s.alpha, s.beta, p.a,
-                   p.dedt_av)
+            stress_terms(p.sig, p.rho, p.B, p.S)
+            forces(p.x, p.v, p.m, p.rho, p.h, p.c, p.S, self.F, nl.offsets, p.n_support,
+                   nl.idx, self.dim, k.support_scale, s.alpha, s.beta, p.a, p.dedt_av)
         if self.as_on:
             artificial_stress_tensor(p.sig, p.rho, p.as_eps, p.R, p.Q)
             artificial_stress_forces(p.x, p.m, p.h, p.R, self.F, nl.offsets, nl.idx,

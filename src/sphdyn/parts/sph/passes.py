@@ -50,18 +50,25 @@ _DET_TOL = 1e-6
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def scaled_stress(sig, rho, S):
-    """``S = sigma / rho^2`` (N, 3, 3) [Pa m^6/kg^2], the stress term of the momentum sum."""
+def stress_terms(sig, rho, B, P):
+    r"""``P_i = sigma_i B_i / rho_i^2`` (N, 3, 3) [Pa m^6/kg^2], the particle's
+    term of the momentum sum of :func:`forces`, once per particle and step
+    (``B`` (N, 3, 3) the correction matrices of :func:`velocity_gradient`,
+    the identity without correction; ``sig`` (N, 3, 3) [Pa], ``rho`` (N,)
+    [kg/m^3])."""
     for i in prange(sig.shape[0]):
         r2 = 1.0 / (rho[i] * rho[i])
         for a in range(3):
+            s0 = sig[i, a, 0] * r2
+            s1 = sig[i, a, 1] * r2
+            s2 = sig[i, a, 2] * r2
             for b in range(3):
-                S[i, a, b] = sig[i, a, b] * r2
+                P[i, a, b] = s0 * B[i, 0, b] + s1 * B[i, 1, b] + s2 * B[i, 2, b]
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
 def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_scale, correct,
-                      F, L, B):
+                      F, L, B, count):
     r"""Velocity gradient with optional Randles-Libersky renormalisation.
 
     .. math::
@@ -86,6 +93,13 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
     kernel is evaluated once per pair and step. Pairs in the Verlet skin are
     rejected on ``r^2`` (no square root or kernel call) and get ``F = 0``.
 
+    The pass also orders each row: the pairs within the support first, in the
+    order they had, ``count[i]`` of them (a stable partition of the row in
+    place; the row still holds the same neighbours, so the Verlet list stays
+    valid). The passes after it visit only those, not the skin's pairs, and
+    the sums over a row keep their order while its pairs stay within the
+    support.
+
     Parameters
     ----------
     x, v : (N, 3) positions [m] and velocities [m/s].
@@ -93,7 +107,8 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
     m, rho : (N,) masses [kg] (0 for zero-mass particles) and densities
         [kg/m^3]; the weight of pair ij is m_j / rho_i (the energy partner of
         :func:`forces`, see the module docstring).
-    offsets, idx : CSR neighbour list.
+    offsets, idx : CSR neighbour list (``idx`` (nnz,) int32, each row
+        reordered in place, see above).
     kid, sigma, dim, support_scale : kernel id, normalisation, dimension (2: z
         terms skipped), support scale kappa.
     correct : bool, apply the renormalisation.
@@ -101,6 +116,7 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
     L : (N, 3, 3) out, velocity gradient [1/s].
     B : (N, 3, 3) out, correction matrix applied to kernel gradients
         (identity when ``correct`` is False).
+    count : (N,) int32 out, pairs within the support at the head of row i.
     """
     n = x.shape[0]
     qmax = support_nb(kid)
@@ -116,6 +132,7 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
         three = dim == 3
         hi = h[i]
         irho = 1.0 / rho[i]
+        head = offsets[i]  # next slot of the row's head (pairs within the support)
         for k in range(offsets[i], offsets[i + 1]):
             j = idx[k]
             d0 = xi0 - x[j, 0]
@@ -133,7 +150,12 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
             if three:
                 scale *= ih
             fk = scale * dwdq_over_q(kid, np.sqrt(r2) * ih)
-            F[k] = fk
+            if k != head:  # swap with the first skin pair of the row
+                idx[k] = idx[head]
+                F[k] = 0.0
+                idx[head] = j
+            F[head] = fk
+            head += 1
             f = fk * (m[j] * irho)
             if f == 0.0:
                 continue
@@ -165,6 +187,7 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
                 m20 -= d2 * g0
                 m21 -= d2 * g1
                 m22 -= d2 * g2
+        count[i] = head - offsets[i]
         # inverse of the moment matrix M (L_true = L_raw M^{-1}, B = M^{-T})
         q00 = 1.0
         q01 = q02 = q10 = q12 = q20 = q21 = 0.0
@@ -212,8 +235,8 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def forces(x, v, m, rho, h, c, S, B, F, offsets, idx, dim, support_scale, correct, alpha,
-           beta, a, dedt_av):
+def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, dim, support_scale, alpha, beta,
+           a, dedt_av):
     r"""Acceleration from the stress divergence and Monaghan artificial viscosity.
 
     Symmetric (momentum-conserving) form of Gray, Monaghan & Swift (2001),
@@ -244,42 +267,27 @@ def forces(x, v, m, rho, h, c, S, B, F, offsets, idx, dim, support_scale, correc
     x, v : (N, 3) positions [m], velocities [m/s].
     m, rho, h, c : (N,) mass [kg], density [kg/m^3], smoothing length [m],
         wave speed [m/s].
-    S : (N, 3, 3) sigma / rho^2 from :func:`scaled_stress` (Cauchy, tension +).
-    B : (N, 3, 3) correction matrices from :func:`velocity_gradient`.
+    P : (N, 3, 3) ``sigma B / rho^2`` from :func:`stress_terms` (Cauchy,
+        tension +), so the pair term is :math:`(P_i + P_j)\,\mathbf g_{ij}`.
     F : (nnz,) pair gradient factors from :func:`velocity_gradient`.
+    offsets, count, idx : the neighbour list and the pairs within the support
+        at the head of each row (:func:`velocity_gradient`); only those are
+        visited.
     a : (N, 3) out, acceleration [m/s^2].
     dedt_av : (N,) out, viscous heating rate [W/kg].
     """
     n = x.shape[0]
     three = dim == 3
     for i in prange(n):
-        s00 = S[i, 0, 0]
-        s01 = S[i, 0, 1]
-        s02 = S[i, 0, 2]
-        s11 = S[i, 1, 1]
-        s12 = S[i, 1, 2]
-        s22 = S[i, 2, 2]
-        if correct:
-            # P_i = (sigma_i / rho_i^2) B_i, applied to g
-            p00 = s00 * B[i, 0, 0] + s01 * B[i, 1, 0] + s02 * B[i, 2, 0]
-            p01 = s00 * B[i, 0, 1] + s01 * B[i, 1, 1] + s02 * B[i, 2, 1]
-            p02 = s00 * B[i, 0, 2] + s01 * B[i, 1, 2] + s02 * B[i, 2, 2]
-            p10 = s01 * B[i, 0, 0] + s11 * B[i, 1, 0] + s12 * B[i, 2, 0]
-            p11 = s01 * B[i, 0, 1] + s11 * B[i, 1, 1] + s12 * B[i, 2, 1]
-            p12 = s01 * B[i, 0, 2] + s11 * B[i, 1, 2] + s12 * B[i, 2, 2]
-            p20 = s02 * B[i, 0, 0] + s12 * B[i, 1, 0] + s22 * B[i, 2, 0]
-            p21 = s02 * B[i, 0, 1] + s12 * B[i, 1, 1] + s22 * B[i, 2, 1]
-            p22 = s02 * B[i, 0, 2] + s12 * B[i, 1, 2] + s22 * B[i, 2, 2]
-        else:
-            p00 = s00
-            p01 = s01
-            p02 = s02
-            p10 = s01
-            p11 = s11
-            p12 = s12
-            p20 = s02
-            p21 = s12
-            p22 = s22
+        p00 = P[i, 0, 0]
+        p01 = P[i, 0, 1]
+        p02 = P[i, 0, 2]
+        p10 = P[i, 1, 0]
+        p11 = P[i, 1, 1]
+        p12 = P[i, 1, 2]
+        p20 = P[i, 2, 0]
+        p21 = P[i, 2, 1]
+        p22 = P[i, 2, 2]
         xi0 = x[i, 0]
         xi1 = x[i, 1]
         xi2 = x[i, 2]
@@ -291,16 +299,14 @@ def forces(x, v, m, rho, h, c, S, B, F, offsets, idx, dim, support_scale, correc
         rhoi = rho[i]
         a0 = a1 = a2 = 0.0
         heat = 0.0
-        for k in range(offsets[i], offsets[i + 1]):
+        for k in range(offsets[i], offsets[i] + count[i]):
             j = idx[k]
             f = F[k]
             mj = m[j]
-            if f == 0.0 or mj == 0.0:
+            if f == 0.0 or mj == 0.0:  # a pair a coupling took out; a zero-mass j
                 continue
             d0 = xi0 - x[j, 0]
             d1 = xi1 - x[j, 1]
-            g0 = f * d0
-            g1 = f * d1
             w0 = vi0 - v[j, 0]
             w1 = vi1 - v[j, 1]
             if three:
@@ -309,29 +315,15 @@ def forces(x, v, m, rho, h, c, S, B, F, offsets, idx, dim, support_scale, correc
             else:
                 d2 = 0.0
                 w2 = 0.0
+            g0 = f * d0
+            g1 = f * d1
             g2 = f * d2
-            if correct:
-                b0 = B[j, 0, 0] * g0 + B[j, 0, 1] * g1 + B[j, 0, 2] * g2
-                b1 = B[j, 1, 0] * g0 + B[j, 1, 1] * g1 + B[j, 1, 2] * g2
-                b2 = B[j, 2, 0] * g0 + B[j, 2, 1] * g1 + B[j, 2, 2] * g2
-            else:
-                b0 = g0
-                b1 = g1
-                b2 = g2
-            t00 = S[j, 0, 0]
-            t01 = S[j, 0, 1]
-            t11 = S[j, 1, 1]
-            f0 = p00 * g0 + p01 * g1 + t00 * b0 + t01 * b1
-            f1 = p10 * g0 + p11 * g1 + t01 * b0 + t11 * b1
+            f0 = (p00 + P[j, 0, 0]) * g0 + (p01 + P[j, 0, 1]) * g1 + (p02 + P[j, 0, 2]) * g2
+            f1 = (p10 + P[j, 1, 0]) * g0 + (p11 + P[j, 1, 1]) * g1 + (p12 + P[j, 1, 2]) * g2
+            f2 = 0.0
             if three:
-                t02 = S[j, 0, 2]
-                t12 = S[j, 1, 2]
-                t22 = S[j, 2, 2]
-                f0 += p02 * g2 + t02 * b2
-                f1 += p12 * g2 + t12 * b2
-                f2 = p20 * g0 + p21 * g1 + p22 * g2 + t02 * b0 + t12 * b1 + t22 * b2
-            else:
-                f2 = 0.0
+                f2 = ((p20 + P[j, 2, 0]) * g0 + (p21 + P[j, 2, 1]) * g1
+                      + (p22 + P[j, 2, 2]) * g2)
             # artificial viscosity, approaching pairs only
             vx = w0 * d0 + w1 * d1 + w2 * d2
             if vx < 0.0:

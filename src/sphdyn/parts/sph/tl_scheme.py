@@ -45,7 +45,8 @@ class TotalLagrangian:
 
     Only pairs of particles within one body and both in ``rows`` are kept;
     rows of other particles are empty, so the arrays are (N, ...) and all
-    passes write the ``rows`` only. :meth:`update_reference` makes the current
+    passes write the ``rows`` only (the zeroed pages of the other rows are
+    never touched and take no memory). :meth:`update_reference` makes the current
     configuration the new reference (``X``, ``rho_ref``; the Cauchy stress
     carries over, F restarts from I).
 
@@ -82,12 +83,18 @@ class TotalLagrangian:
         nnz = self.idx.size
         self.fac = np.zeros(nnz, dtype=np.float32)
         w = np.zeros(nnz)
+        # (N, ...) arrays indexed by particle, written only on the rows: the
+        # zeroed pages of the other particles are never touched, so they take
+        # no memory (a model with a small total-Lagrangian body among many
+        # updated-Lagrangian particles, as the drop-weight ram)
         self.B0 = np.zeros((n, 3, 3))
         self.gsum = np.zeros((n, 3))
-        reference_gradients(X, p.h0, self.vol, self.offsets, self.idx, k.kid, k.sigma,
-                            dim, k.support_scale, self.fac, w, self.B0, self.gsum)
-        self.F = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
-        self.Finv = self.F.copy()
+        reference_gradients(self.rows, X, p.h0, self.vol, self.offsets, self.idx, k.kid,
+                            k.sigma, dim, k.support_scale, self.fac, w, self.B0, self.gsum)
+        self.F = np.zeros((n, 3, 3))
+        self.F[self.rows] = np.eye(3)
+        self.Finv = np.zeros((n, 3, 3))
+        self.Finv[self.rows] = np.eye(3)
         self.P = np.zeros((n, 3, 3))
         self.Q = np.zeros((n, 3, 3))
         self.hgk = np.zeros(nnz, dtype=np.float32)
@@ -120,10 +127,11 @@ class TotalLagrangian:
         self.hgk[cut] = 0.0
         i, j = rows[cut], self.idx[cut]
         share = (self.vol[j] * self.fac[cut].astype(np.float64))[:, None] * (self.X[i] - self.X[j])
-        self.gsum_f = self.gsum.copy()
+        self.gsum_f = np.zeros(self.gsum.shape)  # pages of other rows stay untouched
+        self.gsum_f[self.rows] = self.gsum[self.rows]
         np.subtract.at(self.gsum_f, i, share)
         if self.dim == 2:
-            self.gsum_f[:, 2] = 0.0
+            self.gsum_f[self.rows, 2] = 0.0
 
     def update_reference(self, p) -> None:
         """Make the current positions and densities the reference configuration.

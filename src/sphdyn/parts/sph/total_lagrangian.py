@@ -70,8 +70,8 @@ def _inverse3(a00, a01, a02, a10, a11, a12, a20, a21, a22, out):
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def reference_gradients(X, h0, vol, offsets, idx, kid, sigma, dim, support_scale, fac, w, B0,
-                        gsum):
+def reference_gradients(rows, X, h0, vol, offsets, idx, kid, sigma, dim, support_scale, fac, w,
+                        B0, gsum):
     r"""Reference kernel factors, kernel values, correction matrices and gradient sums.
 
     The reference gradient of pair ``k = (i, j)`` is stored as one scalar,
@@ -86,6 +86,9 @@ def reference_gradients(X, h0, vol, offsets, idx, kid, sigma, dim, support_scale
 
     Parameters
     ----------
+    rows : (T,) the total-Lagrangian particles; only their rows of ``B0``
+        and ``gsum`` are written (the others' pages are never touched, so
+        an (N, ...) array costs memory only for them).
     X : (N, 3) reference positions [m].
     h0 : (N,) reference smoothing lengths [m].
     vol : (N,) reference volumes m / rho0 [m^dim] (0 for zero-mass particles).
@@ -100,9 +103,9 @@ def reference_gradients(X, h0, vol, offsets, idx, kid, sigma, dim, support_scale
         interior of a regular lattice; the particle's own share of the
         stress divergence, see :func:`tl_forces`).
     """
-    n = X.shape[0]
     qmax = support_nb(kid)
-    for i in prange(n):
+    for t in prange(rows.shape[0]):
+        i = rows[t]
         m00 = m01 = m02 = m10 = m11 = m12 = m20 = m21 = m22 = 0.0
         s0 = s1 = s2 = 0.0
         for k in range(offsets[i], offsets[i + 1]):
