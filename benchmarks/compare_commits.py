@@ -12,8 +12,11 @@ Cases: ``sphdyn bench rings2d``, ``rings2d_tl``, ``block3d --particles
 100000`` (particle-steps per second of the stepping alone) and the paper's
 CSCM disc (``sphdyn run examples/disc_impact.toml --max-steps 150``,
 particle-steps per second from its summary, output of the first frame
-included in both), ``hex3d --elements 100000`` (element-steps per second);
-``--cases`` picks some by name (comma-separated).
+included in both), ``hex3d --elements 100000`` (element-steps per second), and the coarse
+drop-weight beam in its impact (``benchmarks/profile_step.py`` on
+``examples/dropweight_coarse.toml``, 300 steps after 2,000 untimed ones: the
+ram meets the beam at about step 1,900; item-steps per second, the same deck
+file for both trees); ``--cases`` picks some by name (comma-separated).
 """
 
 from __future__ import annotations
@@ -30,12 +33,21 @@ CASES = [("rings2d", ["bench", "rings2d", "--steps", "500"]),
          ("rings2d_tl", ["bench", "rings2d_tl", "--steps", "500"]),
          ("block3d 100k", ["bench", "block3d", "--particles", "100000", "--steps", "30"]),
          ("CSCM disc", ["run", "examples/disc_impact.toml", "-q", "--max-steps", "150"]),
-         ("hex3d 100k", ["bench", "hex3d", "--elements", "100000", "--steps", "100"])]
+         ("hex3d 100k", ["bench", "hex3d", "--elements", "100000", "--steps", "100"]),
+         ("HVI coarse impact", ["profile", "--deck", "examples/dropweight_coarse.toml",
+                                "--start-steps", "2000", "--steps", "300"])]
+
+PROFILE = Path(__file__).resolve().parent / "profile_step.py"
 
 
 def measure(src: str, args: list[str], threads: int) -> float:
     """Particle-steps per second of one fresh process running ``sphdyn args``."""
     env = dict(os.environ, PYTHONPATH=str(Path(src).resolve()))
+    if args[0] == "profile":
+        cmd = [sys.executable, str(PROFILE), *args[1:], "--threads", str(threads)]
+        out = subprocess.run(cmd, check=True, capture_output=True, text=True, env=env)
+        res = json.loads(out.stdout.strip().splitlines()[-1])
+        return 1e9 / res["ns_per_item_step"]
     with tempfile.TemporaryDirectory() as tmp:
         extra = ["--out", tmp] if args[0] == "run" else []
         cmd = [sys.executable, "-m", "sphdyn", *args, *extra, "--threads", str(threads)]
@@ -45,6 +57,13 @@ def measure(src: str, args: list[str], threads: int) -> float:
             return summary["particle_steps_per_s"]
     res = json.loads(out.stdout.strip().splitlines()[-1])
     return res.get("particle_steps_per_s", res.get("element_steps_per_s"))
+
+
+def warm_up(args: list[str]) -> list[str]:
+    """A short run of a case (a few steps, none untimed), to compile first."""
+    if args[0] == "profile":
+        return args[:args.index("--start-steps")] + ["--steps", "3"]
+    return args[:-1] + ["5" if args[0] == "run" else "3"]
 
 
 def main():
@@ -60,7 +79,7 @@ def main():
     print("|---|---|---|---|")
     for name, args in [c for c in CASES if c[0] in chosen]:
         for src in (a.old, a.new):  # compile / fill the Numba caches first
-            measure(src, args[:-1] + ["3" if args[0] == "bench" else "5"], a.threads)
+            measure(src, warm_up(args), a.threads)
         best = {a.old: 0.0, a.new: 0.0}
         for _ in range(a.repeats):
             for src in (a.old, a.new):

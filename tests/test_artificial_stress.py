@@ -81,7 +81,7 @@ def _cloud(dim, n_side=8, dx=0.01, hfac=1.3, jitter=0.2, seed=0):
     m = RHO * dx**dim * (1 + 0.1 * rng.uniform(-1, 1, n))
     h = hfac * dx * (1 + 0.1 * rng.uniform(-1, 1, n))
     nl = build_neighbours(x, h, kernels.support(kid), 0.0, dim)
-    F = np.zeros(nl.idx.size)
+    F = np.zeros(nl.idx.size, dtype=np.float32)
     L = np.zeros((n, 3, 3))
     B = np.zeros((n, 3, 3))
     velocity_gradient(x, np.zeros((n, 3)), h, m, rho, nl.offsets, nl.idx, kid,

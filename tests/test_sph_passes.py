@@ -43,7 +43,7 @@ def _grad(c, v, correct, with_factors=False):
     L = np.zeros((n, 3, 3))
     B = np.zeros((n, 3, 3))
     nl = c["nl"]
-    F = np.zeros(nl.idx.size)
+    F = np.zeros(nl.idx.size, dtype=np.float32)  # as the part stores them
     count = np.zeros(n, np.int32)
     velocity_gradient(c["x"], v, c["h"], c["m"], c["rho"], nl.offsets, nl.idx, c["kid"], c["sigma"],
                       c["dim"], 1.0, correct, F, L, B, count)
@@ -119,7 +119,8 @@ def test_rows_hold_the_pairs_within_the_support_first(dim):
     # A jittered cloud with a Verlet skin (half the support): each row keeps
     # its neighbours, with the count[i] pairs inside the support at its head
     # in their former order (F != 0 there) and the skin's pairs after them
-    # (F = 0, r >= support); L is the same as from the sorted rows (to
+    # (F = 0, r >= support), the factors those of the kernel in single
+    # precision (to float32's 1.2e-7); L is the same as from the sorted rows (to
     # round-off: only zero terms moved) and bitwise the same on a second
     # call (the head's order is kept). The forces pass visits only the head:
     # the same accelerations as over whole rows (count = row length).
@@ -142,6 +143,12 @@ def test_rows_hold_the_pairs_within_the_support_first(dim):
         assert np.all(F[lo:lo + k] != 0.0) and np.all(F[lo + k:hi] == 0.0)
         assert list(row[:k]) == [j for j in old if j in set(row[:k])]
         inside_any += k < hi - lo
+        # the factors are the kernel's, rounded to single precision (F is
+        # float32: half the memory of the list's largest array)
+        hij = 0.5 * (h[i] + h[row[:k]])
+        exact = [kernels.grad_factor(c["kid"], c["sigma"], dim, rr, hh)
+                 for rr, hh in zip(r[:k], hij)]
+        assert np.allclose(F[lo:lo + k], exact, rtol=1.2e-7, atol=0.0)
     assert inside_any > 0.5 * x.shape[0]  # the skin held pairs in most rows
     L2, _ = _grad(c, v, True)
     assert np.array_equal(L, L2)

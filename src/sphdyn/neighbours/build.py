@@ -168,9 +168,10 @@ def _build_csr(x, h, act, rf, skin, dim, offsets_buf=None, idx_buf=None):
     inputs.
 
     ``offsets_buf`` ((N + 1,) int64) and ``idx_buf`` (int32) are reused if
-    given and large enough; ``idx`` is then a leading view of ``idx_buf``.
-    A new ``idx_buf`` gets ``_IDX_HEADROOM`` spare capacity when it replaces
-    a too small one.
+    given and large enough; ``idx`` is a leading view of ``idx_buf``.
+    A new ``idx_buf`` gets ``_IDX_HEADROOM`` spare capacity (the first build
+    too: a rebuild that finds a few more pairs then writes into the same
+    buffer instead of holding an old and a new list at once).
     """
     n = x.shape[0]
     act_ids = (np.arange(n, dtype=np.int64) if act is None
@@ -211,9 +212,9 @@ def _build_csr(x, h, act, rf, skin, dim, offsets_buf=None, idx_buf=None):
     max_row = int(offsets.max())
     np.cumsum(offsets, out=offsets)
     nnz = int(offsets[-1])
-    if idx_buf is None:
-        idx_buf = np.empty(nnz, dtype=np.int32)
-    elif idx_buf.shape[0] < nnz:
+    if idx_buf is None or idx_buf.shape[0] < nnz:
+        # spare capacity for the rebuilds (its pages are not resident until
+        # a longer list writes them, so it costs no memory before)
         idx_buf = np.empty(int(nnz * (1.0 + _IDX_HEADROOM)), dtype=np.int32)
     idx = idx_buf[:nnz]
     bad = _fill_rows(visit, n_grid, offsets, idx, max_row, *args)

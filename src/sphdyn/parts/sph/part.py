@@ -119,7 +119,8 @@ class SPHPart:
             p.add("vs", (3,))
         #: (n_materials, 2) density factors of :func:`update_density_and_h`
         self.density_limits = np.array(settings.density_limits, float).reshape(-1, 2)
-        self.F = np.zeros(0)  # pair gradient factors of the current list
+        # pair gradient factors of the current list (float32, see velocity_gradient)
+        self.F = self._F_buf = np.zeros(0, dtype=np.float32)
         #: callables run after every pass of :meth:`_gradients` (before the
         #: stress divergence): a coupling may zero pair factors ``F`` there
         self.pair_filters: list = []
@@ -296,8 +297,15 @@ class SPHPart:
     def _gradients(self) -> None:
         """Pair kernel gradients (once per step) and the velocity gradient L."""
         p, nl, k = self.p, self.nl, self.kernel
-        if self.F.shape[0] != nl.idx.shape[0]:
-            self.F = np.empty(nl.idx.shape[0])  # only after a neighbour rebuild
+        need = nl.idx.shape[0]
+        if self.F.shape[0] != need:  # only after a neighbour rebuild
+            if self._F_buf.shape[0] < need:
+                # the old factors are not needed (recomputed below): drop them
+                # first, and keep spare capacity as the list does (its pages
+                # are not resident until written)
+                self.F = self._F_buf = None
+                self._F_buf = np.empty(int(need * 1.1), dtype=np.float32)
+            self.F = self._F_buf[:need]
         if self.has_ul:
             velocity_gradient(p.x, p.v, p.h, p.m, p.rho, nl.offsets, nl.idx, k.kid, k.sigma,
                               self.dim, k.support_scale, self.s.correction, self.F, p.L,

@@ -112,7 +112,14 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
     kid, sigma, dim, support_scale : kernel id, normalisation, dimension (2: z
         terms skipped), support scale kappa.
     correct : bool, apply the renormalisation.
-    F : (nnz,) out, pair gradient factors [1/m^(d+2)], aligned with ``idx``.
+    F : (nnz,) float32 out, pair gradient factors [1/m^(d+2)], aligned with
+        ``idx``. Single precision halves the list's largest array (memory at
+        the drop-weight's full size, BENCHMARKS.md); ``L`` and ``B`` are
+        summed from the rounded factors, so the pairing of ``L`` with the
+        force pass (the energy balance) and the exact gradient of linear
+        fields hold to double-precision round-off, as for the
+        total-Lagrangian scheme's factors (a deliberate numerical choice:
+        the factors differ from the double ones by 3e-8 relative at most).
     L : (N, 3, 3) out, velocity gradient [1/s].
     B : (N, 3, 3) out, correction matrix applied to kernel gradients
         (identity when ``correct`` is False).
@@ -149,7 +156,8 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
             scale = sigma * ih2 * ih2
             if three:
                 scale *= ih
-            fk = scale * dwdq_over_q(kid, np.sqrt(r2) * ih)
+            # stored in single precision, and used as stored from here on
+            fk = np.float64(np.float32(scale * dwdq_over_q(kid, np.sqrt(r2) * ih)))
             if k != head:  # swap with the first skin pair of the row
                 idx[k] = idx[head]
                 F[k] = 0.0
