@@ -55,6 +55,9 @@ SKIP = {
     # the mutation check: 19 mutants, each a fresh compile (about 7 minutes)
     "python tools/mutation.py --markdown mutation-result.md":
         "runs the mutation check (minutes); tests/test_mutation_script.py checks its list",
+    # the full drop-weight model: 280,000 particles, about a minute and 0.8 GB to
+    # build; tests/test_run.py runs the case on the coarse deck
+    "sphdyn bench hvi --steps 20": "builds the 280,000-particle drop-weight model",
     # starts an MPI job of 34 ranks
     "mpirun -np 34 dask-mpi --scheduler-file sched.json --nthreads 1 &":
         "starts an MPI job",

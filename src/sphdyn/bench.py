@@ -106,14 +106,19 @@ def rings_speed() -> float:
 
 
 def hvi_deck_path(coarse: bool = False) -> Path:
-    """The drop-weight deck of the repository's ``examples/`` (the ``hvi`` case)."""
+    """The drop-weight deck of ``examples/`` (the ``hvi`` case): in the current
+    directory (a clone of the repository, or the folder the examples were
+    copied to), else in the repository this package was installed from."""
     name = "dropweight_coarse.toml" if coarse else "dropweight.toml"
-    path = Path(__file__).resolve().parents[2] / "examples" / name
-    if not path.is_file():
-        raise ValueError(f"bench hvi: {path} not found; the case runs the deck of the "
-                         "repository's examples/. Fix: run it from a clone of sphdyn "
-                         "(pip install -e .)")
-    return path
+    places = [Path.cwd() / "examples" / name,
+              Path(__file__).resolve().parents[2] / "examples" / name]
+    for path in places:
+        if path.is_file():
+            return path
+    raise ValueError(f"bench hvi: examples/{name} not found in {places[0].parent.parent} "
+                     f"or {places[1].parent.parent}; the case runs that deck of the "
+                     "repository. Fix: run it from a clone of sphdyn (the folder "
+                     "holding examples/)")
 
 
 def case_deck(case: str, particles: int | None = None, coarse: bool = False):
