@@ -32,7 +32,7 @@ def project(J1t, rt, bhat, kappa, K, G, p):
     points beyond the first ``J1`` with ``F >= rt`` are farther than that
     point, so the minimiser is the unique root of ``dphi/dJ1`` found by
     stepping away from ``J1t`` (doubling steps) until the sign changes,
-    then Illinois regula falsi (:func:`_refine`). If no sign change is found
+    then regula falsi (:func:`_refine`). If no sign change is found
     before an end of the interval, or the trial is not above the meridian,
     :func:`project_global` (scan + golden section + refinement) decides.
     The two agree to the refinement tolerance (tests/test_cscm.py).
@@ -73,8 +73,7 @@ def project_on_meridian(J1t, rt, m, K, G, p):
         if apex < 0.0 < X:
             J1b = _piece_minimum(0.0, X, J1t, rt, m, K, G, p)
             Fb = meridian_radius(J1b, m, p)
-            if ((J1b - J1t) ** 2 / (9.0 * K) + (Fb - rt) ** 2 / G
-                    < (J1 - J1t) ** 2 / (9.0 * K) + (F - rt) ** 2 / G):
+            if _phi(J1b, Fb, J1t, rt, K, G) < _phi(J1, F, J1t, rt, K, G):
                 return J1b, Fb
         return J1, F
     return _project_global(J1t, rt, m, K, G, p)
@@ -91,8 +90,7 @@ def _piece_minimum(a, b, J1t, rt, m, K, G, p):
     inside the piece."""
     eps = 1e-9 * (m[3] - p[P_J1APEX])
     x0 = a + eps
-    F0, dF = meridian_radius_slope(x0, m, p)
-    g0 = (x0 - J1t) / (9.0 * K) + (F0 - rt) * dF / G
+    g0, dF = _dphi_slope(x0, J1t, rt, m, K, G, p)
     if g0 >= 0.0:
         return x0
     J1 = _bracket(x0, g0, dF, a, b, J1t, rt, m, K, G, p)
@@ -175,8 +173,8 @@ def project_global(J1t, rt, bhat, kappa, K, G, p):
 
     A coarse scan of ``NSCAN + 1`` points of ``phi`` over ``[J1_apex, X]``
     brackets the global minimum, ``NGOLDEN`` golden-section steps narrow the
-    bracket, and Illinois regula falsi on ``dphi/dJ1 = 0``
-    (:func:`_refine`) converges.
+    bracket, and regula falsi on ``dphi/dJ1 = 0`` (:func:`_refine`)
+    converges.
     """
     return _project_global(J1t, rt, meridian(bhat, kappa, p), K, G, p)
 
@@ -195,7 +193,7 @@ def _project_global(J1t, rt, m, K, G, p):
     for k in range(NSCAN + 1):
         x = lo0 + k * width
         fx = meridian_radius(x, m, p)
-        ph = (x - J1t) ** 2 / (9.0 * K) + (fx - rt) ** 2 / G
+        ph = _phi(x, fx, J1t, rt, K, G)
         if ph < phib:
             phib = ph
             best = k
@@ -206,8 +204,8 @@ def _project_global(J1t, rt, m, K, G, p):
     d = a + gr * (b - a)
     fcv = meridian_radius(c, m, p)
     fdv = meridian_radius(d, m, p)
-    phic = (c - J1t) ** 2 / (9.0 * K) + (fcv - rt) ** 2 / G
-    phid = (d - J1t) ** 2 / (9.0 * K) + (fdv - rt) ** 2 / G
+    phic = _phi(c, fcv, J1t, rt, K, G)
+    phid = _phi(d, fdv, J1t, rt, K, G)
     for _ in range(NGOLDEN):
         if phic < phid:
             b = d
@@ -215,18 +213,18 @@ def _project_global(J1t, rt, m, K, G, p):
             phid = phic
             c = b - gr * (b - a)
             fcv = meridian_radius(c, m, p)
-            phic = (c - J1t) ** 2 / (9.0 * K) + (fcv - rt) ** 2 / G
+            phic = _phi(c, fcv, J1t, rt, K, G)
         else:
             a = c
             c = d
             phic = phid
             d = a + gr * (b - a)
             fdv = meridian_radius(d, m, p)
-            phid = (d - J1t) ** 2 / (9.0 * K) + (fdv - rt) ** 2 / G
+            phid = _phi(d, fdv, J1t, rt, K, G)
     J1 = 0.5 * (a + b)
     # The golden section locates the minimiser only to ~sqrt(eps) relative
-    # (phi is flat there); refine on dphi/dJ1 = 0 (central difference for F')
-    # inside the golden bracket by the Illinois variant of regula falsi
+    # (phi is flat there); refine on dphi/dJ1 = 0 (exact meridian slope)
+    # inside the golden bracket by regula falsi
     # (superlinear, the bracket is kept), if the bracket holds a sign change.
     lo = max(a, p[P_J1APEX])
     hi = min(b, X)
@@ -238,12 +236,25 @@ def _project_global(J1t, rt, m, K, G, p):
 
 
 @njit(cache=True, error_model="numpy")
-def _dphi(J1, J1t, rt, m, K, G, p):
-    """Half the derivative of the projection distance ``phi`` (see
-    :func:`project`), ``(J1 - J1t)/(9K) + (F - rt) F'/G``, with the exact
-    meridian slope ``F'`` of :func:`meridian_radius_slope`."""
+def _phi(J1, F, J1t, rt, K, G):
+    """The projection distance ``phi = (J1 - J1t)^2/(9K) + (F - rt)^2/G`` of the
+    meridian point ``(J1, F)`` from the trial ``(J1t, rt)`` (see :func:`project`)."""
+    return (J1 - J1t) ** 2 / (9.0 * K) + (F - rt) ** 2 / G
+
+
+@njit(cache=True, error_model="numpy")
+def _dphi_slope(J1, J1t, rt, m, K, G, p):
+    """Half the derivative of ``phi`` (see :func:`project`),
+    ``(J1 - J1t)/(9K) + (F - rt) F'/G``, with the exact meridian slope ``F'``
+    of :func:`meridian_radius_slope`; returns it and ``F'``."""
     F, dF = meridian_radius_slope(J1, m, p)
-    return (J1 - J1t) / (9.0 * K) + (F - rt) * dF / G
+    return (J1 - J1t) / (9.0 * K) + (F - rt) * dF / G, dF
+
+
+@njit(cache=True, error_model="numpy")
+def _dphi(J1, J1t, rt, m, K, G, p):
+    """Half the derivative of ``phi`` (:func:`_dphi_slope` without the slope)."""
+    return _dphi_slope(J1, J1t, rt, m, K, G, p)[0]
 
 
 @njit(cache=True, error_model="numpy")
