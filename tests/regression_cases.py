@@ -77,6 +77,9 @@ CASES: dict[str, tuple[int, list[str]]] = {
     # about 1,300 particles: beam and ram head at 36 and 25 mm, the bars'
     # sublayer at their element length
     "dropweight_coarse": (40, ['body.beam.dx="36 mm"', 'body.ram.dx="25 mm"']),
+    # 1D: 450 gas particles; 121 particles, the TNT front reaching the plate
+    "sod_shock_tube": (100, []),
+    "gurney_1d": (300, []),
     "dropweight": (40, ['body.beam.dx="36 mm"', 'body.ram.dx="25 mm"'] + [
         f'mesh.{b}.line.element_length="36 mm"' for b in ("bar_b1", "bar_b2", "bar_t1",
                                                          "bar_t2")]),

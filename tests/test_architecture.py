@@ -64,7 +64,7 @@ def test_kinematics_has_the_common_arrays():
     assert set(k.names(STATE)) == {"x", "v", "a", "a_ext", "m", "bc", "bc_v", "active"}
     assert np.all(k.active == 1)
     with pytest.raises(ValueError, match="dim"):
-        Kinematics(1, 1)
+        Kinematics(1, 4)
 
 
 # ----------------------------------------------------------------- the event

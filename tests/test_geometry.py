@@ -124,7 +124,12 @@ def test_box_rejects_bad_input():
     with pytest.raises(ValueError):
         box_lattice([0, 0], [1, 1], 0.1, 3)  # 2 components in 3D
     with pytest.raises(ValueError):
-        box_lattice([0, 0], [1, 1], 0.1, 1)
+        box_lattice([0, 0], [1, 1], 0.1, 4)
+    # 1D: a segment along x, y and z of the corners ignored
+    x = box_lattice([0.0], [1.0], 0.25, 1)
+    assert np.allclose(x, [[0.125, 0, 0], [0.375, 0, 0], [0.625, 0, 0], [0.875, 0, 0]])
+    with pytest.raises(ValueError, match="cylinder|dim"):
+        cylinder_lattice([0, 0, 0], 1.0, 1.0, "z", 0.1, 1)  # boxes only in 1D
 
 
 # --------------------------------------------------------------------------

@@ -105,19 +105,18 @@ def assert_well_formed(nl):
 
 def random_cloud(rng, n, dim, h0=0.05, h_ratio=1.0):
     x = rng.random((n, 3))
-    if dim == 2:
-        x[:, 2] = 0.0
+    x[:, dim:] = 0.0  # 2D: z = 0; 1D (along x): y = z = 0
     h = h0 * h_ratio ** rng.random(n)  # log-uniform in [h0, h0 * h_ratio]
     return x, h
 
 
 # ---------------------------------------------------------------- tests
 
-@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("dim", [1, 2, 3])
 def test_random_cloud_matches_brute_force_and_kdtree(dim):
     rng = np.random.default_rng(10 + dim)
-    n = 1500 if dim == 2 else 2500
-    x, h = random_cloud(rng, n, dim, h0=0.02 if dim == 2 else 0.04,
+    n = {1: 800, 2: 1500, 3: 2500}[dim]
+    x, h = random_cloud(rng, n, dim, h0={1: 0.005, 2: 0.02, 3: 0.04}[dim],
                         h_ratio=2.0)
     skin = 0.1 * h.min()
     nl = build_neighbours(x, h, RF, skin, dim)
@@ -485,7 +484,7 @@ def test_input_validation():
     x = np.zeros((4, 3))
     h = np.ones(4)
     with pytest.raises(ValueError):
-        build_neighbours(x, h, RF, 0.0, 1)
+        build_neighbours(x, h, RF, 0.0, 4)
     with pytest.raises(ValueError):
         build_neighbours(np.zeros((4, 2)), h, RF, 0.0, 2)
     with pytest.raises(ValueError):

@@ -110,7 +110,8 @@ def _forces(c, sig, v=None, correct=False, alpha=0.0, beta=0.0, cs=1000.0):
     P = np.zeros((n, 3, 3))
     stress_terms(sig, c["rho"], B, P)
     forces(c["x"], v, c["m"], c["rho"], c["h"], np.full(n, cs), P, F,
-           nl.offsets, count, nl.idx, c["dim"], 1.0, alpha, beta, a, dedt)
+           nl.offsets, count, nl.idx, c["dim"], 1.0, np.full(n, alpha), np.full(n, beta),
+           a, dedt, np.zeros(n))
     return a, dedt
 
 
@@ -162,7 +163,8 @@ def test_rows_hold_the_pairs_within_the_support_first(dim):
     stress_terms(sig, c["rho"], B, P)
     a_all, heat_all = np.zeros_like(a_head), np.zeros_like(heat_head)
     forces(x, v, c["m"], c["rho"], h, np.full(x.shape[0], 1000.0), P, F, nl.offsets,
-           np.diff(nl.offsets).astype(np.int32), nl.idx, dim, 1.0, 1.0, 2.0, a_all, heat_all)
+           np.diff(nl.offsets).astype(np.int32), nl.idx, dim, 1.0, np.ones(x.shape[0]),
+           np.full(x.shape[0], 2.0), a_all, heat_all, np.zeros(x.shape[0]))
     assert np.array_equal(a_head, a_all) and np.array_equal(heat_head, heat_all)
 
 
@@ -421,8 +423,11 @@ def test_pair_stress_and_viscosity_match_their_formulas(alpha, beta, approach):
     count = np.ones(2, np.int32)
     a = np.zeros((2, 3))
     dedt = np.zeros(2)
-    forces(x, v, m, rho, h, c, P, F, offsets, count, idx, 3, support_scale, alpha, beta,
-           a, dedt)
+    # each particle its own coefficients: the pair takes their means
+    alphas, betas = alpha * np.array([0.5, 1.5]), beta * np.array([1.5, 0.5])
+    signal = np.zeros(2)
+    forces(x, v, m, rho, h, c, P, F, offsets, count, idx, 3, support_scale, alphas, betas,
+           a, dedt, signal)
     acc, heat, pi = _pair_acceleration(x, v, m, rho, h, c, S, B, F[0], support_scale,
                                        alpha, beta)
     assert (pi != 0.0) == approach
@@ -433,10 +438,18 @@ def test_pair_stress_and_viscosity_match_their_formulas(alpha, beta, approach):
         # the viscous part alone, separately: with zero stress the
         # acceleration is -m_j Pi_ij g_ij exactly
         forces(x, v, m, rho, h, c, np.zeros_like(P), F, offsets, count, idx, 3,
-               support_scale, alpha, beta, a, dedt)
+               support_scale, alphas, betas, a, dedt, signal)
         expect = -m[1] * pi * F[0] * (x[0] - x[1])
         assert np.allclose(a[0], expect, rtol=1e-12, atol=0.0)
         assert heat > 0.0  # viscosity only heats
+        # the signal speed alpha c_ij + beta |mu_ij| of the approaching pair
+        d = x[0] - x[1]
+        hij = support_scale * 0.5 * (h[0] + h[1])
+        mu = hij * np.dot(v[0] - v[1], d) / (np.dot(d, d) + 0.01 * hij ** 2)
+        expect = alpha * 0.5 * (c[0] + c[1]) + beta * abs(mu)
+        assert signal[0] == pytest.approx(expect, rel=1e-12)
+    else:
+        assert signal[0] == 0.0  # no approaching pair, no viscous signal
 
 
 def test_history_counts_particles_held_at_a_density_limit():

@@ -41,7 +41,18 @@ def sph_settings(deck, converted: int = 0, sublayer: int = 0,
         stress_exponent=sph.artificial_stress.n, epsilon=eps, total_lagrangian=tl,
         hourglass=sph.hourglass, reference_update_every=sph.reference_update_every,
         density_limits=tuple((m.min_density_factor, m.max_density_factor)
-                             for m in deck.material))
+                             for m in deck.material),
+        viscosity=tuple(material_viscosity(sph.viscosity, m) for m in deck.material),
+        time_step_factor=tuple(m.time_step_factor for m in deck.material))
+
+
+def material_viscosity(default, material) -> tuple[float, float]:
+    """``(alpha, beta)`` of a material: its [material.viscosity], each absent key
+    the [sph.viscosity] ``default``'s."""
+    own = material.viscosity
+    alpha = default.alpha if own is None or own.alpha is None else own.alpha
+    beta = default.beta if own is None or own.beta is None else own.beta
+    return alpha, beta
 
 
 def contact_on(deck, settings: SPHSettings) -> bool:

@@ -135,22 +135,29 @@ def drift(x, v, dt):
 
 
 @njit(cache=True, error_model="numpy")
-def cfl_time_step(h, c, v, scale, cfl):
+def cfl_time_step(h, c, v, signal, viscous, factor, scale, cfl):
     r"""CFL-limited time step.
 
-    .. math:: \Delta t = C \min_i \frac{s\,h_i}{c_i + |\mathbf v_i|},
+    .. math:: \Delta t = C \min_i \frac{f_i\, s\, h_i}
+              {c_i + |\mathbf v_i| + w_i\, v^{sig}_i},
               \quad s = \min(1, \kappa)
 
-    (Monaghan 1992; LS-DYNA SPH time step). Zero-mass particles are included
-    (they move with the body). ``h``, ``c`` (N,), ``v`` (N, 3). A serial
-    O(N) loop without allocation (its cost is far below one pair pass).
+    (Monaghan 1992; LS-DYNA SPH time step), with ``factor`` :math:`f_i`
+    (a material's time-step factor) and, for the particles of fluid
+    materials, the artificial viscosity's signal speed ``signal``
+    :math:`v^{sig}_i = \max_j(\bar\alpha_{ij} \bar c_{ij} + \bar\beta_{ij}
+    |\mu_{ij}|)` of the last force pass weighted by ``viscous``
+    :math:`w_i` (1.2, Monaghan 1992, sec. 10; 0 for solids). Zero-mass
+    particles are included (they move with the body). ``h``, ``c``,
+    ``signal``, ``viscous``, ``factor`` (N,), ``v`` (N, 3). A serial O(N)
+    loop without allocation (its cost is far below one pair pass).
     Returns the step [s] and the index of the controlling particle.
     """
     best = np.inf
     k = 0
     for i in range(h.shape[0]):
         sp = np.sqrt(v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2)
-        t = scale * h[i] / (c[i] + sp + 1e-300)
+        t = factor[i] * (scale * h[i] / (c[i] + sp + viscous[i] * signal[i] + 1e-300))
         if t < best:
             best = t
             k = i

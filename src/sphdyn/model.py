@@ -22,6 +22,7 @@ from .initial import initial_fields
 from .interactions.wall import STIFFNESS, WallSpec
 from .deck import DeckError
 from .deck.errors import format_problem
+from .detonation import light_explosives
 from .preflight import checked_lattices, support_radius
 from .materials import MaterialGroup, get_model, history_layout
 from .mesh_model import MeshModel, build_meshes, mesh_node_set
@@ -289,6 +290,11 @@ def build_model(deck) -> Model:
         h0 = g.model.initial_history(g.params)
         if len(h0):
             particles.hist[np.ix_(g.idx, g.column + np.arange(len(h0)))] = h0
+        if g.model.initial_state is not None:  # a gas at its ambient pressure
+            e0, p0 = g.model.initial_state(g.params)
+            particles.e[g.idx] = e0
+            particles.sig[g.idx] = -p0 * np.eye(3)
+    light_explosives(deck, particles, groups)
 
     body_index = {b.name: k for k, b in enumerate(deck.body)}
     sets: dict[str, np.ndarray] = {}
@@ -328,8 +334,7 @@ def build_model(deck) -> Model:
         deck.domain.lo, float)
     hi = hi_b + deck.domain.margin * size if deck.domain.hi is None else np.asarray(
         deck.domain.hi, float)
-    if dim == 2:
-        lo[2], hi[2] = -np.inf, np.inf
+    lo[dim:], hi[dim:] = -np.inf, np.inf  # 2D: z, 1D: y and z unbounded
 
     return Model(
         particles=particles, groups=groups, walls=wall_specs(deck), sets=sets,

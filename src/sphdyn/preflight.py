@@ -50,7 +50,10 @@ def _power(x: float, n: int) -> float:
 
 
 def ball_volume(radius: float, dim: int) -> float:
-    """Area of a disc (2D) or volume of a ball (3D) of ``radius``."""
+    """Length of a segment (1D), area of a disc (2D) or volume of a ball (3D)
+    of ``radius``."""
+    if dim == 1:
+        return 2.0 * radius
     return math.pi * _power(radius, 2) if dim == 2 else 4.0 / 3.0 * math.pi * _power(radius, 3)
 
 

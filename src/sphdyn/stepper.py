@@ -196,17 +196,23 @@ class Stepper:
         # energy events took out of the model (plain erosion), still in the balance
         removed = [ev.energy_removed for ev in self.events if hasattr(ev, "energy_removed")]
         e_removed = float(sum(removed))
+        # energy materials released into the model (an explosive's chemical energy)
+        sources = [p for p in self.parts if getattr(p, "has_sources", False)]
+        e_chemical = float(sum(p.supplied_energy() for p in sources))
         rec = {
             "time": self.t, "step": float(self.step_count),
             "dt": self.dt_step if dt is None else dt,
             "E_kinetic": kinetic, "E_internal": ie, "E_viscous": iav,
             "E_contact": e_contact, "W_external": self.work_external,
-            "E_total": kinetic + ie + e_contact - self.work_external + e_removed,
+            "E_total": (kinetic + ie + e_contact - self.work_external + e_removed
+                        - e_chemical),
             # how quasi-static the run is: small (< 0.05 say) for a static answer
             "KE_IE_ratio": kinetic / ie if ie > 0.0 else 0.0,
         }
         if removed:
             rec["E_removed"] = e_removed
+        if sources:
+            rec["E_chemical"] = e_chemical
         for part in self.parts:
             rec.update(part.columns())
         for inter in self.interactions:

@@ -26,6 +26,7 @@ from .introspect import field_annotation, metadata, strip_optional, variants
 from .scope import SCOPE, scope_of
 from .sections.bodies import Body, Crack, MassField, Mesostructure, Variation
 from .messages import problem
+from .sections.detonation import Detonation
 from .sections.gauges import Gauge
 from .sections.material import MaterialSection, parameter_clashes
 from .sections.output import Output, Probe
@@ -38,7 +39,7 @@ from .sections.walls import Wall
 from .values import ExistingFile, NonEmpty, Section
 
 __all__ = [
-    "BeamSection", "BlockMesh", "Body", "Boundary", "Convert", "LineMesh", "Load", "Mesh",
+    "BeamSection", "BlockMesh", "Body", "Boundary", "Convert", "Detonation", "LineMesh", "Load", "Mesh",
     "MeshGroup", "Contact", "Crack", "Deck", "DeckSections", "Domain",
     "ExistingFile", "Gauge", "Geometry", "MassField", "MaterialSection", "Mesostructure",
     "Output", "ParticleSet", "Probe", "Region", "Run", "Section", "Sph", "Time",
@@ -87,6 +88,8 @@ class DeckSections(Section):
                                                      "particle sets.")
     gauge: tuple[Gauge, ...] = Field((), description="Strain, displacement and "
                                      "section-force gauges at material points.")
+    detonation: tuple[Detonation, ...] = Field(
+        (), description="Detonation points of high explosives.")
     output: Output = Field(default_factory=Output, description="Output.")
 
     @model_validator(mode="wrap")
@@ -109,6 +112,45 @@ class DeckSections(Section):
                           f"not fit together ({message})",
                           "change the values named there; docs/deck-reference.md "
                           "gives each key's meaning and range")
+        return self
+
+    @model_validator(mode="after")
+    def _one_dimensional(self):
+        """A 1D deck: particles only, updated-Lagrangian."""
+        if self.run.dimension != 1:
+            return self
+        if self.mesh:
+            raise problem("a 1D deck (run.dimension = 1) has no finite elements",
+                          "remove the [[mesh]] tables, or use run.dimension = 2 or 3")
+        if self.sph.formulation == "total_lagrangian" and any(
+                b.formulation is None for b in self.body):
+            raise problem("sph.formulation = \"total_lagrangian\" in a 1D deck",
+                          "use \"updated_lagrangian\" (the total-Lagrangian passes "
+                          "are 2D and 3D only)")
+        return self
+
+    @model_validator(mode="after")
+    def _explosives_lit(self):
+        """Every detonation lights a high explosive; every explosive with a
+        programmed burn has a detonation that lights it."""
+        he = [m.name for m in self.material if m.model == "high_explosive"]
+        for k, d in enumerate(self.detonation):
+            if d.material is not None and d.material not in he:
+                raise problem(f"detonation[{k}].material '{d.material}' is not a high "
+                              "explosive", "name a material with model = "
+                              "\"high_explosive\"" + (f" ({', '.join(he)})" if he else ""))
+        if self.detonation and not he:
+            raise problem("there are [[detonation]] points but no high explosive",
+                          "add a material with model = \"high_explosive\", or remove "
+                          "the [[detonation]] tables")
+        for k, m in enumerate(self.material):
+            if m.model != "high_explosive" or m.burn == "beta":
+                continue
+            if not any(d.material in (None, m.name) for d in self.detonation):
+                raise problem(f"material[{k}] '{m.name}' has a programmed burn but no "
+                              "[[detonation]] lights it",
+                              "add [[detonation]] point = [x, y, z] in the charge, or "
+                              "set burn = \"beta\" (lit by compression only)")
         return self
 
     def frame_interval(self) -> float:

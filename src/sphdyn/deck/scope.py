@@ -35,7 +35,7 @@ def get_key(obj: Any, key: str) -> Any:
 def scope_of(data: Any) -> Scope:
     """Collect the dimension and the table names from raw deck data."""
     dim = get_key(get_key(data, "run"), "dimension")
-    if isinstance(dim, bool) or dim not in (2, 3):
+    if isinstance(dim, bool) or dim not in (1, 2, 3):
         dim = None
     names = {}
     for section in NAMED_SECTIONS:

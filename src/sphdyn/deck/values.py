@@ -133,7 +133,8 @@ class UniqueName:
 
 @dataclass(frozen=True)
 class Vector:
-    """Before-validator: 3 entries, or 2 entries padded with ``z = 0``.
+    """Before-validator: 3 entries, or 2 entries padded with ``z = 0``, or (in
+    a 1D deck) 1 entry padded with ``y = z = 0``.
 
     Two entries are refused only when the deck is known to be 3D.
     """
@@ -141,11 +142,14 @@ class Vector:
     def __call__(self, value: Any) -> Any:
         dim = dimension()
         fix = "give 3 entries [x, y, z]" + (
-            "" if dim == 3 else " (or [x, y] in a 2D deck)")
+            "" if dim == 3 else " (or [x, y] in a 2D deck)" if dim == 2 else
+            " (or [x, y] in a 2D deck, [x] in a 1D deck)")
         if not isinstance(value, (list, tuple)):
             raise problem(f"{show(value)} is not a vector", fix)
         if len(value) == 2 and dim != 3:
             return (*value, 0.0)
+        if len(value) == 1 and dim in (1, None):
+            return (*value, 0.0, 0.0)
         if len(value) != 3:
             raise problem(f"the vector has {len(value)} entries", fix)
         return value
@@ -169,7 +173,11 @@ class NonEmpty:
 
 
 def flat_in_2d(vec: tuple[float, float, float]) -> tuple[float, float, float]:
-    """After-validator: in a 2D deck the z-component must be zero."""
+    """After-validator: in a 2D deck the z-component must be zero, in a 1D deck
+    the y- and z-components."""
+    if dimension() == 1 and (vec[1] != 0.0 or vec[2] != 0.0):
+        raise problem(f"the y- or z-component is not 0 but the deck is 1D "
+                      "(run.dimension = 1, along x)", "give only [x]")
     if dimension() == 2 and vec[2] != 0.0:
         raise problem(f"the z-component is {show_number(vec[2])} but the deck is 2D "
                       "(run.dimension = 2)",

@@ -60,9 +60,10 @@ _RTOL = 1e-9
 # --------------------------------------------------------------------------
 # helpers
 # --------------------------------------------------------------------------
-def _check_dim(dim: int) -> int:
-    if dim not in (2, 3):
-        raise ValueError(f"dim must be 2 or 3, got {dim!r}")
+def _check_dim(dim: int, one: bool = False) -> int:
+    """``dim`` as an int: 2 or 3, or also 1 (a segment along x) if ``one``."""
+    if dim not in ((1, 2, 3) if one else (2, 3)):
+        raise ValueError(f"dim must be {'1, ' if one else ''}2 or 3, got {dim!r}")
     return int(dim)
 
 
@@ -79,7 +80,7 @@ def _positive(name: str, value: float) -> float:
 def _point(p, dim: int, name: str) -> np.ndarray:
     """Coerce a point to a (3,) float64 array; in 2D keep x, y and set z = 0."""
     a = np.asarray(p, dtype=np.float64).reshape(-1)
-    allowed = (2, 3) if dim == 2 else (3,)
+    allowed = {1: (1, 2, 3), 2: (2, 3)}.get(dim, (3,))
     if a.size not in allowed:
         raise ValueError(f"{name} must have {' or '.join(map(str, allowed))} "
                          f"components in {dim}D, got {a.size}")
@@ -123,11 +124,12 @@ def box_lattice(lo, hi, dx: float, dim: int) -> np.ndarray:
 
     Parameters
     ----------
-    lo, hi : array_like, (3,) or (2,) in 2D
-        Opposite corners [m], ``hi >= lo``; in 2D only x and y are used.
+    lo, hi : array_like, (3,) or (2,) in 2D or (1,) in 1D
+        Opposite corners [m], ``hi >= lo``; in 2D only x and y are used, in
+        1D only x (a segment).
     dx : float
         Particle spacing [m].
-    dim : {2, 3}
+    dim : {1, 2, 3}
         Spatial dimension.
 
     Returns
@@ -139,7 +141,7 @@ def box_lattice(lo, hi, dx: float, dim: int) -> np.ndarray:
         overhangs or falls short equally at both ends. Nominal volume per
         particle ``dx**dim``.
     """
-    dim = _check_dim(dim)
+    dim = _check_dim(dim, one=True)
     dx = _positive("dx", dx)
     lo, hi = _point(lo, dim, "lo"), _point(hi, dim, "hi")
     if np.any(hi < lo):

@@ -142,7 +142,7 @@ def select(x, region: Mapping | None, dim: int) -> np.ndarray:
         Unknown shape (the message names the valid ones), unknown or missing
         keys, invalid parameters.
     """
-    dim = _check_dim(dim)
+    dim = _check_dim(dim, one=True)
     x = _positions(x)
     if region is None:
         return np.arange(x.shape[0], dtype=np.int64)
@@ -160,9 +160,9 @@ def select(x, region: Mapping | None, dim: int) -> np.ndarray:
         raise ValueError(f"region {kind!r}: unknown keys {unknown}, missing keys {missing}; "
                          f"allowed: {list(required + optional)}")
 
-    if dim == 2:
+    if dim < 3:  # 2D: z = 0; 1D: y = z = 0
         x = x.copy()
-        x[:, 2] = 0.0
+        x[:, dim:] = 0.0
     size = float(np.linalg.norm(np.ptp(x, axis=0))) if x.shape[0] else 0.0
     mask = _MASKS[kind](x, params, dim, size)
     return np.flatnonzero(mask).astype(np.int64)

@@ -124,6 +124,20 @@ class MaterialModel:
         The model writes a scalar damage (0 intact, 1 failed) into
         ``damage``: only then may elements of it erode by damage
         (:mod:`sphdyn.parts.fem.erosion_criteria`).
+    fluid : bool
+        A fluid (gas, detonation products): no shear stiffness, and its
+        particles' time step includes the artificial viscosity's signal
+        speed (:func:`sphdyn.integrate.cfl_time_step`).
+    initial_state : callable or None
+        ``initial_state(params) -> (e0, p0)``: the specific internal energy
+        [J/kg] and pressure [Pa] of the material at rest at its initial
+        density (a gas at its ambient pressure); None: both zero.
+    released_energy : callable or None
+        ``released_energy(params, hist, m) -> float``: the energy [J] the
+        model has added to its items' internal energy from a source (an
+        explosive's chemical energy, burned mass times ``E0 / rho0``), from
+        their history rows ``hist`` (n, nh) and masses ``m`` (n,). The energy
+        balance counts it as supplied (``E_chemical``).
     """
 
     name: str
@@ -134,6 +148,9 @@ class MaterialModel:
     schema: Any = None
     initial_stress: bool = False
     has_damage: bool = False
+    fluid: bool = False
+    initial_state: Callable[[np.ndarray], tuple[float, float]] | None = None
+    released_energy: Callable[[np.ndarray, np.ndarray, np.ndarray], float] | None = None
 
     @property
     def n_history(self) -> int:

@@ -123,8 +123,8 @@ def _fill_rows(visit, n_grid, offsets, idx, max_row, x, h, dim, half_rf, skin,
 def _check_inputs(x, h, radius_factor, skin, dim, active):
     """Validated ``(x, h, act)``: contiguous float64 ``x``, ``h`` and a bool
     ``act`` (None = all active); ValueError naming the bad argument."""
-    if dim not in (2, 3):
-        raise ValueError(f"dim must be 2 or 3, got {dim}")
+    if dim not in (1, 2, 3):  # 1: along x, y = z = 0
+        raise ValueError(f"dim must be 1, 2 or 3, got {dim}")
     x = np.ascontiguousarray(x, dtype=np.float64)
     h = np.ascontiguousarray(h, dtype=np.float64)
     if x.ndim != 2 or x.shape[1] != 3:

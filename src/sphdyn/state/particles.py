@@ -77,8 +77,8 @@ class Kinematics(ArrayStore):
     """
 
     def __init__(self, n: int, dim: int):
-        if dim not in (2, 3):
-            raise ValueError(f"dim must be 2 or 3, got {dim}")
+        if dim not in (1, 2, 3):
+            raise ValueError(f"dim must be 1, 2 or 3, got {dim}")
         super().__init__(n)
         self.dim = dim
         for name, (tail, dtype) in KINEMATICS.items():

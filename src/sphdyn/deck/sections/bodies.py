@@ -11,6 +11,7 @@ from pydantic import BeforeValidator, Field, field_validator, model_validator
 
 from ..expressions import ExpressionError, check_expression
 from ..messages import problem, show, show_number
+from ..scope import dimension
 from ..units import LENGTH, RATE
 from ..values import (Corner, Direction, ExistingFile, Position, PositiveLength, Section,
                       UpperCorner, Vector, VelocityVector, integer, name_of, quantity,
@@ -372,6 +373,22 @@ class Body(Section):
     damping: quantity(RATE, "damping coefficient", lo=0) = Field(
         0.0, description="Mass-proportional damping c [1/s] of the body's particles "
                          "(a = -c v) for quasi-static loading, as [[mesh]] damping.")
+
+    @model_validator(mode="after")
+    def _one_dimensional(self):
+        """A 1D deck fills boxes (segments along x) and updates its particles'
+        reference (the total-Lagrangian passes are 2D and 3D only)."""
+        if dimension() != 1:
+            return self
+        if self.geometry.shape != "box":
+            raise problem(f"geometry.shape '{self.geometry.shape}' in a 1D deck "
+                          "(run.dimension = 1)", "use shape = \"box\" with lo = [x0], "
+                          "hi = [x1]")
+        if self.formulation == "total_lagrangian" or self.mesostructure is not None:
+            raise problem("a 1D deck has updated-Lagrangian bodies without "
+                          "mesostructure", "remove formulation and mesostructure, or "
+                          "use run.dimension = 2 or 3")
+        return self
 
     @model_validator(mode="after")
     def _mesostructure_resolved(self):

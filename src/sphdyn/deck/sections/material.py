@@ -20,7 +20,7 @@ from .bodies import Variation
 #: and how it varies or erodes, and the density limits the SPH part reads
 #: (:class:`sphdyn.parts.sph.part.SPHSettings`).
 NOT_PARAMETERS = ("name", "model", "variation", "erosion", "min_density_factor",
-                  "max_density_factor")
+                  "max_density_factor", "viscosity", "time_step_factor")
 
 #: Mass density of a material (required, > 0).
 Density = quantity(DENSITY, lo=0, lo_open=True)
@@ -52,6 +52,17 @@ class MaterialErosion(Section):
                           "give erode, principal_strain, effective_strain or "
                           "min_time_step")
         return self
+
+
+class MaterialViscosity(Section):
+    """[material.viscosity]: this material's artificial-viscosity coefficients
+    (absent keys: [sph.viscosity]'s). A pair of particles of two materials uses
+    the means of their coefficients."""
+
+    alpha: Optional[real("viscosity coefficient", lo=0)] = Field(
+        None, description="Linear (bulk) coefficient alpha.")
+    beta: Optional[real("viscosity coefficient", lo=0)] = Field(
+        None, description="Quadratic (von Neumann-Richtmyer) coefficient beta.")
 
 
 class MaterialSection(Section):
@@ -87,6 +98,14 @@ class MaterialSection(Section):
         3.0, description="Particles of this material keep a density of at most this "
                          "times their initial density (Autodyn's SPH maximum density "
                          "factor).")
+    viscosity: Optional[MaterialViscosity] = Field(
+        None, description="Artificial viscosity of this material's particles "
+                          "([material.viscosity]; absent: [sph.viscosity]).")
+    time_step_factor: real("time-step factor", lo=0, hi=1, lo_open=True) = Field(
+        1.0, description="The CFL step of this material's particles times this factor "
+                         "(a stricter limit for one material). The particles of a fluid "
+                         "(gas, high_explosive) also count the artificial viscosity's "
+                         "signal speed, 1.2 (alpha c + beta mu_max) (Monaghan 1992).")
 
     @model_validator(mode="after")
     def _varied_parameter(self):
@@ -108,8 +127,8 @@ class MaterialSection(Section):
 
     def values(self) -> dict:
         """The model's parameters in SI units, as ``pack`` takes them: every key
-        but name, model, variation, erosion and the density limits, absent (None)
-        values left out."""
+        but name, model, variation, erosion, the density limits, the viscosity
+        and the time-step factor, absent (None) values left out."""
         return {key: v for key, v in self.model_dump().items()
                 if key not in NOT_PARAMETERS and v is not None}
 

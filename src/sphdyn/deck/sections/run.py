@@ -14,9 +14,12 @@ class Run(Section):
 
     title: StrictStr = Field("", description="Free text naming the run; "
                              "copied into the outputs.")
-    dimension: Literal[2, 3] = Field(
-        description="2 = plane strain, quantities per unit depth (masses in "
-                    "kg/m); 3 = three-dimensional.")
+    dimension: Literal[1, 2, 3] = Field(
+        description="1 = uniaxial strain along x, quantities per unit cross-section "
+                    "(masses in kg/m^2; box bodies, no meshes, updated-Lagrangian: "
+                    "shock tubes, detonation fronts, flyer plates); 2 = plane "
+                    "strain, quantities per unit depth (masses in kg/m); 3 = "
+                    "three-dimensional.")
     t_end: quantity(TIME, "end time", lo=0, lo_open=True) = Field(
         description="Simulated end time.")
     gravity: Optional[AccelerationVector] = Field(

@@ -46,6 +46,11 @@ from .swegle import FLAG_FRACTION, REL_STRESS_TOL, count_unstable, stress_scale,
 from .tl_scheme import TotalLagrangian
 
 
+#: Monaghan's (1992, sec. 10) weight of the viscous signal speed in the time
+#: step of fluid particles: h / (c + 1.2 (alpha c + beta max mu))
+VISCOUS_SIGNAL_WEIGHT = 1.2
+
+
 @dataclass(frozen=True)
 class SPHSettings:
     """The SPH scheme's settings, resolved from the deck by :mod:`sphdyn.assembly`
@@ -71,6 +76,10 @@ class SPHSettings:
     #: (min, max) density factors per material index (``particles.mat``): the
     #: updated-Lagrangian density is kept within them times ``rho0``; () no limits
     density_limits: tuple = ()
+    #: (alpha, beta) of the artificial viscosity per material index; () all alpha, beta
+    viscosity: tuple = ()
+    #: time-step factor per material index; () all 1
+    time_step_factor: tuple = ()
 
 
 @register_part("sph")
@@ -104,9 +113,13 @@ class SPHPart:
         if variation is not None:
             p.variation = variation
         # S: sigma B / rho^2 of stress_terms
+        # av_*: per-particle viscosity, dt_*: time-step factor and viscous
+        # signal weight of its material; av_signal written by the force pass
         for name, tail in (("B", (3, 3)), ("dedt_av", ()), ("S", (3, 3)),
                            ("size", ()), ("bulk_modulus", ()), ("young", ()),
-                           ("as_eps", ()), ("swegle", ())):
+                           ("as_eps", ()), ("swegle", ()), ("av_alpha", ()),
+                           ("av_beta", ()), ("av_signal", ()), ("dt_factor", ()),
+                           ("dt_viscous", ())):
             p.add(name, tail)
         p.add("tl", (), np.bool_, fill=False)
         p.add("n_support", (), np.int32)  # pairs within the support (velocity_gradient)
@@ -148,11 +161,21 @@ class SPHPart:
         p.tl[rows] = tl_body[p.body[rows]]
         eps = np.asarray(s.epsilon, float)
         p.as_eps[rows] = np.where(p.tl[rows], 0.0, eps[p.body[rows]])
+        p.av_alpha[rows] = s.alpha
+        p.av_beta[rows] = s.beta
+        p.dt_factor[rows] = 1.0
+        p.dt_viscous[rows] = 0.0
         for g in self.groups:
             sel = g.idx[(g.idx >= lo) & (g.idx < hi)]
             k, mu = g.model.bulk_modulus(g.params), g.model.shear_modulus(g.params)
             p.bulk_modulus[sel] = k
             p.young[sel] = 9.0 * k * mu / (3.0 * k + mu)
+            if s.viscosity:
+                p.av_alpha[sel], p.av_beta[sel] = s.viscosity[g.material]
+            if s.time_step_factor:
+                p.dt_factor[sel] = s.time_step_factor[g.material]
+            if g.model.fluid:  # Monaghan's (1992) viscous time-step condition
+                p.dt_viscous[sel] = VISCOUS_SIGNAL_WEIGHT
         self.ul_active = ~p.tl if p.tl.any() else None
         self.has_ul = not p.tl.all()  # False: the updated-Lagrangian passes are skipped
 
@@ -187,9 +210,11 @@ class SPHPart:
 
     # ----------------------------------------------------------- protocol
     def stable_dt(self) -> tuple[float, int]:
-        """CFL step :math:`C \\min h / (c + |v|)` and the controlling particle."""
+        """CFL step :math:`C \\min f h / (c + |v| + w v_{sig})` and the controlling
+        particle (:func:`~sphdyn.integrate.cfl_time_step`)."""
         p = self.p
-        return cfl_time_step(p.h, p.c, p.v, min(1.0, self.kernel.support_scale), self.s.cfl)
+        return cfl_time_step(p.h, p.c, p.v, p.av_signal, p.dt_viscous, p.dt_factor,
+                             min(1.0, self.kernel.support_scale), self.s.cfl)
 
     def start(self, dt: float) -> None:
         """Accelerations of the initial state (gradients and divergence, no update)."""
@@ -240,6 +265,21 @@ class SPHPart:
         """Internal energy and its artificial-viscosity part [J] (J/m in 2D)."""
         return internal_energies(self.p.m, self.p.e, self.p.e_av)
 
+    @property
+    def has_sources(self) -> bool:
+        """Whether a material of the part releases energy (an explosive)."""
+        return any(g.model.released_energy is not None for g in self.groups)
+
+    def supplied_energy(self) -> float:
+        """Energy [J] the materials have released into the particles so far
+        (:attr:`~sphdyn.materials.MaterialModel.released_energy`)."""
+        p, total = self.p, 0.0
+        for g in self.groups:
+            if g.model.released_energy is not None and g.idx.size:
+                total += g.model.released_energy(g.params, g.history(p.hist)[g.idx],
+                                                 p.m[g.idx])
+        return total
+
     def columns(self) -> dict[str, float]:
         """``swegle_unstable``: particles flagged by the Swegle criterion now;
         ``density_limited``: updated-Lagrangian particles held at a density limit."""
@@ -267,7 +307,8 @@ class SPHPart:
 
     def state(self) -> tuple[dict, dict[str, np.ndarray]]:
         p = self.p
-        arrays = {"B": p.B, "dedt_av": p.dedt_av, "nl_offsets": self.nl.offsets,
+        arrays = {"B": p.B, "dedt_av": p.dedt_av, "av_signal": p.av_signal,
+                  "nl_offsets": self.nl.offsets,
                   "nl_idx": self.nl.idx, "nl_x_ref": self.nl.x_ref,
                   "nl_h_ref": self.nl.h_ref}
         if self.tl is not None:  # the reference configuration may have been updated
@@ -280,6 +321,8 @@ class SPHPart:
         self.step = int(scalars["step"])
         p.B = arrays["B"]
         p.dedt_av = arrays["dedt_av"]
+        if "av_signal" in arrays:  # (checkpoints before 2026-11-26 have none)
+            p.av_signal = arrays["av_signal"]
         nl = self.nl
         nl.offsets = arrays["nl_offsets"].copy()
         nl.idx = arrays["nl_idx"].copy()
@@ -325,7 +368,8 @@ class SPHPart:
         if self.has_ul:
             stress_terms(p.sig, p.rho, p.B, p.S)
             forces(p.x, p.v, p.m, p.rho, p.h, p.c, p.S, self.F, nl.offsets, p.n_support,
-                   nl.idx, self.dim, k.support_scale, s.alpha, s.beta, p.a, p.dedt_av)
+                   nl.idx, self.dim, k.support_scale, p.av_alpha, p.av_beta, p.a,
+                   p.dedt_av, p.av_signal)
         if self.as_on:
             artificial_stress_tensor(p.sig, p.rho, p.as_eps, p.R, p.Q)
             artificial_stress_forces(p.x, p.m, p.h, p.R, self.F, nl.offsets, nl.idx,

@@ -81,7 +81,8 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
     (``L[i, a, b] = dv_a/dx_b``). Without correction ``B_i = I``. With it, any
     linear velocity field is differentiated exactly at every particle that
     has a non-degenerate neighbourhood (Randles & Libersky 1996). In 2D the
-    z row and column of the moment matrix are set to the identity.
+    z row and column of the moment matrix are set to the identity, in 1D
+    (uniaxial strain along x, every y and z zero) the y ones too.
 
     The pass also stores the kernel-gradient factor of every pair,
 
@@ -110,7 +111,7 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
     offsets, idx : CSR neighbour list (``idx`` (nnz,) int32, each row
         reordered in place, see above).
     kid, sigma, dim, support_scale : kernel id, normalisation, dimension (2: z
-        terms skipped), support scale kappa.
+        terms skipped; 1: y and z zero), support scale kappa.
     correct : bool, apply the renormalisation.
     F : (nnz,) float32 out, pair gradient factors [1/m^(d+2)], aligned with
         ``idx``. Single precision halves the list's largest array (memory at
@@ -156,6 +157,8 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
             scale = sigma * ih2 * ih2
             if three:
                 scale *= ih
+            elif dim == 1:
+                scale = sigma * ih2 * ih
             # stored in single precision, and used as stored from here on
             fk = np.float64(np.float32(scale * dwdq_over_q(kid, np.sqrt(r2) * ih)))
             if k != head:  # swap with the first skin pair of the row
@@ -202,9 +205,12 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
         q11 = 1.0
         q22 = 1.0
         if correct:
-            if dim == 2:
+            if dim < 3:
                 m02 = m12 = m20 = m21 = 0.0
                 m22 = 1.0
+            if dim == 1:
+                m01 = m10 = 0.0
+                m11 = 1.0
             c00 = m11 * m22 - m12 * m21
             c01 = m02 * m21 - m01 * m22
             c02 = m01 * m12 - m02 * m11
@@ -244,7 +250,7 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
 
 @njit(cache=True, error_model="numpy", parallel=True)
 def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, dim, support_scale, alpha, beta,
-           a, dedt_av):
+           a, dedt_av, signal):
     r"""Acceleration from the stress divergence and Monaghan artificial viscosity.
 
     Symmetric (momentum-conserving) form of Gray, Monaghan & Swift (2001),
@@ -258,15 +264,22 @@ def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, dim, support_scale, al
           - \Pi_{ij} \mathbf g_{ij} \Big),
 
     .. math::
-        \Pi_{ij} = \frac{-\alpha \bar c_{ij} \mu_{ij} + \beta \mu_{ij}^2}
-                        {\bar\rho_{ij}}, \quad
+        \Pi_{ij} = \frac{-\bar\alpha_{ij} \bar c_{ij} \mu_{ij}
+                         + \bar\beta_{ij} \mu_{ij}^2}{\bar\rho_{ij}}, \quad
         \mu_{ij} = \frac{h_{ij} \mathbf v_{ij}\cdot\mathbf x_{ij}}
                         {r_{ij}^2 + 0.01 h_{ij}^2}
         \ \text{if}\ \mathbf v_{ij}\cdot\mathbf x_{ij} < 0,\ \text{else } 0,
 
-    (Monaghan 1992). The viscous heating rate
+    (Monaghan 1992), with the pair's coefficients the means of the two
+    particles' (each material may have its own, :mod:`sphdyn.parts.sph.part`).
+    The viscous heating rate
     :math:`\dot e_i^{av} = \tfrac12 \sum_j m_j \Pi_{ij}\, \mathbf v_{ij}\cdot
-    \mathbf g_{ij}` (>= 0) is written to ``dedt_av``. Zero-mass neighbours
+    \mathbf g_{ij}` (>= 0) is written to ``dedt_av``, and the largest
+    viscous signal speed of an approaching pair,
+    :math:`\max_j (\bar\alpha_{ij}\bar c_{ij} + \bar\beta_{ij}|\mu_{ij}|)`
+    (0 without one), to ``signal``: Monaghan's (1992, sec. 10) time-step
+    condition :math:`h / (c + 1.2(\alpha c + \beta \max_j \mu_{ij}))`
+    uses it (:func:`sphdyn.integrate.cfl_time_step`). Zero-mass neighbours
     contribute nothing; a zero-mass particle still gets an acceleration (it
     moves as an interpolation point).
 
@@ -281,8 +294,10 @@ def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, dim, support_scale, al
     offsets, count, idx : the neighbour list and the pairs within the support
         at the head of each row (:func:`velocity_gradient`); only those are
         visited.
+    alpha, beta : (N,) artificial-viscosity coefficients of each particle [-].
     a : (N, 3) out, acceleration [m/s^2].
     dedt_av : (N,) out, viscous heating rate [W/kg].
+    signal : (N,) out, viscous signal speed [m/s].
     """
     n = x.shape[0]
     three = dim == 3
@@ -305,8 +320,11 @@ def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, dim, support_scale, al
         hi = h[i]
         ci = c[i]
         rhoi = rho[i]
+        alphai = alpha[i]
+        betai = beta[i]
         a0 = a1 = a2 = 0.0
         heat = 0.0
+        sig_max = 0.0
         for k in range(offsets[i], offsets[i] + count[i]):
             j = idx[k]
             f = F[k]
@@ -338,8 +356,12 @@ def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, dim, support_scale, al
                 hij = support_scale * 0.5 * (hi + h[j])
                 r2 = d0 * d0 + d1 * d1 + d2 * d2
                 mu = hij * vx / (r2 + 0.01 * hij * hij)
-                pi_ij = (-alpha * 0.5 * (ci + c[j]) * mu + beta * mu * mu) / (
-                    0.5 * (rhoi + rho[j]))
+                aij = 0.5 * (alphai + alpha[j]) * 0.5 * (ci + c[j])
+                bij = 0.5 * (betai + beta[j])
+                pi_ij = (-aij * mu + bij * mu * mu) / (0.5 * (rhoi + rho[j]))
+                s_ij = aij - bij * mu  # mu < 0
+                if s_ij > sig_max:
+                    sig_max = s_ij
                 f0 -= pi_ij * g0
                 f1 -= pi_ij * g1
                 f2 -= pi_ij * g2
@@ -351,6 +373,7 @@ def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, dim, support_scale, al
         a[i, 1] = a1
         a[i, 2] = a2
         dedt_av[i] = heat
+        signal[i] = sig_max
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
