@@ -139,6 +139,7 @@ class SPHPart:
         self.pair_filters: list = []
         self.swegle_unstable = 0
         self._swegle_at = None  # (t, step) the indicator was evaluated at
+        self._visc = None  # the force pass's viscosity arrays (_viscosity_arrays)
         self.step = 0
         self._derive(0, p.n)
         r0 = kernel.radius_factor * float(p.h.max()) if p.n else 0.0
@@ -178,6 +179,7 @@ class SPHPart:
                 p.dt_viscous[sel] = VISCOUS_SIGNAL_WEIGHT
         self.ul_active = ~p.tl if p.tl.any() else None
         self.has_ul = not p.tl.all()  # False: the updated-Lagrangian passes are skipped
+        self._visc = None
 
     def _grown(self, n_old: int, n_new: int) -> None:
         """Particles ``n_old:n_new`` were added: groups, derived data, neighbours.
@@ -323,6 +325,7 @@ class SPHPart:
         p.dedt_av = arrays["dedt_av"]
         if "av_signal" in arrays:  # (checkpoints before 2026-11-26 have none)
             p.av_signal = arrays["av_signal"]
+            self._visc = None  # it holds the replaced array
         nl = self.nl
         nl.offsets = arrays["nl_offsets"].copy()
         nl.idx = arrays["nl_idx"].copy()
@@ -367,9 +370,9 @@ class SPHPart:
         p, nl, k, s = self.p, self.nl, self.kernel, self.s
         if self.has_ul:
             stress_terms(p.sig, p.rho, p.B, p.S)
+            alpha, beta, signal = self._viscosity_arrays()
             forces(p.x, p.v, p.m, p.rho, p.h, p.c, p.S, self.F, nl.offsets, p.n_support,
-                   nl.idx, self.dim, k.support_scale, p.av_alpha, p.av_beta, p.a,
-                   p.dedt_av, p.av_signal)
+                   nl.idx, self.dim, k.support_scale, alpha, beta, p.a, p.dedt_av, signal)
         if self.as_on:
             artificial_stress_tensor(p.sig, p.rho, p.as_eps, p.R, p.Q)
             artificial_stress_forces(p.x, p.m, p.h, p.R, self.F, nl.offsets, nl.idx,
@@ -377,6 +380,21 @@ class SPHPart:
                                      s.stress_exponent, p.a, p.v, p.dedt_av)
         if self.tl is not None:
             self.tl.accelerations(p, p.dedt_av)
+
+    def _viscosity_arrays(self):
+        """``(alpha, beta, signal)`` for :func:`.passes.forces`: the particles'
+        coefficients, or one value each when all particles share them (the
+        pass then forms no pair means), and the signal-speed array, or an empty
+        one when no particle is of a fluid (the pass then skips it; the
+        solids' step does not use it). Recomputed after particles are added."""
+        if self._visc is None:
+            p = self.p
+            a, b = p.av_alpha, p.av_beta
+            if p.n and np.all(a == a[0]) and np.all(b == b[0]):
+                a, b = a[:1], b[:1]
+            signal = p.av_signal if np.any(p.dt_viscous > 0.0) else p.av_signal[:0]
+            self._visc = (a, b, signal)
+        return self._visc
 
     def swegle_field(self) -> np.ndarray:
         """Swegle indicator (N,) of the current state (see :mod:`.swegle`).

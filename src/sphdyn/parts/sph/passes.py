@@ -294,13 +294,17 @@ def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, dim, support_scale, al
     offsets, count, idx : the neighbour list and the pairs within the support
         at the head of each row (:func:`velocity_gradient`); only those are
         visited.
-    alpha, beta : (N,) artificial-viscosity coefficients of each particle [-].
+    alpha, beta : (N,) artificial-viscosity coefficients of each particle
+        [-], or (1,) the one value of all (no per-pair means to form).
     a : (N, 3) out, acceleration [m/s^2].
     dedt_av : (N,) out, viscous heating rate [W/kg].
-    signal : (N,) out, viscous signal speed [m/s].
+    signal : (N,) out, viscous signal speed [m/s], or (0,): not wanted (no
+        fluid particles; the pass then skips it).
     """
     n = x.shape[0]
     three = dim == 3
+    per_particle = alpha.shape[0] > 1
+    want_signal = signal.shape[0] > 0
     for i in prange(n):
         p00 = P[i, 0, 0]
         p01 = P[i, 0, 1]
@@ -320,8 +324,8 @@ def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, dim, support_scale, al
         hi = h[i]
         ci = c[i]
         rhoi = rho[i]
-        alphai = alpha[i]
-        betai = beta[i]
+        alphai = alpha[i] if per_particle else alpha[0]
+        betai = beta[i] if per_particle else beta[0]
         a0 = a1 = a2 = 0.0
         heat = 0.0
         sig_max = 0.0
@@ -356,12 +360,17 @@ def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, dim, support_scale, al
                 hij = support_scale * 0.5 * (hi + h[j])
                 r2 = d0 * d0 + d1 * d1 + d2 * d2
                 mu = hij * vx / (r2 + 0.01 * hij * hij)
-                aij = 0.5 * (alphai + alpha[j]) * 0.5 * (ci + c[j])
-                bij = 0.5 * (betai + beta[j])
+                if per_particle:
+                    aij = 0.5 * (alphai + alpha[j]) * 0.5 * (ci + c[j])
+                    bij = 0.5 * (betai + beta[j])
+                else:
+                    aij = alphai * 0.5 * (ci + c[j])
+                    bij = betai
                 pi_ij = (-aij * mu + bij * mu * mu) / (0.5 * (rhoi + rho[j]))
-                s_ij = aij - bij * mu  # mu < 0
-                if s_ij > sig_max:
-                    sig_max = s_ij
+                if want_signal:
+                    s_ij = aij - bij * mu  # mu < 0
+                    if s_ij > sig_max:
+                        sig_max = s_ij
                 f0 -= pi_ij * g0
                 f1 -= pi_ij * g1
                 f2 -= pi_ij * g2
@@ -373,7 +382,8 @@ def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, dim, support_scale, al
         a[i, 1] = a1
         a[i, 2] = a2
         dedt_av[i] = heat
-        signal[i] = sig_max
+        if want_signal:
+            signal[i] = sig_max
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
