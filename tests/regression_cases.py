@@ -32,6 +32,13 @@ DATA = Path(__file__).resolve().parent / "data" / "regression"
 #: 1,000 particles or fewer, so the whole set runs in well under 3 minutes.
 COMMON = ["output.history_every=1", "output.vtk=false", "output.progress=false",
           "output.checkpoint_every=0"]
+#: the blast decks at 25 mm (three particle layers, the gauges on the lowest
+#: at lattice points, the bars' elements as long as the spacing)
+BLAST_COARSE = ['body.slab.dx="25 mm"', 'body.charge.dx="6 mm"',
+                "gauge.bottom_strain.points=[[0.1875, 0.2375, 0.01], [0.3125, 0.2375, 0.01]]",
+                "gauge.bottom_centre.point=[0.2375, 0.2375, 0.01]"] + [
+                    f'mesh.bar_{d}{k}.line.element_length="25 mm"'
+                    for d in "xy" for k in range(1, 6)]
 CASES: dict[str, tuple[int, list[str]]] = {
     "disc_impact": (60, ['body.disc.dx="6.25 mm"']),
     "disc_impact_crack": (60, ['body.disc.dx="6.25 mm"']),
@@ -80,6 +87,10 @@ CASES: dict[str, tuple[int, list[str]]] = {
     # 1D: 450 gas particles; 121 particles, the TNT front reaching the plate
     "sod_shock_tube": (100, []),
     "gurney_1d": (300, []),
+    # about 1,200 slab, 400 charge and 800 sublayer particles; the charge
+    # burns in these steps
+    "blast_slab_coarse": (30, BLAST_COARSE),
+    "blast_slab": (30, BLAST_COARSE),
     "dropweight": (40, ['body.beam.dx="36 mm"', 'body.ram.dx="25 mm"'] + [
         f'mesh.{b}.line.element_length="36 mm"' for b in ("bar_b1", "bar_b2", "bar_t1",
                                                          "bar_t2")]),

@@ -484,3 +484,16 @@ def test_side_view_takes_the_largest_value_across_the_width():
     assert img.shape == (2, 2)
     assert img[1, 0] == 0.7 and img[0, 1] == 1.0
     assert np.isnan(img[0, 0]) and np.isnan(img[1, 1])
+
+
+def test_plan_view_takes_the_largest_value_through_the_thickness():
+    # the same particles seen along z (axes x, y): cells (x 0, y 0), (x 0,
+    # y 2) and (x 1, y 0)
+    from sphdyn.analysis import projected_max
+
+    x0 = np.array([[0.005, 0.005, 0.015], [0.005, 0.025, 0.015], [0.015, 0.0, 0.005],
+                   [0.006, 0.004, 0.005]])
+    img = projected_max(x0, np.array([0.2, 0.7, 1.0, 0.1]), 0.01, (0, 1))
+    assert img.shape == (3, 2)
+    assert img[0, 0] == 0.2 and img[2, 0] == 0.7 and img[0, 1] == 1.0
+    assert np.isnan(img[1, 0]) and np.isnan(img[1, 1]) and np.isnan(img[2, 1])

@@ -129,18 +129,25 @@ def window_mean_force(time, impulse, window: float) -> np.ndarray:
     return (impulse - before) / window
 
 
-def side_view_max(x0, values, dx: float) -> np.ndarray:
-    """A side view (x-z plane) of a lattice body: the largest of ``values`` over
-    the width (y) at each point of the side, as an image.
+def projected_max(x0, values, dx: float, axes: tuple[int, int] = (0, 2)) -> np.ndarray:
+    """A view of a lattice body along its third axis: the largest of ``values``
+    at each point of the plane of ``axes``, as an image.
 
     ``x0`` (N, 3) the particles' initial positions (cell centres of a lattice
     of spacing ``dx`` [m] from the origin, or element centres), ``values``
-    (N,). Returns (nz, nx) with ``img[k, i]`` the largest value of the
-    particles in cell ``(floor(x/dx), floor(z/dx)) = (i, k)``, NaN where none
-    (the damage pictures of examples/igirder.py and dropweight.py).
+    (N,), ``axes`` (horizontal, vertical) of the image. Returns (nv, nh) with
+    ``img[k, i]`` the largest value of the particles in cell
+    ``(floor(x_h/dx), floor(x_v/dx)) = (i, k)``, NaN where none.
     """
-    ix = np.floor(x0[:, 0] / dx).astype(int)  # the centres are mid-cell: no ties
-    iz = np.floor(x0[:, 2] / dx).astype(int)
-    img = np.full((iz.max() + 1, ix.max() + 1), np.nan)
-    np.fmax.at(img, (iz, ix), values)
+    ih = np.floor(x0[:, axes[0]] / dx).astype(int)  # the centres are mid-cell: no ties
+    iv = np.floor(x0[:, axes[1]] / dx).astype(int)
+    img = np.full((iv.max() + 1, ih.max() + 1), np.nan)
+    np.fmax.at(img, (iv, ih), values)
     return img
+
+
+def side_view_max(x0, values, dx: float) -> np.ndarray:
+    """The side view (x-z plane, the largest value over the width y) of
+    :func:`projected_max` (the damage pictures of examples/igirder.py and
+    dropweight.py)."""
+    return projected_max(x0, values, dx, (0, 2))

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .events import DomainExit
 from .interactions import Gravity, ParticleContact, Wall
 from .mesh_assembly import erosion_events, mesh_interactions, mesh_part
 from .kernels import KernelContext
@@ -88,5 +89,7 @@ def build_stepper(deck, model: Model | None = None, events=(), monitors=()) -> S
     if deck.run.gravity is not None and any(deck.run.gravity):
         interactions += [Gravity(q, deck.run.gravity) for q in parts]
     events = list(events) + erosion_events(deck, model, part, meshes)
+    if part is not None and deck.domain.outside == "remove":
+        events.append(DomainExit(part, model.domain_lo, model.domain_hi))
     dt_max = deck.time.dt_max if deck.time.dt_max is not None else np.inf
     return Stepper(parts, interactions, events, monitors, dt_max=dt_max)

@@ -29,14 +29,18 @@ _NO_RHO = np.zeros(0)
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def _flags(x, v, a, sig, rho, lo, hi, out):
+def _flags(x, v, a, sig, rho, active, lo, hi, out):
     """Flag (N,) items: non-finite x, v, a (and stress, density when ``sig``,
-    ``rho`` have N rows; mesh nodes pass empty ones) or outside [lo, hi]."""
+    ``rho`` have N rows; mesh nodes pass empty ones) or outside [lo, hi].
+    Items with ``active == 0`` (removed from the calculation) are not checked."""
     n = x.shape[0]
     full = sig.shape[0] == n and rho.shape[0] == n
     bad = 0
     for i in prange(n):
         f = OK
+        if active[i] == 0:
+            out[i] = f
+            continue
         s = a[i, 0] + a[i, 1] + a[i, 2] + v[i, 0] + v[i, 1] + v[i, 2]
         s += x[i, 0] + x[i, 1] + x[i, 2]
         r = 1.0
@@ -64,7 +68,7 @@ def check_particles(p, lo, hi, t, step, work: np.ndarray, label: str = "") -> No
     (``"node(s) of mesh 'beam'"``) names them in the diagnosis.
     """
     sig, rho = getattr(p, "sig", _NO_SIG), getattr(p, "rho", _NO_RHO)
-    if _flags(p.x, p.v, p.a, sig, rho, lo, hi, work) == 0:
+    if _flags(p.x, p.v, p.a, sig, rho, p.active, lo, hi, work) == 0:
         return
     what = label or "particle(s)"
     lines = [f"run stopped at t = {t:.6e} s, step {step}:"]

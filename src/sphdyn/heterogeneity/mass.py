@@ -187,8 +187,8 @@ def mass_field(m0: float, spec: dict | None, solid: np.ndarray,
     total = float(np.sum(f))
     if not total > 0.0:
         raise ValueError(f"the mass distribution {spec['distribution']!r} drew only "
-                         f"zeros for {n} particles; choose parameters with a positive "
-                         "mean")
+                         f"zeros for {n} particles. Fix: give [body.mass] parameters "
+                         "with a positive mean (docs/heterogeneity.md)")
     scale = n / total
     m[solid] = m0 * f * scale
     return m, scale

@@ -159,9 +159,20 @@ def plot_history(csv_path: str | os.PathLike,
     return [save_figure(fig, out_dir / f"{name}.png", 120) for name, fig in figures.items()]
 
 
+#: curves above which a legend goes beside the axes in columns of this many
+LEGEND_ROWS = 12
+
+
 def _finish_axes(ax, title: str) -> None:
+    """Title, legend and grid; a long legend (many bars' forces) in columns
+    beside the axes, small, so that it does not squeeze the plot away."""
     ax.set_title(title)
-    ax.legend(loc="best")
+    n = len(ax.get_legend_handles_labels()[0])
+    if n > LEGEND_ROWS:
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="x-small",
+                  ncol=-(-n // LEGEND_ROWS))
+    else:
+        ax.legend(loc="best")
     ax.grid(True, alpha=0.3)
 
 

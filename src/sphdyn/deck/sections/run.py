@@ -55,7 +55,8 @@ class Time(Section):
 
 
 class Domain(Section):
-    """[domain]: guard box; a particle leaving it stops the run."""
+    """[domain]: guard box; a particle leaving it stops the run, or (outside =
+    "remove") leaves the calculation."""
 
     lo: Optional[Position] = Field(
         None, description="Lower corner (absent: from the bodies and margin).")
@@ -65,3 +66,9 @@ class Domain(Section):
         1.0, description="For an absent corner: the initial bounding box of "
                          "the bodies expanded on each side by margin times its "
                          "largest side (the same distance in every direction).")
+    outside: Literal["stop", "remove"] = Field(
+        "stop", description="What a particle leaving the box does: stop the run with "
+        "a diagnosis, or be removed from the calculation (LS-DYNA's SPH box: fixed "
+        "where it left, out of the neighbour search, its kinetic and internal energy "
+        "booked as E_left_domain; for blast products flying off). Total-Lagrangian "
+        "particles and mesh nodes always stop the run.")

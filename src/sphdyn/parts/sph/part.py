@@ -37,7 +37,7 @@ from ...guards import SimulationFailed
 from ...integrate import add_heat, cfl_time_step, drift, internal_energies
 from ...kernels import KernelContext
 from ...neighbours import build_neighbours, mean_neighbours, update_neighbours
-from ...state import Particles
+from ...state import BC_FIXED, Particles
 from ..base import register_part
 from .artificial_stress import artificial_stress_forces, artificial_stress_tensor
 from .passes import (forces, stress_terms, update_density_and_h, velocity_gradient,
@@ -177,7 +177,7 @@ class SPHPart:
                 p.dt_factor[sel] = s.time_step_factor[g.material]
             if g.model.fluid:  # Monaghan's (1992) viscous time-step condition
                 p.dt_viscous[sel] = VISCOUS_SIGNAL_WEIGHT
-        self.ul_active = ~p.tl if p.tl.any() else None
+        self.ul_active = self._active_mask()
         self.has_ul = not p.tl.all()  # False: the updated-Lagrangian passes are skipped
         self._visc = None
 
@@ -208,6 +208,38 @@ class SPHPart:
             self.tl.young = p.young
             self.tl.rebuild(p, np.concatenate([self.tl.X, p.x0[n_old:]]),
                             np.concatenate([self.tl.rho_ref, p.rho0[n_old:]]))
+        self._swegle_at = None
+
+    def _active_mask(self):
+        """Particles of the updated-Lagrangian neighbour lists: not
+        total-Lagrangian (those have their own) and not removed
+        (:meth:`deactivate`); None when that is every particle."""
+        p = self.p
+        act = p.active == 1
+        if p.tl.any():
+            act &= ~p.tl
+        return None if act.all() else act
+
+    def deactivate(self, rows: np.ndarray) -> None:
+        """Take updated-Lagrangian particles ``rows`` out of the calculation
+        (LS-DYNA's SPH box): out of the neighbour lists from now on, fixed where
+        they are (velocity and acceleration zero), their internal energy and
+        stress zero (the caller books what they carried). Their mass stays."""
+        p = self.p
+        if np.any(p.tl[rows]):
+            raise ValueError("total-Lagrangian particles cannot be removed")
+        p.active[rows] = 0
+        p.bc[rows] = BC_FIXED
+        p.v[rows] = 0.0
+        p.a[rows] = 0.0
+        p.e[rows] = 0.0
+        p.e_av[rows] = 0.0
+        p.sig[rows] = 0.0
+        p.dedt_av[rows] = 0.0
+        p.av_signal[rows] = 0.0
+        self.ul_active = self._active_mask()
+        self.nl = build_neighbours(p.x, p.h, self.kernel.radius_factor, self.skin, self.dim,
+                                   active=self.ul_active)
         self._swegle_at = None
 
     # ----------------------------------------------------------- protocol
@@ -331,6 +363,9 @@ class SPHPart:
         nl.idx = arrays["nl_idx"].copy()
         nl.x_ref = arrays["nl_x_ref"].copy()
         nl.h_ref = arrays["nl_h_ref"].copy()
+        # the lists were built without the particles removed by then
+        self.ul_active = self._active_mask()
+        nl.active_ref = None if self.ul_active is None else self.ul_active.copy()
         if self.tl is not None:
             if "tl_X" in arrays and not (np.array_equal(arrays["tl_X"], self.tl.X) and
                                          np.array_equal(arrays["tl_rho_ref"],

@@ -1,0 +1,191 @@
+"""Thesis ch. 9 (Figs. 9.4-9.7): a TNT charge detonated 100 mm above an RC slab.
+
+Runs examples/blast_slab_coarse.toml (slab dx 10 mm) without and with the
+CSCM rate effects into out/blast_slab_coarse and out/blast_slab_coarse_rate
+(``--full``: also examples/blast_slab.toml, dx 5 mm, into out/blast_slab;
+``--reuse`` only reads), and writes
+
+* docs/figures/blast_slab.png: the gauges over time, the strain at the
+  bottom surface (Fig. 9.4) and the displacement at the bottom centre
+  (Fig. 9.5), of every run found; the damage of the top and the bottom face
+  at the end of the first run (Fig. 9.6);
+* docs/figures/blast_slab_detonation.png: cross-sections through the
+  charge's axis (y = 250 mm) at 10, 30 and 60 us, particles coloured by
+  material (Fig. 9.7), from a short run of the coarse model with a frame
+  every 10 us (out/blast_slab_early);
+* a table (stdout, markdown): peak displacement and strain, when they occur,
+  the released chemical energy, steps, wall time, energy error.
+
+    python examples/blast_slab.py [--reuse] [--full]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+#: run name: (deck, overrides, label)
+RUNS = {
+    "blast_slab_coarse": ("blast_slab_coarse.toml", [], "dx 10 mm, no rate effects"),
+    "blast_slab_coarse_rate": ("blast_slab_coarse.toml", ["material.0.rate_effects=true"],
+                               "dx 10 mm, rate effects"),
+    "blast_slab": ("blast_slab.toml", [], "dx 5 mm, no rate effects"),
+}
+#: the first 60 us of the coarse model with a frame every 10 us (the
+#: detonation's cross-sections; the products leave the box within 0.3 ms)
+EARLY = ("blast_slab_coarse.toml", ["run.t_end=6e-5", "output.every=1e-5"])
+#: material indices of the decks
+CONCRETE, TNT = 0, 3
+CENTRE_Y = 0.25  # the charge's axis [m]
+
+
+def run(name: str, reuse: bool) -> Path:
+    """Run one model (unless ``reuse`` finds its output); its output folder."""
+    from sphdyn.simulation import run_deck
+
+    deck, overrides, _ = RUNS[name]
+    out = ROOT / "out" / name
+    if not (reuse and (out / "summary.json").exists()):
+        run_deck(ROOT / "examples" / deck, out, overrides=overrides, progress=True)
+    return out
+
+
+def _frame(path: Path) -> dict:
+    """Positions, displacements, damage and material of a frame's particles."""
+    import h5py
+
+    with h5py.File(path, "r") as f:
+        return {k: f[k][:] for k in ("position", "displacement", "damage", "material")}
+
+
+def face_damage(out: Path) -> tuple[np.ndarray, np.ndarray, float]:
+    """The damage of the concrete's top and bottom particle layers at the last
+    frame as (ny, nx) images, and the lattice spacing [m]."""
+    from sphdyn.analysis import projected_max
+
+    fr = _frame(sorted((out / "frames").glob("frame_*.h5"))[-1])
+    concrete = fr["material"] == CONCRETE
+    x0 = (fr["position"] - fr["displacement"])[concrete]
+    d = fr["damage"][concrete]
+    z = np.round(x0[:, 2], 6)
+    dx = float(np.min(np.diff(np.unique(z))))
+    top, bottom = z == z.max(), z == z.min()
+    return (projected_max(x0[top], d[top], dx, (0, 1)),
+            projected_max(x0[bottom], d[bottom], dx, (0, 1)), dx)
+
+
+def cross_sections(out: Path, times: tuple[float, ...], band: float = 0.01):
+    """Particles within ``band`` [m] of the plane y = 250 mm at the frames
+    nearest ``times`` [s] (a slice of the products' cloud, and the slab's
+    rows there): list of (time, x (n, 3), material (n,))."""
+    from sphdyn.io.hdf5 import read_frame_header
+
+    frames = sorted((out / "frames").glob("frame_*.h5"))
+    stamps = np.array([read_frame_header(p)[0] for p in frames])
+    found = []
+    for t in times:
+        k = int(np.argmin(np.abs(stamps - t)))
+        fr = _frame(frames[k])
+        near = np.abs(fr["position"][:, 1] - CENTRE_Y) < band
+        found.append((stamps[k], fr["position"][near], fr["material"][near]))
+    return found
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--reuse", action="store_true", help="only read out/blast_slab*")
+    ap.add_argument("--full", action="store_true", help="also run the dx 5 mm deck")
+    a = ap.parse_args()
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from sphdyn.io import read_history_csv
+
+    done = {n for n in RUNS if (ROOT / "out" / n / "summary.json").exists()}
+    names = [n for n in RUNS if n in done] if a.reuse else \
+        [n for n in RUNS if n != "blast_slab" or a.full or n in done]
+    outs = {n: run(n, a.reuse or (n == "blast_slab" and not a.full)) for n in names}
+
+    fig = plt.figure(figsize=(11, 11), layout="constrained")
+    grid = fig.add_gridspec(3, 2, height_ratios=[1, 1, 1.1])
+    ax_s, ax_d = fig.add_subplot(grid[0, :]), fig.add_subplot(grid[1, :])
+    rows = []
+    for name, out in outs.items():
+        strain = read_history_csv(out / "gauges" / "bottom_strain.csv")
+        disp = read_history_csv(out / "gauges" / "bottom_centre.csv")
+        label = RUNS[name][2]
+        ax_s.plot(1e3 * strain["time"], 1e6 * strain["strain"], label=label)
+        ax_d.plot(1e3 * disp["time"], 1e3 * disp["displacement_z"], label=label)
+        h = read_history_csv(out / "history.csv")
+        summary = json.loads((out / "summary.json").read_text())
+        k, j = np.argmin(disp["displacement_z"]), np.argmax(strain["strain"])
+        rows.append((label, disp["displacement_z"][k], disp["time"][k],
+                     strain["strain"][j], strain["time"][j], h["E_chemical"][-1],
+                     summary["steps"], summary["wall_seconds"],
+                     summary["energy_error_max_rel"], summary["status"]))
+    ax_s.set_ylabel("bottom-surface strain [µm/m]")
+    ax_s.set_title("Strain at the bottom surface, x = 200-300 mm at the centre line "
+                   "(thesis Fig. 9.4)")
+    ax_d.set_ylabel("displacement [mm]")
+    ax_d.set_xlabel("time [ms]")
+    ax_d.set_title("Vertical displacement at the bottom centre (thesis Fig. 9.5)")
+    for ax in (ax_s, ax_d):
+        ax.grid(alpha=0.3)
+        ax.legend()
+    first = next(iter(outs))
+    top, bottom, dx = face_damage(outs[first])
+    for col, (img, face) in enumerate(((top, "top"), (bottom, "bottom"))):
+        ax = fig.add_subplot(grid[2, col])
+        im = ax.imshow(img, origin="lower", cmap="inferno_r", vmin=0, vmax=1,
+                       extent=(0, img.shape[1] * dx * 1e3, 0, img.shape[0] * dx * 1e3))
+        ax.set_title(f"Damage of the {face} face at the end (thesis Fig. 9.6)")
+        ax.set_xlabel("x [mm]")
+        ax.set_ylabel("y [mm]")
+    fig.colorbar(im, ax=ax, shrink=0.8, label="damage")
+    fig.suptitle(f"TNT 100 mm above an RC slab (thesis ch. 9): {RUNS[first][2]} and "
+                 "the runs found")
+    figures = ROOT / "docs" / "figures"
+    figures.mkdir(parents=True, exist_ok=True)
+    fig.savefig(figures / "blast_slab.png", dpi=110)
+
+    early = ROOT / "out" / "blast_slab_early"
+    if not (a.reuse and (early / "summary.json").exists()):
+        from sphdyn.simulation import run_deck
+        run_deck(ROOT / "examples" / EARLY[0], early, overrides=EARLY[1])
+    sections = cross_sections(early, (1e-5, 3e-5, 6e-5))
+    fig, axes = plt.subplots(1, len(sections), figsize=(14, 4.6), layout="constrained")
+    for ax, (t, x, mat) in zip(axes, sections):
+        for m, colour, label in ((CONCRETE, "0.6", "concrete"), (TNT, "tab:orange",
+                                                                 "detonation products")):
+            sel = mat == m
+            ax.scatter(1e3 * x[sel, 0], 1e3 * x[sel, 2], s=2, c=colour, label=label)
+        ax.set_xlim(-100, 600)
+        ax.set_ylim(-60, 540)
+        ax.set_aspect("equal")
+        ax.set_title(f"t = {1e6 * t:.0f} us")
+        ax.set_xlabel("x [mm]")
+    axes[0].set_ylabel("z [mm]")
+    axes[0].legend(loc="upper left", markerscale=4)
+    fig.suptitle("Slice through the charge's axis, 240 mm < y < 260 mm (thesis Fig. 9.7), "
+                 "dx 10 mm, charge 3 mm")
+    fig.savefig(figures / "blast_slab_detonation.png", dpi=110)
+
+    print("| model | peak displacement [mm] | at [ms] | largest bottom strain [µm/m] "
+          "| at [ms] | chemical energy [kJ] | steps | wall [s] | energy error (max, rel.) "
+          "| status |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for label, d, td, e, te, q, steps, wall, err, status in rows:
+        print(f"| {label} | {1e3 * d:.2f} | {1e3 * td:.2f} | {1e6 * e:.0f} | "
+              f"{1e3 * te:.2f} | {1e-3 * q:.1f} | {steps} | {wall:.0f} | {err:.4f} | "
+              f"{status} |")
+
+
+if __name__ == "__main__":
+    main()
