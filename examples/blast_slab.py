@@ -16,7 +16,15 @@ CSCM rate effects into out/blast_slab_coarse and out/blast_slab_coarse_rate
 * a table (stdout, markdown): peak displacement and strain, when they occur,
   the released chemical energy, steps, wall time, energy error.
 
-    python examples/blast_slab.py [--reuse] [--full]
+``--orientation`` runs the thesis's sensitivity study instead, as an
+ensemble of the coarse deck over the charge's tilt from upright (about y
+through its centre, the detonator turning with it):
+``sphdyn ensemble examples/blast_slab_coarse.toml --samples 1 --vary
+body.charge.geometry.tilt=0,45,90`` into out/blast_slab_coarse-ensemble,
+and writes docs/figures/blast_slab_orientation.png (the gauges of each tilt)
+and a table.
+
+    python examples/blast_slab.py [--reuse] [--full] [--orientation]
 """
 
 from __future__ import annotations
@@ -48,10 +56,9 @@ def run(name: str, reuse: bool) -> Path:
     from sphdyn.simulation import run_deck
 
     deck, overrides, _ = RUNS[name]
-    out = ROOT / "out" / name
-    if not (reuse and (out / "summary.json").exists()):
-        run_deck(ROOT / "examples" / deck, out, overrides=overrides, progress=True)
-    return out
+    run_deck(ROOT / "examples" / deck, ROOT / "out" / name, overrides, reuse=reuse,
+             progress=True)
+    return ROOT / "out" / name
 
 
 def _frame(path: Path) -> dict:
@@ -95,10 +102,55 @@ def cross_sections(out: Path, times: tuple[float, ...], band: float = 0.01):
     return found
 
 
+TILTS = (0, 45, 90)
+
+
+def orientation(reuse: bool) -> None:
+    """The charge-orientation study (module docstring): ensemble, figure, table."""
+    import matplotlib.pyplot as plt
+
+    from sphdyn.ensemble import run_ensemble
+    from sphdyn.io import read_history_csv
+    from sphdyn.io.plots import markdown_table
+
+    out = ROOT / "out" / "blast_slab_coarse-ensemble"
+    if not (reuse and (out / "ensemble.csv").exists()):
+        run_ensemble(ROOT / "examples" / "blast_slab_coarse.toml", 1,
+                     [f"body.charge.geometry.tilt={','.join(map(str, TILTS))}"], out)
+    fig, (ax_s, ax_d) = plt.subplots(2, 1, figsize=(9, 7), sharex=True,
+                                     layout="constrained")
+    rows = []
+    for k, tilt in enumerate(TILTS):
+        run_dir = out / f"sample_{k:04d}"
+        strain = read_history_csv(run_dir / "gauges" / "bottom_strain.csv")
+        disp = read_history_csv(run_dir / "gauges" / "bottom_centre.csv")
+        ax_s.plot(1e3 * strain["time"], 1e6 * strain["strain"], label=f"tilt {tilt} deg")
+        ax_d.plot(1e3 * disp["time"], 1e3 * disp["displacement_z"],
+                  label=f"tilt {tilt} deg")
+        i, j = np.argmin(disp["displacement_z"]), np.argmax(strain["strain"])
+        rows.append({"tilt [deg]": tilt,
+                     "peak displacement [mm]": f"{1e3 * disp['displacement_z'][i]:.2f}",
+                     "at [ms]": f"{1e3 * disp['time'][i]:.2f}",
+                     "largest bottom strain [µm/m]": f"{1e6 * strain['strain'][j]:.0f}",
+                     "at [ms] ": f"{1e3 * strain['time'][j]:.2f}"})
+    ax_s.set_ylabel("bottom-surface strain [µm/m]")
+    ax_d.set_ylabel("displacement [mm]")
+    ax_d.set_xlabel("time [ms]")
+    for ax in (ax_s, ax_d):
+        ax.grid(alpha=0.3)
+        ax.legend()
+    fig.suptitle("Charge orientation: the coarse slab's gauges, the charge tilted about y "
+                 "(0 = upright)")
+    fig.savefig(ROOT / "docs" / "figures" / "blast_slab_orientation.png", dpi=110)
+    print(markdown_table(rows))
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--reuse", action="store_true", help="only read out/blast_slab*")
     ap.add_argument("--full", action="store_true", help="also run the dx 5 mm deck")
+    ap.add_argument("--orientation", action="store_true",
+                    help="the charge-orientation ensemble instead")
     a = ap.parse_args()
 
     import matplotlib
@@ -106,7 +158,12 @@ def main() -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    if a.orientation:
+        orientation(a.reuse)
+        return
+
     from sphdyn.io import read_history_csv
+    from sphdyn.io.plots import markdown_table
 
     done = {n for n in RUNS if (ROOT / "out" / n / "summary.json").exists()}
     names = [n for n in RUNS if n in done] if a.reuse else \
@@ -126,10 +183,16 @@ def main() -> None:
         h = read_history_csv(out / "history.csv")
         summary = json.loads((out / "summary.json").read_text())
         k, j = np.argmin(disp["displacement_z"]), np.argmax(strain["strain"])
-        rows.append((label, disp["displacement_z"][k], disp["time"][k],
-                     strain["strain"][j], strain["time"][j], h["E_chemical"][-1],
-                     summary["steps"], summary["wall_seconds"],
-                     summary["energy_error_max_rel"], summary["status"]))
+        rows.append({
+            "model": label,
+            "peak displacement [mm]": f"{1e3 * disp['displacement_z'][k]:.2f}",
+            "at [ms]": f"{1e3 * disp['time'][k]:.2f}",
+            "largest bottom strain [µm/m]": f"{1e6 * strain['strain'][j]:.0f}",
+            "at [ms] ": f"{1e3 * strain['time'][j]:.2f}",
+            "chemical energy [kJ]": f"{1e-3 * h['E_chemical'][-1]:.1f}",
+            "steps": summary["steps"], "wall [s]": f"{summary['wall_seconds']:.0f}",
+            "energy error (max, rel.)": f"{summary['energy_error_max_rel']:.4f}",
+            "status": summary["status"]})
     ax_s.set_ylabel("bottom-surface strain [µm/m]")
     ax_s.set_title("Strain at the bottom surface, x = 200-300 mm at the centre line "
                    "(thesis Fig. 9.4)")
@@ -155,10 +218,10 @@ def main() -> None:
     figures.mkdir(parents=True, exist_ok=True)
     fig.savefig(figures / "blast_slab.png", dpi=110)
 
+    from sphdyn.simulation import run_deck
+
     early = ROOT / "out" / "blast_slab_early"
-    if not (a.reuse and (early / "summary.json").exists()):
-        from sphdyn.simulation import run_deck
-        run_deck(ROOT / "examples" / EARLY[0], early, overrides=EARLY[1])
+    run_deck(ROOT / "examples" / EARLY[0], early, EARLY[1], reuse=a.reuse)
     sections = cross_sections(early, (1e-5, 3e-5, 6e-5))
     fig, axes = plt.subplots(1, len(sections), figsize=(14, 4.6), layout="constrained")
     for ax, (t, x, mat) in zip(axes, sections):
@@ -177,14 +240,7 @@ def main() -> None:
                  "dx 10 mm, charge 3 mm")
     fig.savefig(figures / "blast_slab_detonation.png", dpi=110)
 
-    print("| model | peak displacement [mm] | at [ms] | largest bottom strain [µm/m] "
-          "| at [ms] | chemical energy [kJ] | steps | wall [s] | energy error (max, rel.) "
-          "| status |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
-    for label, d, td, e, te, q, steps, wall, err, status in rows:
-        print(f"| {label} | {1e3 * d:.2f} | {1e3 * td:.2f} | {1e6 * e:.0f} | "
-              f"{1e3 * te:.2f} | {1e-3 * q:.1f} | {steps} | {wall:.0f} | {err:.4f} | "
-              f"{status} |")
+    print(markdown_table(rows))
 
 
 if __name__ == "__main__":

@@ -42,10 +42,9 @@ def run(name: str, reuse: bool) -> Path:
     from sphdyn.simulation import run_deck
 
     deck, overrides, _ = RUNS[name]
-    out = ROOT / "out" / name
-    if not (reuse and (out / "summary.json").exists()):
-        run_deck(ROOT / "examples" / deck, out, overrides=overrides, progress=True)
-    return out
+    run_deck(ROOT / "examples" / deck, ROOT / "out" / name, overrides, reuse=reuse,
+             progress=True)
+    return ROOT / "out" / name
 
 
 def side_damage(out: Path) -> tuple[np.ndarray, float]:

@@ -34,8 +34,8 @@ def run(model: str, reuse: bool) -> Path:
     from sphdyn.simulation import run_deck
 
     out = ROOT / "out" / f"erosion_blocks_{model}"
-    if not (reuse and (out / "summary.json").exists()):
-        run_deck(ROOT / "examples" / f"erosion_blocks_{model}.toml", out, progress=True)
+    run_deck(ROOT / "examples" / f"erosion_blocks_{model}.toml", out, reuse=reuse,
+             progress=True)
     return out
 
 

@@ -41,8 +41,7 @@ def run(name: str, reuse: bool) -> Path:
     from sphdyn.simulation import run_deck
 
     out = ROOT / "out" / name
-    if not (reuse and (out / "summary.json").exists()):
-        run_deck(ROOT / "examples" / f"{name}.toml", out)
+    run_deck(ROOT / "examples" / f"{name}.toml", out, reuse=reuse)
     return out
 
 

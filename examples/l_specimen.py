@@ -35,9 +35,8 @@ def run(label: str, dx: float, reuse: bool) -> Path:
     from sphdyn.simulation import run_deck
 
     out = ROOT / "out" / f"l_specimen_{label}"
-    if not (reuse and (out / "summary.json").exists()):
-        run_deck(ROOT / "examples" / "l_specimen.toml", out,
-                 overrides=[f"body.L.dx={dx!r}"], progress=True)
+    run_deck(ROOT / "examples" / "l_specimen.toml", out, [f"body.L.dx={dx!r}"],
+             reuse=reuse, progress=True)
     return out
 
 

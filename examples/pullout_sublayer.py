@@ -28,9 +28,8 @@ def run(ratio: float, reuse: bool) -> Path:
     from sphdyn.simulation import run_deck
 
     out = ROOT / "out" / f"pullout_sublayer_r{ratio:g}"
-    if not (reuse and (out / "summary.json").exists()):
-        run_deck(ROOT / "examples" / "pullout_sublayer.toml", out,
-                 overrides=[f"mesh.bar.sublayer.mass_ratio={ratio}"], progress=True)
+    run_deck(ROOT / "examples" / "pullout_sublayer.toml", out,
+             [f"mesh.bar.sublayer.mass_ratio={ratio}"], reuse=reuse, progress=True)
     return out
 
 

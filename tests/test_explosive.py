@@ -568,3 +568,33 @@ def test_blast_slab_coarse_first_100_us(tmp_path):
     assert np.max(np.abs(h["E_total"])) < 0.03 * h["E_chemical"][-1]
     disp = read_history_csv(tmp_path / "gauges" / "bottom_centre.csv")
     assert disp["displacement_z"][-1] < -1e-5
+
+
+def test_a_detonation_point_turns_with_its_tilted_charge():
+    # the charge tilted 90 degrees about y: the point given at the upright
+    # charge's top centre lights the (now sideways) end first
+    from sphdyn.model import build_model
+    d = _deck(dim=3, material=None, detonation=[{"point": [0.005, 0.005, 0.0115],
+                                                 "rotate_with": "charge"}])
+    d["body"][0]["geometry"] = {"shape": "cylinder", "centre": [0.005, 0.005, 0.0],
+                                "radius": 0.003, "length": 0.024, "axis": "z",
+                                "tilt": 90.0}
+    model = build_model(load_deck_dict(d))
+    p = model.particles
+    t_l = -p.hist[p.mat == 0, p.hist_names.index("burn_clock")]
+    x = p.x[p.mat == 0]
+    assert np.ptp(x[:, 0]) > 0.02 > np.ptp(x[:, 2])  # lying along x
+    assert x[np.argmin(t_l), 0] > 0.005 + 0.01  # lit at the end at +x
+    point = np.array([0.005 + 0.0115, 0.005, 0.0])
+    assert np.allclose(t_l, np.linalg.norm(x - point, axis=1) / 6930.0, rtol=1e-12)
+    # without rotate_with the same point lies outside the turned charge
+    d["detonation"][0].pop("rotate_with")
+    with pytest.raises(DeckError, match=r"detonation\[0\]\.point"):
+        build_model(load_deck_dict(d))
+
+
+def test_tilt_is_refused_outside_3d():
+    d = _deck()
+    d["body"][0]["geometry"] = {"shape": "cylinder", "centre": [0.005, 0.005],
+                                "radius": 0.004, "tilt": 30.0}
+    assert "tilt turns a cylinder in 3D only" in _problems(d)

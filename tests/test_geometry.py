@@ -514,3 +514,34 @@ def test_bounding_box():
     np.testing.assert_array_equal(hi, [3.0, 1.0, 0.5])
     with pytest.raises(ValueError):
         bounding_box(np.zeros((0, 3)))
+
+
+def test_rotate_about_is_right_handed_and_keeps_distances():
+    from sphdyn.geometry.lattice import rotate_about
+    c = np.array([1.0, 2.0, 3.0])
+    e = np.eye(3)
+    # about z: x -> y; about x: y -> z; about y: z -> x (right-handed)
+    assert np.allclose(rotate_about(c + e[[0]], c, "z", 90), c + e[1], atol=1e-15)
+    assert np.allclose(rotate_about(c + e[[1]], c, "x", 90), c + e[2], atol=1e-15)
+    assert np.allclose(rotate_about(c + e[[2]], c, "y", 90), c + e[0], atol=1e-15)
+    x = np.random.default_rng(0).normal(size=(50, 3))
+    y = rotate_about(x, c, "y", 37.0)
+    assert np.allclose(np.linalg.norm(y - c, axis=1), np.linalg.norm(x - c, axis=1))
+    assert np.allclose(rotate_about(y, c, "y", -37.0), x)
+
+
+def test_tilted_cylinder_lattice_and_its_preflight_depth():
+    from types import SimpleNamespace
+
+    from sphdyn.geometry.lattice import rotate_about
+    from sphdyn.preflight import depth_inside
+    c = [0.25, 0.25, 0.2]
+    up = cylinder_lattice(c, 0.015, 0.07, "z", 0.003, 3)
+    tilted = cylinder_lattice(c, 0.015, 0.07, "z", 0.003, 3, tilt=30.0, tilt_axis="y")
+    assert np.allclose(tilted, rotate_about(up, c, "y", 30.0))
+    g = SimpleNamespace(shape="cylinder", centre=c, radius=0.015, length=0.07, axis="z",
+                        tilt=30.0, tilt_axis="y")
+    assert np.all(depth_inside(g, tilted, 3) > 0)  # every particle inside
+    tip = rotate_about(np.array([[0.25, 0.25, 0.2 + 0.034]]), c, "y", 30.0)
+    assert depth_inside(g, tip, 3)[0] == pytest.approx(0.001, abs=1e-12)
+    assert depth_inside(g, np.array([[0.25, 0.25, 0.234]]), 3)[0] < 0  # upright tip

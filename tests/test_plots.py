@@ -161,3 +161,11 @@ def test_material_point_figure_names_model_and_parameters():
     assert fig.axes[0].get_xlabel() == "strain eps_xx [‰]"
     assert np.allclose(fig.axes[0].get_lines()[0].get_xdata(), res["x"] * 1e3)
     assert fig.get_suptitle() == title
+
+
+def test_markdown_table_from_rows():
+    from sphdyn.io.plots import markdown_table
+    text = markdown_table([{"a": 1, "b [mm]": "2.00"}, {"a": 3, "b [mm]": "4.00"}])
+    assert text.splitlines() == ["| a | b [mm] |", "|---|---|", "| 1 | 2.00 |",
+                                 "| 3 | 4.00 |"]
+    assert markdown_table([]) == ""

@@ -273,3 +273,18 @@ def test_probe_of_a_missing_history_variable_is_rejected_before_running(tmp_path
     deck = tmp_path / "d.toml"
     deck.write_text(text)
     assert main(["check", str(deck)]) == 2
+
+
+def test_run_deck_reuses_a_finished_run(tmp_path):
+    # reuse: a folder with a summary is not run again (the deck need not even
+    # be valid), its summary is returned; without reuse the deck is loaded
+    import json
+
+    from sphdyn.deck import DeckError
+    from sphdyn.simulation import run_deck
+    (tmp_path / "summary.json").write_text(json.dumps({"status": "completed", "steps": 7}))
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[run]\n")
+    assert run_deck(bad, tmp_path, reuse=True) == {"status": "completed", "steps": 7}
+    with pytest.raises(DeckError):
+        run_deck(bad, tmp_path)

@@ -17,6 +17,7 @@ import numpy as np
 
 from .deck import DeckError
 from .deck.errors import format_problem
+from .geometry.lattice import rotate_about
 from .materials.explosive import H_CLOCK, detonation_velocity, lit
 
 
@@ -31,6 +32,17 @@ def lighting_times(x: np.ndarray, points: np.ndarray, times: np.ndarray,
     return t
 
 
+def _turned(deck, det):
+    """The detonation with its point turned with its ``rotate_with`` body's tilt."""
+    if det.rotate_with is None:
+        return det
+    g = next(b for b in deck.body if b.name == det.rotate_with).geometry
+    if not getattr(g, "tilt", None):
+        return det
+    point = rotate_about(np.asarray([det.point], float), g.centre, g.tilt_axis, g.tilt)[0]
+    return det.model_copy(update={"point": tuple(float(c) for c in point)})
+
+
 def light_explosives(deck, particles, groups) -> None:
     """Set the burn clock ``-t_l`` of every lit explosive's particles.
 
@@ -38,7 +50,7 @@ def light_explosives(deck, particles, groups) -> None:
     a point is not in a charge it lights: farther than one particle spacing
     from every particle of those materials.
     """
-    dets = deck.detonation
+    dets = [_turned(deck, d) for d in deck.detonation]
     if not dets:
         return
     spacing = particles.vol0 ** (1.0 / particles.dim)

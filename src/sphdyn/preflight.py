@@ -23,7 +23,7 @@ import numpy as np
 
 from .deck import DeckError
 from .deck.errors import format_problem
-from .geometry.lattice import polygon_area
+from .geometry.lattice import polygon_area, rotate_about
 
 #: Bytes of per-particle state and work arrays (besides history variables and
 #: neighbour lists): about 850 measured for block3d at 1M particles
@@ -103,6 +103,8 @@ def depth_inside(geometry, x: np.ndarray, dim: int) -> np.ndarray:
     if g.shape == "box":
         lo, hi = np.asarray(g.lo)[:dim], np.asarray(g.hi)[:dim]
         return np.min(np.minimum(x[:, :dim] - lo, hi - x[:, :dim]), axis=1)
+    if getattr(g, "tilt", None):  # into the upright cylinder's frame
+        x = rotate_about(x, g.centre, g.tilt_axis, -g.tilt)
     rel = x - np.asarray(g.centre)
     if g.shape == "sphere":
         return g.radius - np.linalg.norm(rel[:, :dim], axis=1)

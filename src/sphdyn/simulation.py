@@ -337,8 +337,14 @@ def _output_failure(exc: OSError, s) -> str:
             "from the last checkpoint or run again.")
 
 
-def run_deck(path, outdir=None, overrides=None, **kw) -> dict:
-    """Load, validate and run a deck; the Python equivalent of ``sphdyn run``."""
-    deck = load_deck(path, overrides)
+def run_deck(path, outdir=None, overrides=None, reuse: bool = False, **kw) -> dict:
+    """Load, validate and run a deck; the Python equivalent of ``sphdyn run``.
+
+    With ``reuse``, a run whose ``outdir`` already has a ``summary.json``
+    is not run again: its summary is returned (the example scripts' redraws).
+    """
     outdir = Path(outdir) if outdir else Path("out") / Path(path).stem
+    if reuse and (outdir / "summary.json").exists():
+        return json.loads((outdir / "summary.json").read_text())
+    deck = load_deck(path, overrides)
     return Simulation.from_deck(deck, outdir).run(**kw)

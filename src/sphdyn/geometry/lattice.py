@@ -34,6 +34,7 @@ __all__ = [
     "box_lattice",
     "cylinder_lattice",
     "ring_lattice",
+    "rotate_about",
     "sphere_lattice",
     "prism_lattice",
     "polygon_area",
@@ -189,8 +190,26 @@ def _radial_lattice(centre, inner: float, outer: float, length, axis, dx: float,
     return c + rel[keep]
 
 
+def rotate_about(x, centre, axis, degrees: float) -> np.ndarray:
+    """Points ``x`` (n, 3) [m] rotated by ``degrees`` about the line through
+    ``centre`` (3,) along ``axis`` ("x", "y", "z" or 0, 1, 2), right-handed
+    (a new array)."""
+    a = _axis_index(axis)
+    u, v = [k for k in range(3) if k != a]
+    if a == 1:  # right-handed about y: z -> x
+        u, v = v, u
+    t = np.radians(float(degrees))
+    c, s = np.cos(t), np.sin(t)
+    rel = np.asarray(x, float) - np.asarray(centre, float)
+    out = rel.copy()
+    out[:, u] = c * rel[:, u] - s * rel[:, v]
+    out[:, v] = s * rel[:, u] + c * rel[:, v]
+    return out + np.asarray(centre, float)
+
+
 def cylinder_lattice(centre, radius: float, length, axis, dx: float, dim: int,
-                     *, rule: str = "centre") -> np.ndarray:
+                     *, rule: str = "centre", tilt: float | None = None,
+                     tilt_axis="y") -> np.ndarray:
     """Particles filling a solid circular cylinder (a disc in 2D).
 
     The lattice is grid based (not radial), as for the concrete disc of
@@ -217,6 +236,11 @@ def cylinder_lattice(centre, radius: float, length, axis, dx: float, dim: int,
         "centre" keeps points with distance from the axis <= radius (plus a
         relative tolerance of 1e-9); it gives the paper's 1,264 particles per
         layer for 40 across (10,112 for 8 layers).
+    tilt : float, optional
+        3D: the lattice (cylinder and grid) rotated by this angle [degrees]
+        about ``tilt_axis`` through ``centre`` (:func:`rotate_about`), e.g.
+        a charge turned from upright.
+    tilt_axis : {"x", "y", "z"}, optional
 
     Returns
     -------
@@ -225,7 +249,12 @@ def cylinder_lattice(centre, radius: float, length, axis, dx: float, dim: int,
         particle ``dx**dim``.
     """
     radius = _positive("radius", radius)
-    return _radial_lattice(centre, -np.inf, radius, length, axis, dx, dim, rule)
+    x = _radial_lattice(centre, -np.inf, radius, length, axis, dx, dim, rule)
+    if tilt:
+        if dim != 3:
+            raise ValueError("tilt is for 3D cylinders only")
+        x = rotate_about(x, _point(centre, dim, "centre"), tilt_axis, tilt)
+    return x
 
 
 def ring_lattice(centre, inner_radius: float, outer_radius: float, length, axis,

@@ -16,6 +16,7 @@ from .atomic import atomic_path
 from .history import read_history_csv
 
 __all__ = ["plot_history", "history_figures", "save_figure", "time_unit", "per_depth",
+           "markdown_table",
            "run_dimension_and_end", "ENERGY_COLUMNS", "energy_columns", "relative_drift"]
 
 #: Energy columns plotted first, in this order, when present. Any other
@@ -157,6 +158,17 @@ def plot_history(csv_path: str | os.PathLike,
     figures = history_figures(read_history_csv(csv_path), csv_path.name, force_window,
                               dimension, t_end)
     return [save_figure(fig, out_dir / f"{name}.png", 120) for name, fig in figures.items()]
+
+
+def markdown_table(rows: list[dict]) -> str:
+    """A Markdown table of ``rows`` (dicts with the same keys, in order: the
+    header), values as given (format them first)."""
+    if not rows:
+        return ""
+    keys = list(rows[0])
+    lines = ["| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
+    lines += ["| " + " | ".join(str(r[k]) for k in keys) + " |" for r in rows]
+    return "\n".join(lines)
 
 
 #: curves above which a legend goes beside the axes in columns of this many

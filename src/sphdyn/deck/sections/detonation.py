@@ -23,3 +23,7 @@ class Detonation(Section):
     material: Optional[reference_to("material")] = Field(
         None, description="The high-explosive material it lights (absent: every "
                           "high explosive of the deck).")
+    rotate_with: Optional[reference_to("body")] = Field(
+        None, description="A body whose cylinder is tilted (geometry.tilt): the point "
+                          "turns with it about the cylinder's centre (a detonator on a "
+                          "tilted charge; point is given for the upright charge).")

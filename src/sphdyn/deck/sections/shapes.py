@@ -10,7 +10,7 @@ from ..messages import problem, show_number
 from ..scope import dimension
 from ..units import LENGTH
 from ..values import (Axis, Corner, Direction, Position, PositiveLength, Section,
-                      UpperCorner, UpperPosition, quantity)
+                      UpperCorner, UpperPosition, quantity, real)
 
 
 class Box(Section):
@@ -66,6 +66,20 @@ class Cylinder(Section):
         description="Length along the axis; required in 3D, not allowed in 2D.")
     axis: PlanarAxis = Field("z", description="Axis direction; must be z "
                                               "in 2D.")
+    tilt: Optional[real("tilt angle", lo=-180, hi=180)] = Field(
+        None, description="3D: the cylinder (and its lattice) turned by this angle in "
+        "degrees about tilt_axis through its centre (right-handed), e.g. a charge "
+        "tilted from upright; a [[detonation]] point with rotate_with = this body "
+        "turns with it.")
+    tilt_axis: Axis = Field("y", description="Axis of the tilt (through the centre).")
+
+    @field_validator("tilt")
+    @classmethod
+    def _tilt_in_3d(cls, tilt):
+        if tilt is not None and dimension() in (1, 2):
+            raise problem("tilt turns a cylinder in 3D only",
+                          "remove tilt, or set run.dimension = 3")
+        return tilt
 
 
 class Ring(Section):
