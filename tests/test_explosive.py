@@ -598,3 +598,19 @@ def test_tilt_is_refused_outside_3d():
     d["body"][0]["geometry"] = {"shape": "cylinder", "centre": [0.005, 0.005],
                                 "radius": 0.004, "tilt": 30.0}
     assert "tilt turns a cylinder in 3D only" in _problems(d)
+
+
+@pytest.mark.parametrize("plate_mm", [1.0, 4.2])
+def test_gurney_over_the_mass_ratio(tmp_path, plate_mm):
+    # the deck with lighter and heavier plates (10 and 42 particles of 0.1 mm:
+    # M/C = 0.48 and 2.02): the plate at 30 us within 10 % of Gurney's
+    # velocity for its M/C (measured +7.2 % and +1.1 %; the light plate is
+    # still gaining, Gurney's linear velocity profile fits heavy plates best)
+    from sphdyn.simulation import run_deck
+    ex = _examples_module()
+    run_deck(Path(ex.ROOT) / "examples" / "gurney_1d.toml", tmp_path,
+             [f'body.plate.geometry.hi=["{10.0 + plate_mm} mm"]', "output.vtk=false",
+              "output.progress=false"])
+    g = ex.gurney_result(tmp_path)
+    m_over_c = round(plate_mm / 0.1) * 7850.0 / (100 * 1630.0)
+    assert g["v"][-1] == pytest.approx(ex.gurney_open_face(m_over_c), rel=0.10)
