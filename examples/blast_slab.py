@@ -105,12 +105,37 @@ def cross_sections(out: Path, times: tuple[float, ...], band: float = 0.01):
 TILTS = (0, 45, 90)
 
 
+def plot_gauges(ax_s, ax_d, out: Path, label: str) -> dict:
+    """Draw a run's bottom strain and bottom-centre displacement on ``ax_s``,
+    ``ax_d``; their peaks and times as table columns."""
+    from sphdyn.io import read_history_csv
+
+    strain = read_history_csv(out / "gauges" / "bottom_strain.csv")
+    disp = read_history_csv(out / "gauges" / "bottom_centre.csv")
+    ax_s.plot(1e3 * strain["time"], 1e6 * strain["strain"], label=label)
+    ax_d.plot(1e3 * disp["time"], 1e3 * disp["displacement_z"], label=label)
+    i, j = np.argmin(disp["displacement_z"]), np.argmax(strain["strain"])
+    return {"peak displacement [mm]": f"{1e3 * disp['displacement_z'][i]:.2f}",
+            "at [ms]": f"{1e3 * disp['time'][i]:.2f}",
+            "largest bottom strain [µm/m]": f"{1e6 * strain['strain'][j]:.0f}",
+            "at [ms] ": f"{1e3 * strain['time'][j]:.2f}"}
+
+
+def finish_gauge_axes(ax_s, ax_d) -> None:
+    """Labels, grid and legends of the two gauge panels."""
+    ax_s.set_ylabel("bottom-surface strain [µm/m]")
+    ax_d.set_ylabel("displacement [mm]")
+    ax_d.set_xlabel("time [ms]")
+    for ax in (ax_s, ax_d):
+        ax.grid(alpha=0.3)
+        ax.legend()
+
+
 def orientation(reuse: bool) -> None:
     """The charge-orientation study (module docstring): ensemble, figure, table."""
     import matplotlib.pyplot as plt
 
     from sphdyn.ensemble import run_ensemble
-    from sphdyn.io import read_history_csv
     from sphdyn.io.plots import markdown_table
 
     out = ROOT / "out" / "blast_slab_coarse-ensemble"
@@ -119,26 +144,10 @@ def orientation(reuse: bool) -> None:
                      [f"body.charge.geometry.tilt={','.join(map(str, TILTS))}"], out)
     fig, (ax_s, ax_d) = plt.subplots(2, 1, figsize=(9, 7), sharex=True,
                                      layout="constrained")
-    rows = []
-    for k, tilt in enumerate(TILTS):
-        run_dir = out / f"sample_{k:04d}"
-        strain = read_history_csv(run_dir / "gauges" / "bottom_strain.csv")
-        disp = read_history_csv(run_dir / "gauges" / "bottom_centre.csv")
-        ax_s.plot(1e3 * strain["time"], 1e6 * strain["strain"], label=f"tilt {tilt} deg")
-        ax_d.plot(1e3 * disp["time"], 1e3 * disp["displacement_z"],
-                  label=f"tilt {tilt} deg")
-        i, j = np.argmin(disp["displacement_z"]), np.argmax(strain["strain"])
-        rows.append({"tilt [deg]": tilt,
-                     "peak displacement [mm]": f"{1e3 * disp['displacement_z'][i]:.2f}",
-                     "at [ms]": f"{1e3 * disp['time'][i]:.2f}",
-                     "largest bottom strain [µm/m]": f"{1e6 * strain['strain'][j]:.0f}",
-                     "at [ms] ": f"{1e3 * strain['time'][j]:.2f}"})
-    ax_s.set_ylabel("bottom-surface strain [µm/m]")
-    ax_d.set_ylabel("displacement [mm]")
-    ax_d.set_xlabel("time [ms]")
-    for ax in (ax_s, ax_d):
-        ax.grid(alpha=0.3)
-        ax.legend()
+    rows = [{"tilt [deg]": tilt,
+             **plot_gauges(ax_s, ax_d, out / f"sample_{k:04d}", f"tilt {tilt} deg")}
+            for k, tilt in enumerate(TILTS)]
+    finish_gauge_axes(ax_s, ax_d)
     fig.suptitle("Charge orientation: the coarse slab's gauges, the charge tilted about y "
                  "(0 = upright)")
     fig.savefig(ROOT / "docs" / "figures" / "blast_slab_orientation.png", dpi=110)
@@ -175,33 +184,20 @@ def main() -> None:
     ax_s, ax_d = fig.add_subplot(grid[0, :]), fig.add_subplot(grid[1, :])
     rows = []
     for name, out in outs.items():
-        strain = read_history_csv(out / "gauges" / "bottom_strain.csv")
-        disp = read_history_csv(out / "gauges" / "bottom_centre.csv")
         label = RUNS[name][2]
-        ax_s.plot(1e3 * strain["time"], 1e6 * strain["strain"], label=label)
-        ax_d.plot(1e3 * disp["time"], 1e3 * disp["displacement_z"], label=label)
+        peaks = plot_gauges(ax_s, ax_d, out, label)
         h = read_history_csv(out / "history.csv")
         summary = json.loads((out / "summary.json").read_text())
-        k, j = np.argmin(disp["displacement_z"]), np.argmax(strain["strain"])
         rows.append({
-            "model": label,
-            "peak displacement [mm]": f"{1e3 * disp['displacement_z'][k]:.2f}",
-            "at [ms]": f"{1e3 * disp['time'][k]:.2f}",
-            "largest bottom strain [µm/m]": f"{1e6 * strain['strain'][j]:.0f}",
-            "at [ms] ": f"{1e3 * strain['time'][j]:.2f}",
+            "model": label, **peaks,
             "chemical energy [kJ]": f"{1e-3 * h['E_chemical'][-1]:.1f}",
             "steps": summary["steps"], "wall [s]": f"{summary['wall_seconds']:.0f}",
             "energy error (max, rel.)": f"{summary['energy_error_max_rel']:.4f}",
             "status": summary["status"]})
-    ax_s.set_ylabel("bottom-surface strain [µm/m]")
     ax_s.set_title("Strain at the bottom surface, x = 200-300 mm at the centre line "
                    "(thesis Fig. 9.4)")
-    ax_d.set_ylabel("displacement [mm]")
-    ax_d.set_xlabel("time [ms]")
     ax_d.set_title("Vertical displacement at the bottom centre (thesis Fig. 9.5)")
-    for ax in (ax_s, ax_d):
-        ax.grid(alpha=0.3)
-        ax.legend()
+    finish_gauge_axes(ax_s, ax_d)
     first = next(iter(outs))
     top, bottom, dx = face_damage(outs[first])
     for col, (img, face) in enumerate(((top, "top"), (bottom, "bottom"))):

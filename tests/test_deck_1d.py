@@ -2,22 +2,16 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
-from pydantic import ValidationError
+import tomli_w
 
-from sphdyn.deck import DeckError, deck_model
-from sphdyn.deck.errors import explain
+from sphdyn.deck import DeckError, loads_deck
 
 
 def _load(d):
-    model = deck_model()
-    try:
-        return model.model_validate(d, context={"base_dir": Path(".")})
-    except ValidationError as exc:
-        raise DeckError(explain(exc, d, model)) from None
+    """Validate a deck given as a dict, through its TOML text (as a file)."""
+    return loads_deck(tomli_w.dumps(d))
 
 
 def _deck(geometry=None, **extra):

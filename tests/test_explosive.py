@@ -14,10 +14,9 @@ import pytest
 from sphdyn.riemann import sample, shock_speed
 from pathlib import Path
 
-from pydantic import ValidationError
+import tomli_w
 
-from sphdyn.deck import DeckError, deck_model
-from sphdyn.deck.errors import explain
+from sphdyn.deck import DeckError, loads_deck
 from sphdyn.detonation import lighting_times
 from sphdyn.kernels import KernelContext
 from sphdyn.materials import MaterialGroup, get_model
@@ -304,12 +303,8 @@ def _deck(dim=2, material=None, detonation=None, extra=None):
 
 
 def load_deck_dict(d):
-    """Validate a deck given as a dict (DeckError as from a file)."""
-    model = deck_model()
-    try:
-        return model.model_validate(d, context={"base_dir": Path(".")})
-    except ValidationError as exc:
-        raise DeckError(explain(exc, d, model)) from None
+    """Validate a deck given as a dict, through its TOML text (as a file)."""
+    return loads_deck(tomli_w.dumps(d))
 
 
 def _problems(d):

@@ -52,9 +52,8 @@ def _grad(c, v, correct, with_factors=False):
 
 def _linear_field(dim, seed=1):
     A = np.random.default_rng(seed).normal(size=(3, 3))
-    if dim == 2:
-        A[2, :] = 0.0
-        A[:, 2] = 0.0
+    A[dim:, :] = 0.0  # 2D: no z; 1D (along x): only dv_x/dx
+    A[:, dim:] = 0.0
     return A
 
 
@@ -67,19 +66,23 @@ _RAW_GRADIENT_TOL = {"cubic_spline": 0.015, "quintic_spline": 0.015,
                      "quadratic": 0.05}
 
 
-@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("dim", [1, 2, 3])
 @pytest.mark.parametrize("kernel", sorted(_RAW_GRADIENT_TOL))
 def test_linear_velocity_interior_without_correction(dim, kernel):
-    c = _cloud(dim, n_side=16 if dim == 2 else 11, kernel=kernel, hfac=1.5)
+    # 1D pins the kernel's 1D normalisation and the pass's h^-3 factor
+    c = _cloud(dim, n_side={1: 30, 2: 16, 3: 11}[dim], kernel=kernel, hfac=1.5)
     A = _linear_field(dim)
     L, _ = _grad(c, c["x"] @ A.T, correct=False)
     inner = _interior(c, 1)
     assert inner.size > 0
     err = np.abs(L[inner] - A).max() / np.abs(A).max()
-    assert err < _RAW_GRADIENT_TOL[kernel]
+    # the quadratic kernel's kink at q = 0 (w'(0) != 0) costs more on a 1D
+    # lattice: measured 1/9 there (the smooth kernels: <= 1.4 %)
+    tol = 0.12 if (kernel, dim) == ("quadratic", 1) else _RAW_GRADIENT_TOL[kernel]
+    assert err < tol
 
 
-@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("dim", [1, 2, 3])
 @pytest.mark.parametrize("jitter", [0.0, 0.3])
 def test_linear_velocity_everywhere_with_correction(dim, jitter):
     # Randles-Libersky renormalisation differentiates linear fields exactly

@@ -28,6 +28,15 @@ _NO_SIG = np.zeros((0, 3, 3))
 _NO_RHO = np.zeros(0)
 
 
+@njit(cache=True, error_model="numpy")
+def outside_box(x, i, lo, hi):
+    """Whether row ``i`` of ``x`` (N, 3) lies outside the box ``[lo, hi]`` (3,)."""
+    for d in range(3):
+        if x[i, d] < lo[d] or x[i, d] > hi[d]:
+            return True
+    return False
+
+
 @njit(cache=True, error_model="numpy", parallel=True)
 def _flags(x, v, a, sig, rho, active, lo, hi, out):
     """Flag (N,) items: non-finite x, v, a (and stress, density when ``sig``,
@@ -50,10 +59,8 @@ def _flags(x, v, a, sig, rho, active, lo, hi, out):
             s += sig[i, 0, 2] + sig[i, 1, 2]
         if not np.isfinite(s) or r <= 0.0:
             f = NONFINITE
-        else:
-            for d in range(3):
-                if x[i, d] < lo[d] or x[i, d] > hi[d]:
-                    f = OUTSIDE
+        elif outside_box(x, i, lo, hi):
+            f = OUTSIDE
         out[i] = f
         if f != OK:
             bad += 1

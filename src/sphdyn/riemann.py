@@ -38,52 +38,44 @@ def star_state(left, right, gamma):
     return p, u
 
 
+def _left_wave(s, state, ps, us, gamma):
+    """``(rho, u, p)`` at ``s = x/t <= u*`` of the left wave (shock or
+    rarefaction) from ``state`` = (rho, u, p) into the star state ``(ps, us)``
+    (Toro sec. 4.5.1). The right wave is this one mirrored (x, u -> -x, -u)."""
+    rho0, u0, p0 = state
+    gm, gp = gamma - 1.0, gamma + 1.0
+    c = math.sqrt(gamma * p0 / rho0)
+    if ps > p0:  # shock, speed Toro eq. 4.52
+        if s > u0 - c * math.sqrt(gp / (2 * gamma) * ps / p0 + gm / (2 * gamma)):
+            return rho0 * (ps / p0 + gm / gp) / (gm / gp * ps / p0 + 1.0), us, ps
+        return rho0, u0, p0
+    if s > us - c * (ps / p0) ** (gm / (2 * gamma)):  # behind the rarefaction's tail
+        return rho0 * (ps / p0) ** (1 / gamma), us, ps
+    if s > u0 - c:  # inside the fan (Toro eq. 4.56)
+        cf = 2 / gp * (c + gm / 2 * (u0 - s))
+        return rho0 * (cf / c) ** (2 / gm), 2 / gp * (c + gm / 2 * u0 + s), \
+            p0 * (cf / c) ** (2 * gamma / gm)
+    return rho0, u0, p0
+
+
 def sample(x, t, left, right, gamma, x0=0.0):
     """Density, velocity and pressure (each (n,)) at ``x`` (n,) and time ``t``."""
-    (rl, ul, pl), (rr, ur, pr) = left, right
     ps, us = star_state(left, right, gamma)
-    gm, gp = gamma - 1.0, gamma + 1.0
+    mirrored = (right[0], -right[1], right[2])
     out = np.empty((3, len(x)))
     for k, xi in enumerate(np.asarray(x, float)):
         s = (xi - x0) / t
-        if s <= us:  # left of the contact
-            rho, u, p, c = rl, ul, pl, math.sqrt(gamma * pl / rl)
-            if ps > pl:  # left shock
-                sl = ul - c * math.sqrt(gp / (2 * gamma) * ps / pl + gm / (2 * gamma))
-                if s > sl:
-                    rho = rl * (ps / pl + gm / gp) / (gm / gp * ps / pl + 1.0)
-                    u, p = us, ps
-            else:  # left rarefaction
-                cs = c * (ps / pl) ** (gm / (2 * gamma))
-                if s > us - cs:
-                    rho, u, p = rl * (ps / pl) ** (1 / gamma), us, ps
-                elif s > ul - c:
-                    u = 2 / gp * (c + gm / 2 * ul + s)
-                    cf = 2 / gp * (c + gm / 2 * (ul - s))
-                    rho = rl * (cf / c) ** (2 / gm)
-                    p = pl * (cf / c) ** (2 * gamma / gm)
+        if s <= us:
+            out[:, k] = _left_wave(s, left, ps, us, gamma)
         else:
-            rho, u, p, c = rr, ur, pr, math.sqrt(gamma * pr / rr)
-            if ps > pr:  # right shock
-                sr = ur + c * math.sqrt(gp / (2 * gamma) * ps / pr + gm / (2 * gamma))
-                if s < sr:
-                    rho = rr * (ps / pr + gm / gp) / (gm / gp * ps / pr + 1.0)
-                    u, p = us, ps
-            else:  # right rarefaction
-                cs = c * (ps / pr) ** (gm / (2 * gamma))
-                if s < us + cs:
-                    rho, u, p = rr * (ps / pr) ** (1 / gamma), us, ps
-                elif s < ur + c:
-                    u = 2 / gp * (-c + gm / 2 * ur + s)
-                    cf = 2 / gp * (c - gm / 2 * (ur - s))
-                    rho = rr * (cf / c) ** (2 / gm)
-                    p = pr * (cf / c) ** (2 * gamma / gm)
-        out[:, k] = rho, u, p
+            rho, u, p = _left_wave(-s, mirrored, ps, -us, gamma)
+            out[:, k] = rho, -u, p
     return out
 
 
 def shock_speed(left, right, gamma):
-    """Speed of the right-moving shock [m/s] (the right state is shocked)."""
+    """Speed of the right-moving shock [m/s] (the right state is shocked,
+    Toro eq. 4.59)."""
     (rr, ur, pr) = right
     ps, _ = star_state(left, right, gamma)
     c = math.sqrt(gamma * pr / rr)

@@ -18,6 +18,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..guards import outside_box
+
 
 @njit(cache=True, error_model="numpy")
 def outside_rows(x, active, tl, lo, hi):
@@ -25,20 +27,14 @@ def outside_rows(x, active, tl, lo, hi):
     outside ``[lo, hi]`` (``active`` (N,) int8, ``tl`` (N,) bool)."""
     n = 0
     for i in range(x.shape[0]):
-        if active[i] != 0 and not tl[i]:
-            for d in range(3):
-                if x[i, d] < lo[d] or x[i, d] > hi[d]:
-                    n += 1
-                    break
-    out = np.empty(n, np.int64)
+        if active[i] != 0 and not tl[i] and outside_box(x, i, lo, hi):
+            n += 1
+    out = np.empty(n, np.int64)  # (usually 0,): the count first, no list growing
     k = 0
     for i in range(x.shape[0]):
-        if active[i] != 0 and not tl[i]:
-            for d in range(3):
-                if x[i, d] < lo[d] or x[i, d] > hi[d]:
-                    out[k] = i
-                    k += 1
-                    break
+        if active[i] != 0 and not tl[i] and outside_box(x, i, lo, hi):
+            out[k] = i
+            k += 1
     return out
 
 

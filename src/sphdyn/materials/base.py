@@ -198,6 +198,13 @@ def trace6(s):
 
 
 @njit(cache=True, error_model="numpy")
+def isotropic6(m):
+    """The 6-tuple ``m I`` (an isotropic tensor; a fluid's stress is
+    ``isotropic6(-p)``)."""
+    return (m, m, m, 0.0, 0.0, 0.0)
+
+
+@njit(cache=True, error_model="numpy")
 def ddot6(a, b):
     """Double contraction ``a : b = a_ij b_ij`` of two symmetric 6-tuples."""
     return (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]

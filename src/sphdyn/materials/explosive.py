@@ -54,9 +54,11 @@ from ..deck.messages import problem
 from ..deck.sections.material import Density, MaterialSection
 from ..deck.units import PRESSURE, VELOCITY
 from ..deck.values import PositivePressure, quantity, real
-from .base import P_DENSITY, MaterialModel, get_float, register
+from .base import (P_DENSITY, MaterialModel, get_float, isotropic6, load_sym6, register,
+                   store_sym6, trace6)
+from .registry import schema_defaults
 from .eos.jwl import jwl_parts, jwl_sound_speed
-from .fluid import fluid_energy, pressure_of, store_pressure
+from .fluid import fluid_energy
 
 #: TNT (Dobratz & Crawford 1985; the issue's and LS-DYNA's common set), SI.
 TNT = {"density": 1630.0, "D": 6930.0, "P_CJ": 21.0e9, "A": 371.2e9, "B": 3.231e9,
@@ -114,10 +116,11 @@ def explosive_update(idx, L, dt, rho, sig, e, c, damage, hist, params, size):
         hist[i, H_BURN] = f
         pc, _ = jwl_parts(V, A, B, R1, R2, w)
         tr_d = L[i, 0, 0] + L[i, 1, 1] + L[i, 2, 2]
-        e_new, p = fluid_energy(e[i], (f - f_old) * q, pressure_of(sig, i), f * pc,
-                                w * rho[i], p_min, tr_d, dt, rho[i])
+        p_old = -trace6(load_sym6(sig, i)) / 3.0
+        e_new, p = fluid_energy(e[i], (f - f_old) * q, p_old, f * pc, w * rho[i], p_min,
+                                tr_d, dt, rho[i])
         e[i] = e_new
-        store_pressure(sig, i, p)
+        store_sym6(sig, i, isotropic6(-p))
         c[i] = jwl_sound_speed(rho[i], V, rho0 * (e_new + (1.0 - f) * q), A, B, R1, R2, w)
 
 
@@ -182,11 +185,6 @@ class ExplosiveParams(MaterialSection):
         if missing:
             raise problem(f"the explosive has no {', '.join(missing)}",
                           "give them, or preset = \"tnt\" and override keys one by one")
-        if self.P_CJ >= self.density * self.D ** 2:
-            raise problem(f"P_CJ = {self.P_CJ:.4g} Pa is not below rho0 D^2 = "
-                          f"{self.density * self.D ** 2:.4g} Pa (V_CJ would be <= 0)",
-                          "check P_CJ, D and density (TNT: 21 GPa, 6930 m/s, "
-                          "1630 kg/m^3)")
         return self
 
 
@@ -200,13 +198,17 @@ def pack_explosive(values: dict) -> np.ndarray:
     rho0 = g["density"]
     v_cj = 1.0 - g["P_CJ"] / (rho0 * g["D"] ** 2)
     if v_cj <= 0.0:
-        raise ValueError("P_CJ must be below density * D^2")
+        raise ValueError(f"P_CJ = {g['P_CJ']:.4g} Pa is not below rho0 D^2 = "
+                         f"{rho0 * g['D'] ** 2:.4g} Pa (V_CJ would be <= 0; TNT: 21 GPa, "
+                         "6930 m/s, 1630 kg/m^3)")
     c0 = float(jwl_sound_speed(rho0, 1.0, g["E0"], g["A"], g["B"], g["R1"], g["R2"],
                                g["omega"]))
-    width = get_float(values, "burn_width", default=1.5, min_value=0.0,
+    default = schema_defaults(ExplosiveParams)
+    width = get_float(values, "burn_width", default=default["burn_width"], min_value=0.0,
                       min_inclusive=False)
-    p_min = get_float(values, "pressure_cutoff", default=0.0, max_value=0.0)
-    mode = BURN_MODES[values.get("burn", "both")]
+    p_min = get_float(values, "pressure_cutoff", default=default["pressure_cutoff"],
+                      max_value=0.0)
+    mode = BURN_MODES[values.get("burn", default["burn"])]
     return np.array([rho0, rho0 * c0 * c0, 0.0, g["A"], g["B"], g["R1"], g["R2"],
                      g["omega"], g["E0"], g["D"], g["P_CJ"], v_cj, mode, width, p_min])
 

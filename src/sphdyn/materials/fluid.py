@@ -1,5 +1,6 @@
-r"""What the fluid models share: an isotropic stress and an energy equation
-solved exactly for an equation of state linear in the internal energy.
+r"""What the fluid models share: an energy equation solved exactly for an
+equation of state linear in the internal energy (their stress is isotropic,
+``-p I``: :func:`~sphdyn.materials.base.isotropic6`).
 
 For a fluid :math:`\sigma = -pI`, so the energy equation of the common
 kernel (``dt/2 (sigma_old + sigma_new):D / rho``, as for the solids) reads
@@ -51,17 +52,3 @@ def fluid_energy(e_old, dq, p_old, a, b, p_min, tr_d, dt, rho):
         p_new = p_min
         e_new = e_old + dq - k * (p_old + p_new)
     return e_new, p_new
-
-
-@njit(cache=True, error_model="numpy")
-def store_pressure(sig, i, p):
-    """``sig[i] = -p I`` (no deviatoric stress); ``sig`` (N, 3, 3) [Pa]."""
-    for a in range(3):
-        for b in range(3):
-            sig[i, a, b] = -p if a == b else 0.0
-
-
-@njit(cache=True, error_model="numpy")
-def pressure_of(sig, i):
-    """``p = -tr(sig[i]) / 3`` [Pa] (compression positive)."""
-    return -(sig[i, 0, 0] + sig[i, 1, 1] + sig[i, 2, 2]) / 3.0

@@ -23,9 +23,11 @@ from ..deck.messages import problem
 from ..deck.sections.material import MaterialSection
 from ..deck.units import PRESSURE
 from ..deck.values import quantity, real
-from .base import P_DENSITY, MaterialModel, get_float, register
-from .eos.polynomial import polynomial_parts, polynomial_sound_speed
-from .fluid import fluid_energy, pressure_of, store_pressure
+from .base import (P_DENSITY, MaterialModel, get_float, isotropic6, load_sym6, register,
+                   store_sym6, trace6)
+from .registry import schema_defaults
+from .eos.polynomial import polynomial_parts, polynomial_pressure, polynomial_sound_speed
+from .fluid import fluid_energy
 
 # parameter vector after the common [density, K, G]: C0..C6, cutoff, E0
 P_C0, P_PMIN, P_E0 = 3, 10, 11
@@ -49,10 +51,10 @@ def gas_update(idx, L, dt, rho, sig, e, c, damage, hist, params, size):
         mu = rho[i] / rho0 - 1.0
         a, b, _, _ = polynomial_parts(mu, C0, C1, C2, C3, C4, C5, C6)
         tr_d = L[i, 0, 0] + L[i, 1, 1] + L[i, 2, 2]
-        e_new, p = fluid_energy(e[i], 0.0, pressure_of(sig, i), a, rho0 * b, p_min, tr_d,
-                                dt, rho[i])
+        p_old = -trace6(load_sym6(sig, i)) / 3.0
+        e_new, p = fluid_energy(e[i], 0.0, p_old, a, rho0 * b, p_min, tr_d, dt, rho[i])
         e[i] = e_new
-        store_pressure(sig, i, p)
+        store_sym6(sig, i, isotropic6(-p))
         c[i] = polynomial_sound_speed(rho[i], rho0, rho0 * e_new, C0, C1, C2, C3, C4, C5,
                                       C6)
 
@@ -124,20 +126,23 @@ def pack_gas(values: dict) -> np.ndarray:
     C = _coefficients(values)
     if values.get("pressure") is not None:
         p0 = get_float(values, "pressure", min_value=0.0)
+        if p0 != C[0] and C[4] == 0.0:
+            raise ValueError("the initial pressure cannot be reached with C4 = 0")
         E0 = 0.0 if p0 == C[0] else (p0 - C[0]) / C[4]
     else:
         E0 = get_float(values, "E0", default=0.0, min_value=0.0)
-    p_min = get_float(values, "pressure_cutoff", default=0.0, max_value=0.0)
+    p_min = get_float(values, "pressure_cutoff",
+                      default=schema_defaults(GasParams)["pressure_cutoff"], max_value=0.0)
     c0 = float(polynomial_sound_speed(rho0, rho0, E0, *C))
     return np.array([rho0, max(rho0 * c0 * c0, 1.0), 0.0, *C, p_min, E0])
 
 
 def initial_gas_state(params: np.ndarray) -> tuple[float, float]:
     """``(e0 [J/kg], p0 [Pa])`` at rest at the initial density: ``E0 / rho0`` and
-    ``C0 + C4 E0``, not below the cutoff."""
+    the pressure at ``mu = 0`` (``C0 + C4 E0``), not below the cutoff."""
     E0 = float(params[P_E0])
-    return E0 / params[P_DENSITY], max(params[P_C0] + params[P_C0 + 4] * E0,
-                                       params[P_PMIN])
+    p0 = polynomial_pressure(0.0, E0, *params[P_C0:P_C0 + 7])
+    return E0 / params[P_DENSITY], max(float(p0), float(params[P_PMIN]))
 
 
 GAS = register(MaterialModel(

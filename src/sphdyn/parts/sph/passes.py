@@ -154,11 +154,12 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
             # grad_factor with one division: sigma / h^(d+2) * w'(q)/q
             ih = 1.0 / hij
             ih2 = ih * ih
-            scale = sigma * ih2 * ih2
-            if three:
-                scale *= ih
-            elif dim == 1:
+            if dim == 1:
                 scale = sigma * ih2 * ih
+            else:
+                scale = sigma * ih2 * ih2
+                if three:
+                    scale *= ih
             # stored in single precision, and used as stored from here on
             fk = np.float64(np.float32(scale * dwdq_over_q(kid, np.sqrt(r2) * ih)))
             if k != head:  # swap with the first skin pair of the row
