@@ -25,3 +25,21 @@ def step(s, t_stop=None) -> dict:
 def wall(s, name):
     """The wall interaction called ``name``."""
     return next(i for i in s.interactions if i.name == name)
+
+
+def restarted_pair(deck, advance, steps: int):
+    """Two steppers of ``deck``: one run on, one restored from the first's
+    state after ``advance(stepper)`` and run the same ``steps`` steps; both
+    returned, for a bitwise comparison of a restart."""
+    import copy
+
+    st = build_stepper(deck)
+    advance(st)
+    scalars, groups = copy.deepcopy(st.state())
+    for _ in range(steps):
+        st.step()
+    st2 = build_stepper(deck)
+    st2.restore(scalars, groups)
+    for _ in range(steps):
+        st2.step()
+    return st, st2

@@ -404,20 +404,13 @@ def test_restart_of_a_burning_charge_is_bitwise():
     # checkpoint after 6 steps of the 2D deck (the front and its viscous
     # signal speed, which sets the fluids' step, mid-charge), restore into a
     # fresh model, 6 more steps: every particle array and the books equal
-    import copy
+    from stepping import restarted_pair
 
-    from sphdyn.assembly import build_stepper
-    deck = load_deck_dict(_deck())
-    st = build_stepper(deck)
-    for _ in range(6):
-        st.step()
-    scalars, groups = copy.deepcopy(st.state())
-    for _ in range(6):
-        st.step()
-    st2 = build_stepper(deck)
-    st2.restore(scalars, groups)
-    for _ in range(6):
-        st2.step()
+    def advance(st):
+        for _ in range(6):
+            st.step()
+
+    st, st2 = restarted_pair(load_deck_dict(_deck()), advance, 6)
     for name, arr in st.parts[0].p.arrays().items():
         assert np.array_equal(arr, getattr(st2.parts[0].p, name)), name
     assert st.record() == st2.record()

@@ -7,7 +7,8 @@ Called by :func:`sphdyn.assembly.build_stepper` with the meshes of
 ``F_<mesh>_coupling`` (penalty) or ``F_<mesh>_coupling_x|y|z`` (tied, hybrid),
 the sublayer of a bar ``F_<mesh>_sublayer_x|y|z`` (the bond force), the
 debris coupling of an eroding mesh ``F_<mesh>_debris``, its erosion
-``eroded_<mesh>`` and the rest of :meth:`sphdyn.events.ElementErosion.columns`.
+``eroded_<mesh>`` and the rest of :meth:`sphdyn.events.ElementErosion.columns`,
+a blast load ``W_<blast>``, ``<blast>_force_x|y|z`` and ``<blast>_impulse_x|y|z``.
 """
 
 from __future__ import annotations
@@ -21,7 +22,9 @@ from .deck.errors import format_problem
 from .events import ElementErosion, ErosionRules
 from .interactions import HybridCoupling, PenaltyCoupling, TiedCoupling, Wall
 from .interactions.nodal import MassDamping, NodalLoad, PrescribedMotion
+from .interactions.blast import BlastLoad
 from .interactions.embedded import EmbeddedNodes
+from .interactions.penalty_geometry import exterior_faces, faces_on_nodes
 from .interactions.sublayer import SublayerCoupling
 from .materials import get_model
 from .mesh_model import MeshModel
@@ -120,6 +123,7 @@ def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
         part, idx = _target(model, sph_part, meshes, load.set)
         out.append(NodalLoad(_unique(load.set, taken), part, idx, load.force,
                              ramp_time=load.ramp_time, shape=load.ramp))
+    out += blast_loads(deck, model, sph_part, meshes, taken)
     for b, body in enumerate(deck.body):
         if body.damping > 0.0:
             out.append(MassDamping(body.name, sph_part,
@@ -178,6 +182,35 @@ def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
         except ValueError as exc:
             raise DeckError([format_problem(where, str(exc).split(": ", 1)[-1],
                                             "move the bar into the solid mesh")]) from None
+    return out
+
+
+def blast_loads(deck, model, sph_part, meshes: dict, taken: set) -> list:
+    """The [[blast]] loads: the exposed faces of each set (particle faces, or
+    the exterior faces of a solid mesh on the set's nodes)."""
+    out = []
+    for k, bl in enumerate(deck.blast):
+        where = f"blast[{k}]"
+        part, idx = _target(model, sph_part, meshes, bl.set)
+        faces = None
+        if bl.set in model.mesh_sets:
+            mm = next(m for m in model.meshes if m.name == model.mesh_sets[bl.set][0])
+            if mm.element != "solid":
+                raise DeckError([format_problem(
+                    f"{where}.set", f"set '{bl.set}' holds nodes of the {mm.element} line "
+                    f"'{mm.name}', which has no faces", "name a set of particles or of "
+                    "a solid mesh's nodes")])
+            faces = faces_on_nodes(exterior_faces(part.el.conn), idx)
+        try:
+            out.append(BlastLoad(bl.name or _unique("blast", taken), part, bl.charge,
+                                 bl.point, burst=bl.burst, time=bl.time, idx=idx,
+                                 faces=faces, turned_away=bl.turned_away))
+        except ValueError as exc:
+            fix = ("name a set on the surface of a body or mesh" if "no exposed" in str(exc)
+                   else "move the charge or choose other faces; closer in, model the "
+                        "charge itself (a high_explosive body, docs/examples.md)")
+            raise DeckError([format_problem(where, str(exc).split(": ", 1)[-1], fix)]) \
+                from None
     return out
 
 

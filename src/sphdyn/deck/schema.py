@@ -26,6 +26,7 @@ from .introspect import field_annotation, metadata, strip_optional, variants
 from .scope import SCOPE, scope_of
 from .sections.bodies import Body, Crack, MassField, Mesostructure, Variation
 from .messages import problem
+from .sections.blast import Blast
 from .sections.detonation import Detonation
 from .sections.gauges import Gauge
 from .sections.material import MaterialSection, parameter_clashes
@@ -39,7 +40,7 @@ from .sections.walls import Wall
 from .values import ExistingFile, NonEmpty, Section
 
 __all__ = [
-    "BeamSection", "BlockMesh", "Body", "Boundary", "Convert", "Detonation", "LineMesh", "Load", "Mesh",
+    "BeamSection", "Blast", "BlockMesh", "Body", "Boundary", "Convert", "Detonation", "LineMesh", "Load", "Mesh",
     "MeshGroup", "Contact", "Crack", "Deck", "DeckSections", "Domain",
     "ExistingFile", "Gauge", "Geometry", "MassField", "MaterialSection", "Mesostructure",
     "Output", "ParticleSet", "Probe", "Region", "Run", "Section", "Sph", "Time",
@@ -90,6 +91,8 @@ class DeckSections(Section):
                                      "section-force gauges at material points.")
     detonation: tuple[Detonation, ...] = Field(
         (), description="Detonation points of high explosives.")
+    blast: tuple[Blast, ...] = Field(
+        (), description="Empirical air-blast loads (Kingery-Bulmash) on sets.")
     output: Output = Field(default_factory=Output, description="Output.")
 
     @model_validator(mode="wrap")

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 from typing import Any, Optional
 
 #: Sections whose tables have a ``name`` that others refer to.
-NAMED_SECTIONS = ("material", "body", "mesh", "set", "wall")
+NAMED_SECTIONS = ("material", "body", "mesh", "set", "wall", "blast")
 
 
 @dataclass(frozen=True)

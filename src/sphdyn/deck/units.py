@@ -71,6 +71,7 @@ DENSITY = Dimension("mass density", "kg/m^3", "2400 kg/m^3", 2400.0,
 VELOCITY = Dimension("velocity", "m/s", "15 m/s", 15.0, "metres per second")
 FORCE = Dimension("force", "N", "10 kN", 1e4, "newtons")
 RATE = Dimension("rate", "1/s", "100 1/s", 100.0, "per second")
+MASS = Dimension("mass", "kg", "75 g", 0.075, "kilograms")
 ACCELERATION = Dimension("acceleration", "m/s^2", "9.81 m/s^2", 9.81,
                          "metres per second squared")
 
