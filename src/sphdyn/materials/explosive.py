@@ -19,9 +19,17 @@ chooses :math:`F_1` (programmed), :math:`F_2` (beta) or the larger (both,
 the default; LS-DYNA's BETA = 2, 1, 0). The unburned explosive has no
 stiffness (``p = 0`` at ``F = 0``). With the programmed burn alone a front
 run over many particles overdrives (1D TNT at 1600 particles per 0.1 m:
-50 GPa after 8 us, 400 particles stay near P_CJ); the cause is not known
-yet (a stiffness of the unburned explosive did not cure it). With the beta
-part the front stays at the Chapman-Jouguet state (22.4 GPa at 12 us).
+49 GPa after 8 us, 400 particles stay near P_CJ): the kernel reaches ahead
+of the front, the burned particles compress the unlit ones before their
+lighting time, and those burn at a smaller relative volume, so at a higher
+pressure, which compresses the next ones more; the front's speed is fixed,
+so nothing relaxes it (measured: the relative volume at the lighting time
+falls from 0.89 at 25 mm to 0.84 at 50 mm and 0.62 at 55 mm, the peak
+pressure from 21 to 28 and 49 GPa; a stiffness of the unburned explosive
+slows this but does not stop it). With the beta part a compressed particle
+burns as soon as it is compressed, and the front stays at the
+Chapman-Jouguet state (relative volume at lighting 0.84-0.87, 21.7 GPa at
+8 us, 22.4 GPa at 12 us).
 
 Energy. The particle starts with no internal energy; as it burns, the
 chemical energy :math:`q = E_0/\rho_0` per unit mass is released into it,
@@ -160,7 +168,8 @@ class ExplosiveParams(MaterialSection):
         "both", description="Burn fraction from the lighting time (programmed), "
         "from the compression (beta: (1 - V)/(1 - V_CJ)) or the larger of the two "
         "(both, LS-DYNA's default); LS-DYNA's BETA = 2, 1, 0. With programmed "
-        "alone a front run over many particles overdrives (docs/theory.md).")
+        "alone a front run over many particles overdrives: the kernel compresses the "
+        "unlit explosive ahead of it (docs/theory.md).")
     burn_width: real("burn width", lo=0, lo_open=True) = Field(
         1.5, description="Width of the programmed burn front in particle spacings "
                          "(1.5 is LS-DYNA's 2 A_max / (3 v) for a cube).")
