@@ -346,3 +346,86 @@ def test_blast_load_rejects_an_empty_face_set():
 
     with pytest.raises(ValueError, match="no exposed face"):
         BlastLoad("b", Part, 1.0, (0, 0, 1), idx=np.arange(2))
+
+
+PLATES_2D = """
+[run]
+dimension = 2
+t_end = "2.5 ms"
+{steel}[[body]]
+name = "plate"
+material = "steel"
+dx = "10 mm"
+geometry = {{ shape = "box", lo = [-0.1, 0], hi = [0.1, 0.02] }}
+[[mesh]]
+name = "block"
+material = "steel"
+block = {{ lo = [0.9, 0], hi = [1.1, 0.02], divisions = [20, 2] }}
+[[set]]
+name = "plate"
+body = "plate"
+[[set]]
+name = "block"
+mesh = "block"
+[[blast]]
+name = "on_particles"
+set = "plate"
+charge = "1 kg"
+point = [0, 1.0]
+turned_away = "unloaded"
+[[blast]]
+name = "on_mesh"
+set = "block"
+charge = "1 kg"
+point = [1.0, 1.0]
+turned_away = "unloaded"
+[output]
+progress = false
+vtk = false
+"""
+
+
+def test_blast_in_2d_loads_edges_per_unit_thickness():
+    # plane strain: particle faces of length dx, quad4 edges; the same plate
+    # as particles and as elements takes the same impulse per unit thickness
+    # (the sum of its faces' fitted impulses, 1 %)
+    st = build_stepper(loads_deck(PLATES_2D.format(steel=STEEL)))
+    on_p, on_m = (next(i for i in st.interactions if i.name == n)
+                  for n in ("on_particles", "on_mesh"))
+    assert on_p.n_faces == on_m.n_faces == 2 * 20 + 2 * 2
+    assert np.allclose(on_p.area, 0.01, rtol=1e-12)
+    sph, mesh = st.parts
+    geo = [face_geometry(mesh.kin.x, f) for f in on_m.faces]
+    assert sum(g[2] for g in geo) == pytest.approx(2 * 0.2 + 2 * 0.02, rel=1e-12)
+    want_m = _face_impulse(on_m, [g[0] for g in geo], [g[1] for g in geo],
+                           [g[2] for g in geo])
+    want_p = _face_impulse(on_p, sph.kin.x[on_p.item] + on_p.half[:, None] * on_p.normal,
+                           on_p.normal, on_p.area)
+    assert want_p[1] == pytest.approx(want_m[1], rel=1e-3)  # same faces, same places
+    while st.t < 2.5e-3:
+        st.step()
+    rec = st.record()
+    assert rec["on_particles_impulse_y"] == pytest.approx(want_p[1], rel=0.01)
+    assert rec["on_mesh_impulse_y"] == pytest.approx(want_m[1], rel=0.01)
+
+
+def test_faces_of_eroded_elements_and_removed_particles_are_not_loaded():
+    st = build_stepper(loads_deck(PLATES.format(steel=STEEL)))
+    on_p, on_m = (next(i for i in st.interactions if i.name == n)
+                  for n in ("on_particles", "on_mesh"))
+    sph, mesh = st.parts
+    while st.t < 6e-4:  # the pulse is on
+        st.step()
+    conn = mesh.el.conn
+    assert all(set(f) <= set(conn[e]) for f, e in zip(on_m.faces, on_m.elements))
+    top = np.flatnonzero(on_m.force[:, 2] < 0.0)
+    assert top.size == 400
+    gone = on_m.elements[top[:3]]
+    mesh.el.active[gone] = 0  # eroded
+    sph.kin.active[on_p.item[0]] = 0  # left the domain
+    a = np.zeros_like(mesh.kin.a)
+    on_m.forces(st.t, st.dt_step, a)
+    assert np.all(on_m.force[top[:3]] == 0.0) and np.all(on_m.force[top[3:], 2] < 0.0)
+    on_p.forces(st.t, st.dt_step, np.zeros_like(sph.kin.a))
+    shared = on_p.item == on_p.item[0]
+    assert np.all(on_p.force[shared] == 0.0) and np.any(on_p.force[~shared] != 0.0)

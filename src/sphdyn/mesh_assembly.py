@@ -24,7 +24,7 @@ from .interactions import HybridCoupling, PenaltyCoupling, TiedCoupling, Wall
 from .interactions.nodal import MassDamping, NodalLoad, PrescribedMotion
 from .interactions.blast import BlastLoad
 from .interactions.embedded import EmbeddedNodes
-from .interactions.penalty_geometry import exterior_faces, faces_on_nodes
+from .interactions.penalty_geometry import exterior_faces, on_nodes
 from .interactions.sublayer import SublayerCoupling
 from .materials import get_model
 from .mesh_model import MeshModel
@@ -192,7 +192,7 @@ def blast_loads(deck, model, sph_part, meshes: dict, taken: set) -> list:
     for k, bl in enumerate(deck.blast):
         where = f"blast[{k}]"
         part, idx = _target(model, sph_part, meshes, bl.set)
-        faces = None
+        faces = elements = None
         if bl.set in model.mesh_sets:
             mm = next(m for m in model.meshes if m.name == model.mesh_sets[bl.set][0])
             if mm.element != "solid":
@@ -200,11 +200,14 @@ def blast_loads(deck, model, sph_part, meshes: dict, taken: set) -> list:
                     f"{where}.set", f"set '{bl.set}' holds nodes of the {mm.element} line "
                     f"'{mm.name}', which has no faces", "name a set of particles or of "
                     "a solid mesh's nodes")])
-            faces = faces_on_nodes(exterior_faces(part.el.conn), idx)
+            faces, elements = exterior_faces(part.el.conn, with_elements=True)
+            keep = on_nodes(faces, idx)
+            faces, elements = faces[keep], elements[keep]
         try:
-            out.append(BlastLoad(bl.name or _unique("blast", taken), part, bl.charge,
+            out.append(BlastLoad(_unique(bl.name or "blast", taken), part, bl.charge,
                                  bl.point, burst=bl.burst, time=bl.time, idx=idx,
-                                 faces=faces, turned_away=bl.turned_away))
+                                 faces=faces, elements=elements,
+                                 turned_away=bl.turned_away))
         except ValueError as exc:
             fix = ("name a set on the surface of a body or mesh" if "no exposed" in str(exc)
                    else "move the charge or choose other faces; closer in, model the "

@@ -51,16 +51,20 @@ from .base import InteractionBase
 
 
 @njit(cache=True, error_model="numpy")
-def particle_blast(x, m, item, normal, half, area, xc, w13, burst, tau, unload_away,
-                   par, force, a_out):
+def particle_blast(x, m, active, item, normal, half, area, xc, w13, burst, tau,
+                   unload_away, par, force, a_out):
     r"""Blast forces on particle faces: face ``f`` of particle ``item[f]``
     has the fixed outward normal ``normal[f]`` (3,), its centre at
     ``x[item] + half[f] * normal[f]``, area ``area[f]`` [m^2]; ``xc`` (3,) the
     charge [m], ``w13`` :math:`W^{1/3}`, ``tau`` = t - t_d [s]. Writes
-    ``force`` (F, 3) [N], adds ``force / m`` to ``a_out`` (N, 3)
-    (serial: several faces may share a particle); ``par`` (8,) scratch."""
+    ``force`` (F, 3) [N] (0 on particles no longer ``active``), adds
+    ``force / m`` to ``a_out`` (N, 3) (serial: several faces may share a
+    particle); ``par`` (8,) scratch."""
     for f in range(item.shape[0]):
         i = item[f]
+        if active[i] == 0:
+            force[f, 0] = force[f, 1] = force[f, 2] = 0.0
+            continue
         c0 = x[i, 0] + half[f] * normal[f, 0]
         c1 = x[i, 1] + half[f] * normal[f, 1]
         c2 = x[i, 2] + half[f] * normal[f, 2]
@@ -111,12 +115,17 @@ def face_geometry(x, face):
 
 
 @njit(cache=True, error_model="numpy")
-def mesh_blast(x, m, faces, xc, w13, burst, tau, unload_away, par, force, a_out):
+def mesh_blast(x, m, faces, elements, active, xc, w13, burst, tau, unload_away, par,
+               force, a_out):
     """Blast forces on mesh faces ``faces`` (F, nf) [N], each shared equally
-    by its nodes: writes ``force`` (F, 3), adds ``force / (nf m)`` to the
-    nodes' ``a_out`` (serial: faces share nodes)."""
+    by its nodes: writes ``force`` (F, 3) (0 on faces whose element
+    ``elements[f]`` is no longer ``active``: eroded), adds ``force / (nf m)``
+    to the nodes' ``a_out`` (serial: faces share nodes)."""
     nf = faces.shape[1]
     for f in range(faces.shape[0]):
+        if active[elements[f]] == 0:
+            force[f, 0] = force[f, 1] = force[f, 2] = 0.0
+            continue
         c, n, area = face_geometry(x, faces[f])
         p = _pressure(c[0], c[1], c[2], n[0], n[1], n[2], xc, w13, burst, tau,
                       unload_away, par)
@@ -187,7 +196,8 @@ class BlastLoad(InteractionBase):
     charge : TNT-equivalent mass W [kg]; ``point`` (3,) its centre [m];
         ``time`` t_d [s]; ``burst``: ``"free_air"`` or ``"surface"``.
     faces : (F, nf) mesh faces (node ids), or None for particle faces of
-        the set ``idx``.
+        the set ``idx``; ``elements`` (F,) their elements (a face of an
+        eroded element is not loaded).
     turned_away : ``"incident"`` or ``"unloaded"`` (module docstring).
 
     Raises ``ValueError`` if the set has no exposed face, or a face lies
@@ -195,7 +205,8 @@ class BlastLoad(InteractionBase):
     """
 
     def __init__(self, name: str, part, charge: float, point, *, burst: str = "free_air",
-                 time: float = 0.0, idx=None, faces=None, turned_away: str = "incident"):
+                 time: float = 0.0, idx=None, faces=None, elements=None,
+                 turned_away: str = "incident"):
         self.name, self.part = name, part
         self.w13 = float(charge) ** (1.0 / 3.0)
         self.xc = np.asarray(point, dtype=float)
@@ -211,6 +222,7 @@ class BlastLoad(InteractionBase):
             centres = q.x[self.item] + self.half[:, None] * self.normal
         else:
             self.items = self.faces
+            self.elements = np.ascontiguousarray(elements, dtype=np.int64)
             centres = q.x[self.faces].mean(axis=1)
         if not self.items.shape[0]:
             raise ValueError(f"{name}: the set has no exposed face")
@@ -234,12 +246,13 @@ class BlastLoad(InteractionBase):
         q = self.part.kin
         tau = t - self.t_det
         if self.faces is None:
-            particle_blast(q.x, q.m, self.item, self.normal, self.half, self.area, self.xc,
-                           self.w13, self.burst, tau, self.unload_away, self._par,
+            particle_blast(q.x, q.m, q.active, self.item, self.normal, self.half, self.area,
+                           self.xc, self.w13, self.burst, tau, self.unload_away, self._par,
                            self.force, a_out)
         else:
-            mesh_blast(q.x, q.m, self.faces, self.xc, self.w13, self.burst, tau,
-                       self.unload_away, self._par, self.force, a_out)
+            mesh_blast(q.x, q.m, self.faces, self.elements, self.part.el.active, self.xc,
+                       self.w13, self.burst, tau, self.unload_away, self._par, self.force,
+                       a_out)
 
     def after_kick(self, dt_kick: float) -> None:
         self._kick = blast_work(self.force, self.items, self.part.kin.v_mid, dt_kick)

@@ -37,18 +37,20 @@ QUAD4_EDGES = np.array([[0, 1], [1, 2], [2, 3], [3, 0]], dtype=np.int64)
 NEWTON_ITERATIONS = 8
 
 
-def exterior_faces(cells: np.ndarray) -> np.ndarray:
+def exterior_faces(cells: np.ndarray, with_elements: bool = False):
     """Boundary faces of a mesh, oriented outward.
 
     Parameters
     ----------
     cells : (E, 8) hex8 or (E, 4) quad4 connectivity (VTK order).
+    with_elements : also return the element of each face.
 
     Returns
     -------
     faces : (F, 4) quadrilaterals (hex8) or (F, 2) segments (quad4), int64
         node indices in the order of the module docstring: the faces that
         belong to exactly one element, in element order then local-face order.
+    elements : (F,) the element each face belongs to (``with_elements``).
     """
     cells = np.asarray(cells, dtype=np.int64)
     local = {8: HEX8_FACES, 4: QUAD4_EDGES}.get(cells.shape[1])
@@ -58,15 +60,24 @@ def exterior_faces(cells: np.ndarray) -> np.ndarray:
     faces = cells[:, local].reshape(-1, local.shape[1])  # (E * n_local, nf)
     key = np.sort(faces, axis=1)
     _, inverse, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
-    return np.ascontiguousarray(faces[counts[inverse.reshape(-1)] == 1])
+    once = counts[inverse.reshape(-1)] == 1
+    out = np.ascontiguousarray(faces[once])
+    if with_elements:
+        return out, np.flatnonzero(once) // local.shape[0]
+    return out
+
+
+def on_nodes(faces: np.ndarray, nodes) -> np.ndarray:
+    """Mask (F,) of the faces (F, nf) whose nodes all belong to the node set ``nodes``."""
+    inside = np.zeros(int(faces.max()) + 1 if faces.size else 0, dtype=bool)
+    nodes = np.asarray(nodes, dtype=np.int64)
+    inside[nodes[nodes < inside.size]] = True
+    return np.all(inside[faces], axis=1)
 
 
 def faces_on_nodes(faces: np.ndarray, nodes) -> np.ndarray:
     """The faces (F, nf) whose nodes all belong to the node set ``nodes``."""
-    inside = np.zeros(int(faces.max()) + 1 if faces.size else 0, dtype=bool)
-    nodes = np.asarray(nodes, dtype=np.int64)
-    inside[nodes[nodes < inside.size]] = True
-    return faces[np.all(inside[faces], axis=1)]
+    return faces[on_nodes(faces, nodes)]
 
 
 # --------------------------------------------------------------------------

@@ -17,12 +17,13 @@ class Blast(Section):
     products are modelled. Faces: the exterior faces of a solid [[mesh]]
     whose nodes are all in the set, or the exposed lattice faces of the
     set's particles. The fits hold from Z = 0.0531 (free air) or 0.0674
-    (surface) to 40 m/kg^(1/3): a face outside is refused.
+    (surface) to 40 m/kg^(1/3): a face outside is refused. In 2D the faces
+    are edges and the forces per unit thickness (N/m).
     """
 
     name: Optional[name_of("blast")] = Field(
         None, description="Name of the load's history columns (absent: blast, "
-                          "blast_1, ...).")
+                          "blast_2, ...).")
     set: reference_to("set") = Field(description="The [[set]] of particles or mesh "
                                                  "nodes whose exposed faces are loaded.")
     charge: quantity(MASS, "charge mass", lo=0, lo_open=True) = Field(
