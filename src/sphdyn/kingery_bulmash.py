@@ -202,13 +202,14 @@ def decay_coefficient(ratio):
 
 
 @njit(cache=True, error_model="numpy")
-def parameters(z, w13, burst, bound, ab, coef, out):
+def parameters(z, w13, burst, bound, ab, coef, out, decays=True):
     r"""The blast parameters of a TNT charge at scaled distance ``z``
     [m/kg^(1/3)] (clamped to :data:`Z_RANGE`), ``w13`` = :math:`W^{1/3}`
     [kg^(1/3)]; written to ``out`` (8,): :math:`P_{so}`, :math:`P_r` [Pa],
     :math:`t_a`, :math:`t_0` [s] (t_0 lengthened to :math:`2\max(i_s/P_{so},
-    i_r/P_r)` where shorter), :math:`i_s`, :math:`i_r` [Pa s] and the decay
-    coefficients :math:`A_s`, :math:`A_r` of the two pulses."""
+    i_r/P_r)` where shorter), :math:`i_s`, :math:`i_r` [Pa s] and (if
+    ``decays``) the decay coefficients :math:`A_s`, :math:`A_r` of the two
+    pulses (:func:`face_pressure` finds them itself, only during the pulse)."""
     z = min(max(z, Z_RANGE[burst][0]), Z_RANGE[burst][1])
     zlog = math.log10(z * Z_TO_IMPERIAL)
     ms = MS_LB * w13
@@ -225,8 +226,9 @@ def parameters(z, w13, burst, bound, ab, coef, out):
     out[3] = t0
     out[4] = i_s
     out[5] = i_r
-    out[6] = decay_coefficient(pso * t0 / i_s)
-    out[7] = decay_coefficient(pr * t0 / i_r)
+    if decays:
+        out[6] = decay_coefficient(pso * t0 / i_s)
+        out[7] = decay_coefficient(pr * t0 / i_r)
 
 
 @njit(cache=True, error_model="numpy")
@@ -242,13 +244,16 @@ def friedlander(peak, t0, decay, tau):
 @njit(cache=True, error_model="numpy")
 def face_pressure(par, cos_theta, tau):
     r"""Pressure on a face [Pa] at ``tau`` [s] after the detonation from the
-    parameters ``par`` (8,) of :func:`parameters` and the cosine of the angle
-    of incidence (module docstring, ARL-TR-1310 eq. 7)."""
+    parameters ``par`` (the first 6 of :func:`parameters`) and the cosine of
+    the angle of incidence (module docstring, ARL-TR-1310 eq. 7). The decay
+    coefficients are found here, only while the pulse lasts."""
     s = tau - par[2]
-    ps = friedlander(par[0], par[3], par[6], s)
+    if s < 0.0 or s > par[3]:
+        return 0.0
+    ps = friedlander(par[0], par[3], decay_coefficient(par[0] * par[3] / par[4]), s)
     if cos_theta < 0.0:
         return ps
-    pr = friedlander(par[1], par[3], par[7], s)
+    pr = friedlander(par[1], par[3], decay_coefficient(par[1] * par[3] / par[5]), s)
     c2 = cos_theta * cos_theta
     return pr * c2 + ps * (1.0 + c2 - 2.0 * cos_theta)
 

@@ -83,7 +83,7 @@ def _pressure(c0, c1, c2, n0, n1, n2, xc, w13, burst, tau, unload_away, par):
     cos_t = (n0 * r0 + n1 * r1 + n2 * r2) / r
     if unload_away and cos_t < 0.0:
         return 0.0
-    kb.parameters(r / w13, w13, burst, kb.BOUND, kb.AB, kb.COEF, par)
+    kb.parameters(r / w13, w13, burst, kb.BOUND, kb.AB, kb.COEF, par, False)
     return kb.face_pressure(par, cos_t, tau)
 
 
