@@ -429,3 +429,22 @@ def test_faces_of_eroded_elements_and_removed_particles_are_not_loaded():
     on_p.forces(st.t, st.dt_step, np.zeros_like(sph.kin.a))
     shared = on_p.item == on_p.item[0]
     assert np.all(on_p.force[shared] == 0.0) and np.any(on_p.force[~shared] != 0.0)
+
+
+def test_airblast_command_prints_the_parameters(capsys):
+    from sphdyn.cli import main
+    assert main(["airblast", "--charge", "8 kg", "--distance", "2 m", "10",
+                 "--burst", "surface"]) == 0
+    rows = [line.split("|")[1:-1] for line in capsys.readouterr().out.splitlines()
+            if line.startswith("| ") and not line.startswith("| R")]
+    for row, r in zip(rows, (2.0, 10.0)):
+        p = blast_parameters(r / 2.0, 8.0, "surface")  # Z = R / 8^(1/3)
+        got = [float(c) for c in row]
+        assert got[1] == pytest.approx(r / 2.0, rel=1e-3)
+        assert got[2] == pytest.approx(1e-3 * p["Pso"], rel=1e-3)
+        assert got[3] == pytest.approx(1e-3 * p["Pr"], rel=1e-3)
+        assert got[4] == pytest.approx(1e3 * p["ta"], rel=1e-3)
+        assert got[6] == pytest.approx(p["is"], rel=1e-3)  # Pa s = kPa ms
+    assert main(["airblast", "--charge", "75 g", "--distance", "1 mm"]) == 2
+    assert "outside the fits' range" in capsys.readouterr().err
+    assert main(["airblast", "--charge", "75 m", "--distance", "1 m"]) == 2

@@ -409,6 +409,44 @@ def cmd_material_test(args) -> int:
     return 0
 
 
+def cmd_airblast(args) -> int:
+    from .deck.units import LENGTH, MASS, QuantityError, to_si
+    from .io.plots import markdown_table
+    from .kingery_bulmash import Z_RANGE, BURSTS, blast_parameters
+
+    def si(text, dim):  # a plain number is SI, as in decks
+        try:
+            return float(text)
+        except ValueError:
+            return to_si(text, dim)
+
+    try:
+        w = si(args.charge, MASS)
+        ranges = [si(r, LENGTH) for r in args.distance]
+    except QuantityError as exc:
+        raise ValueError(str(exc)) from None
+    if w <= 0.0 or min(ranges) <= 0.0:
+        raise ValueError("the charge and the distances must be > 0. Fix: e.g. "
+                         "--charge '75 g' --distance '1 m' '2 m'")
+    lo, hi = Z_RANGE[BURSTS[args.burst]]
+    rows = []
+    for r in ranges:
+        z = r / w ** (1.0 / 3.0)
+        if not lo <= z <= hi:
+            raise ValueError(f"--distance {r:g} m: scaled distance {z:.4g} m/kg^(1/3) is "
+                             f"outside the fits' range {lo}-{hi}. Fix: a distance between "
+                             f"{lo * w ** (1 / 3):.4g} and {hi * w ** (1 / 3):.4g} m")
+        p = blast_parameters(z, w, args.burst)
+        rows.append({"R [m]": f"{r:g}", "Z [m/kg^(1/3)]": f"{z:.4g}",
+                     "Pso [kPa]": f"{1e-3 * p['Pso']:.4g}", "Pr [kPa]": f"{1e-3 * p['Pr']:.4g}",
+                     "ta [ms]": f"{1e3 * p['ta']:.4g}", "t0 [ms]": f"{1e3 * p['t0']:.4g}",
+                     "is [kPa ms]": f"{p['is']:.4g}", "ir [kPa ms]": f"{p['ir']:.4g}"})
+    print(f"Kingery-Bulmash, {args.burst.replace('_', ' ')} burst, {w:g} kg TNT "
+          "(docs/theory.md \"Empirical blast loads\")")
+    print(markdown_table(rows))
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     from . import __version__
 
@@ -549,6 +587,14 @@ def build_parser() -> argparse.ArgumentParser:
     mt.add_argument("--threads", type=_whole(1), default=None,
                     help="Numba threads (default 1: one material point)")
     mt.set_defaults(func=cmd_material_test)
+    ab = sub.add_parser("airblast", help="Kingery-Bulmash blast parameters of a TNT "
+                        "charge at given distances (as ConWep)")
+    ab.add_argument("--charge", required=True, help="TNT mass, e.g. '75 g' or 0.075")
+    ab.add_argument("--distance", required=True, nargs="+",
+                    help="distances from the charge's centre, e.g. '1 m' '2 m'")
+    ab.add_argument("--burst", default="free_air", choices=("free_air", "surface"),
+                    help="free_air (spherical, default) or surface (hemispherical)")
+    ab.set_defaults(func=cmd_airblast)
     return ap
 
 
