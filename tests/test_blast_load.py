@@ -31,8 +31,8 @@ import pytest
 from sphdyn.assembly import build_stepper
 from sphdyn.deck import DeckError, loads_deck
 from sphdyn.interactions.blast import BlastLoad, face_geometry
-from sphdyn.kingery_bulmash import (blast_parameters, decay_coefficient, face_pressure,
-                                    friedlander)
+from sphdyn.kingery_bulmash import (SURFACE, blast_parameters, decay_coefficient,
+                                    face_pressure, friedlander)
 
 from decks import STEEL
 from stepping import restarted_pair
@@ -233,7 +233,8 @@ def _face_impulse(load, centres, normals, areas):
         r = load.xc - c
         R = np.linalg.norm(r)
         cos = n @ r / R
-        p = blast_parameters(R / load.w13, load.w13 ** 3, "free_air")
+        burst = "surface" if load.burst == SURFACE else "free_air"
+        p = blast_parameters(R / load.w13, load.w13 ** 3, burst)
         if cos >= 0:
             i = p["ir"] * cos ** 2 + p["is"] * (1 + cos ** 2 - 2 * cos)
         else:
@@ -378,7 +379,7 @@ name = "on_mesh"
 set = "block"
 charge = "1 kg"
 point = [1.0, 1.0]
-turned_away = "unloaded"
+burst = "surface"
 [output]
 progress = false
 vtk = false
@@ -386,9 +387,10 @@ vtk = false
 
 
 def test_blast_in_2d_loads_edges_per_unit_thickness():
-    # plane strain: particle faces of length dx, quad4 edges; the same plate
-    # as particles and as elements takes the same impulse per unit thickness
-    # (the sum of its faces' fitted impulses, 1 %)
+    # plane strain: particle faces of length dx, quad4 edges; each plate
+    # takes the sum of its faces' fitted impulses per unit thickness (1 %):
+    # the particles a free-air burst on the faces turned to it, the elements
+    # a surface burst, with the incident pressure on the bottom
     st = build_stepper(loads_deck(PLATES_2D.format(steel=STEEL)))
     on_p, on_m = (next(i for i in st.interactions if i.name == n)
                   for n in ("on_particles", "on_mesh"))
@@ -401,7 +403,6 @@ def test_blast_in_2d_loads_edges_per_unit_thickness():
                            [g[2] for g in geo])
     want_p = _face_impulse(on_p, sph.kin.x[on_p.item] + on_p.half[:, None] * on_p.normal,
                            on_p.normal, on_p.area)
-    assert want_p[1] == pytest.approx(want_m[1], rel=1e-3)  # same faces, same places
     while st.t < 2.5e-3:
         st.step()
     rec = st.record()
