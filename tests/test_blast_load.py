@@ -449,3 +449,20 @@ def test_airblast_command_prints_the_parameters(capsys):
     assert main(["airblast", "--charge", "75 g", "--distance", "1 mm"]) == 2
     assert "outside the fits' range" in capsys.readouterr().err
     assert main(["airblast", "--charge", "75 m", "--distance", "1 m"]) == 2
+
+
+def test_particle_faces_on_a_lattice_and_at_a_crack():
+    from sphdyn.interactions.blast import particle_faces
+    # a 4 x 3 patch (2D, dx 1): 2 (4 + 3) = 14 exposed edges; a zero-mass
+    # crack particle inside closes its neighbours' faces and takes none itself
+    g = np.stack(np.meshgrid(np.arange(4.0), np.arange(3.0), indexing="ij"), -1).reshape(-1, 2)
+    x = np.zeros((12, 3))
+    x[:, :2] = g
+    vol, m = np.ones(12), np.ones(12)
+    item, normal, half, area = particle_faces(x, vol, m, np.arange(12), 2)
+    assert item.size == 14 and np.all(half == 0.5) and np.all(area == 1.0)
+    assert np.all(np.abs(normal).sum(axis=1) == 1.0)
+    m[5] = 0.0  # (1, 2): on the top row, a crack particle
+    item2, normal2, _, _ = particle_faces(x, vol, m, np.arange(12), 2)
+    assert 5 not in item2 and item2.size == 13  # its own top face is gone
+    assert not np.any((item2 == 4) & (normal2[:, 1] > 0.5) & (normal2[:, 0] == 0))

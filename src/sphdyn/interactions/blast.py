@@ -21,10 +21,11 @@ Faces
   equally by the face's nodes.
 * Particles (SPH bodies on a lattice): a particle of spacing
   :math:`\Delta x = V_0^{1/d}` has an exposed face in the direction
-  :math:`\pm\mathbf e_k` where no particle with mass lies within
+  :math:`\pm\mathbf e_k` where no particle lies within
   :math:`\Delta x/2` of :math:`\mathbf x \pm \Delta x\,\mathbf e_k` (found
-  once, at the start); its area is :math:`\Delta x^{d-1}`, its centre
-  :math:`\mathbf x \pm \tfrac12\Delta x\,\mathbf e_k` moves with the
+  once, at the start; an initial crack's zero-mass particles count there:
+  the blast does not enter a crack); its area is :math:`\Delta x^{d-1}`,
+  its centre :math:`\mathbf x \pm \tfrac12\Delta x\,\mathbf e_k` moves with the
   particle, its normal keeps its initial direction (a particle has no
   orientation; a slab loaded by a blast turns by far less than a degree).
 
@@ -157,7 +158,9 @@ def particle_faces(x, vol0, m, idx, dim: int):
     Parameters
     ----------
     x : (N, 3) positions [m]; vol0 : (N,) volumes [m^dim]; m : (N,) masses
-        (particles without mass are voids); idx : (k,) candidates.
+        (particles without mass, an initial crack's, take no load but close
+        their neighbours' faces: the blast does not enter a crack);
+        idx : (k,) candidates.
 
     Returns
     -------
@@ -166,8 +169,7 @@ def particle_faces(x, vol0, m, idx, dim: int):
     """
     idx = np.asarray(idx, dtype=np.int64)
     idx = idx[m[idx] > 0.0]
-    solid = np.flatnonzero(m > 0.0)
-    tree = cKDTree(x[solid, :dim])
+    tree = cKDTree(x[:, :dim])
     dx = vol0[idx] ** (1.0 / dim)
     items, normals, halves = [], [], []
     for k in range(dim):
