@@ -6,8 +6,8 @@ converted to SI) are checked against three independent things:
 * Swisdak's simplified fits of the same surface-burst data (Swisdak 1994,
   *Simplified Kingery Airblast Calculations*, NSWC, DTIC ADA526744, Table 1:
   ln Y = sum c_k (ln Z)^k, Z in m/kg^(1/3), kPa, kPa ms/kg^(1/3),
-  ms/kg^(1/3)), which Swisdak states reproduce Kingery-Bulmash within about
-  1 %: the issue asks 5 % at three scaled distances; measured 1.7 % at worst;
+  ms/kg^(1/3)), fitted to the same data in another form: the issue asks 5 %
+  at three scaled distances; measured 1.7 % at worst over Z = 0.3-30;
 * the metric form of the free-air fits (UN IATG 01.80 / NATO AASTP-4:
   U = -0.214362789151 + 1.35034249993 log10 Z with Z in m/kg^(1/3), kPa,
   kPa ms/kg^(1/3)): the same polynomials in other units, so they pin our unit
