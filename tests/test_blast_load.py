@@ -349,41 +349,16 @@ def test_blast_load_rejects_an_empty_face_set():
         BlastLoad("b", Part, 1.0, (0, 0, 1), idx=np.arange(2))
 
 
-PLATES_2D = """
-[run]
-dimension = 2
-t_end = "2.5 ms"
-{steel}[[body]]
-name = "plate"
-material = "steel"
-dx = "10 mm"
-geometry = {{ shape = "box", lo = [-0.1, 0], hi = [0.1, 0.02] }}
-[[mesh]]
-name = "block"
-material = "steel"
-block = {{ lo = [0.9, 0], hi = [1.1, 0.02], divisions = [20, 2] }}
-[[set]]
-name = "plate"
-body = "plate"
-[[set]]
-name = "block"
-mesh = "block"
-[[blast]]
-name = "on_particles"
-set = "plate"
-charge = "1 kg"
-point = [0, 1.0]
-turned_away = "unloaded"
-[[blast]]
-name = "on_mesh"
-set = "block"
-charge = "1 kg"
-point = [1.0, 1.0]
-burst = "surface"
-[output]
-progress = false
-vtk = false
-"""
+#: the same two plates in plane strain: edges for faces, the mesh's blast a
+#: surface burst with the incident pressure on its bottom
+PLATES_2D = (PLATES.replace("dimension = 3", "dimension = 2")
+             .replace("lo = [-0.1, -0.1, 0], hi = [0.1, 0.1, 0.02]",
+                      "lo = [-0.1, 0], hi = [0.1, 0.02]")
+             .replace("lo = [0.9, -0.1, 0], hi = [1.1, 0.1, 0.02], divisions = [20, 20, 2]",
+                      "lo = [0.9, 0], hi = [1.1, 0.02], divisions = [20, 2]")
+             .replace("point = [0, 0, 1.0]", "point = [0, 1.0]\nturned_away = \"unloaded\"")
+             .replace('point = [1.0, 0, 1.0]\nturned_away = "unloaded"',
+                      'point = [1.0, 1.0]\nburst = "surface"'))
 
 
 def test_blast_in_2d_loads_edges_per_unit_thickness():
