@@ -36,21 +36,39 @@ def _whole(lo: int):
     return parse
 
 
-def _duration(text: str) -> float:
-    """An argparse type: a time, plain numbers in seconds or with units ("250 us")."""
-    from .deck.units import TIME, QuantityError, to_si
+def _si(text: str, dim) -> float:
+    """A quantity on the command line: a plain number is SI (as in decks),
+    else a string with units ("250 us"); raises QuantityError."""
+    from .deck.units import to_si
 
     try:
-        value = float(text)
+        return float(text)
     except ValueError:
+        return to_si(text, dim)
+
+
+def _positive(dim_name: str):
+    """An argparse type: a positive finite quantity of the deck dimension
+    ``dim_name`` (``TIME``, ``MASS``, ...), plain numbers in SI."""
+    from .deck import units
+
+    dim = getattr(units, dim_name)
+
+    def parse(text: str) -> float:
         try:
-            value = to_si(text, TIME)
-        except QuantityError as exc:
+            value = _si(text, dim)
+        except units.QuantityError as exc:
             raise argparse.ArgumentTypeError(f"{exc.what}; {exc.fix}") from None
-    if not value > 0 or value == float("inf"):
-        raise argparse.ArgumentTypeError(f"{text!r} is not a positive finite time; "
-                                         "give e.g. 2e-4 (seconds) or '250 us'")
-    return value
+        if not value > 0 or value == float("inf"):
+            raise argparse.ArgumentTypeError(
+                f"{text!r} is not a positive finite {dim.name}; give e.g. "
+                f"{dim.si_example:g} ({dim.si_name}) or '{dim.example}'")
+        return value
+    return parse
+
+
+#: an argparse type: a time, plain numbers in seconds or with units ("250 us")
+_duration = _positive("TIME")
 
 
 def _writable_dir(path, flag: str) -> Path:
@@ -193,7 +211,7 @@ def cmd_plot(args) -> int:
                 print(p)
         return 0
 
-    from .deck.units import TIME, to_si
+    from .deck.units import TIME
     from .io import plot_snapshots
 
     fields = [f.strip() for item in args.snapshots for f in item.split(",") if f.strip()]
@@ -202,12 +220,7 @@ def cmd_plot(args) -> int:
         items = [t.strip() for t in args.times.split(",") if t.strip()]
         if not items:
             raise ValueError(f"--times {args.times!r} gives no time")
-        times = []
-        for item in items:
-            try:
-                times.append(float(item))
-            except ValueError:
-                times.append(to_si(item, TIME))
+        times = [_si(item, TIME) for item in items]
     fields = list(dict.fromkeys(fields))
     if args.out and len(fields) > 1:
         raise ValueError("--out takes one --snapshots field; run once per field")
@@ -410,24 +423,10 @@ def cmd_material_test(args) -> int:
 
 
 def cmd_airblast(args) -> int:
-    from .deck.units import LENGTH, MASS, QuantityError, to_si
     from .io.plots import markdown_table
     from .kingery_bulmash import Z_RANGE, BURSTS, blast_parameters
 
-    def si(text, dim):  # a plain number is SI, as in decks
-        try:
-            return float(text)
-        except ValueError:
-            return to_si(text, dim)
-
-    try:
-        w = si(args.charge, MASS)
-        ranges = [si(r, LENGTH) for r in args.distance]
-    except QuantityError as exc:
-        raise ValueError(str(exc)) from None
-    if w <= 0.0 or min(ranges) <= 0.0:
-        raise ValueError("the charge and the distances must be > 0. Fix: e.g. "
-                         "--charge '75 g' --distance '1 m' '2 m'")
+    w, ranges = args.charge, args.distance
     lo, hi = Z_RANGE[BURSTS[args.burst]]
     rows = []
     for r in ranges:
@@ -589,8 +588,9 @@ def build_parser() -> argparse.ArgumentParser:
     mt.set_defaults(func=cmd_material_test)
     ab = sub.add_parser("airblast", help="Kingery-Bulmash blast parameters of a TNT "
                         "charge at given distances (as ConWep)")
-    ab.add_argument("--charge", required=True, help="TNT mass, e.g. '75 g' or 0.075")
-    ab.add_argument("--distance", required=True, nargs="+",
+    ab.add_argument("--charge", required=True, type=_positive("MASS"),
+                    help="TNT mass, e.g. '75 g' or 0.075")
+    ab.add_argument("--distance", required=True, nargs="+", type=_positive("LENGTH"),
                     help="distances from the charge's centre, e.g. '1 m' '2 m'")
     ab.add_argument("--burst", default="free_air", choices=("free_air", "surface"),
                     help="free_air (spherical, default) or surface (hemispherical)")

@@ -89,30 +89,43 @@ def _pressure(c0, c1, c2, n0, n1, n2, xc, w13, burst, tau, unload_away, par):
 
 
 @njit(cache=True, error_model="numpy")
-def face_geometry(x, face):
-    r"""Centre (3,), unit outward normal (3,) and area of a mesh face: a
-    quadrilateral (4 nodes, :math:`A\mathbf n = \tfrac12\mathbf d_1\times
-    \mathbf d_2`) or a 2D segment (2 nodes, normal :math:`(t_y, -t_x)/|t|`,
-    area = length per unit thickness); node order of
-    :mod:`~sphdyn.interactions.penalty_geometry`."""
+def face_frame(x, face):
+    r"""Centre, unit outward normal and area of a mesh face as 7 scalars
+    ``(cx, cy, cz, nx, ny, nz, area)``: a quadrilateral (4 nodes,
+    :math:`A\mathbf n = \tfrac12\mathbf d_1\times\mathbf d_2` with the
+    diagonals :math:`\mathbf d_1 = \mathbf x_2 - \mathbf x_0`,
+    :math:`\mathbf d_2 = \mathbf x_3 - \mathbf x_1`) or a 2D segment (2
+    nodes, normal :math:`(t_y, -t_x)/|t|`, area = length per unit
+    thickness); node order of :mod:`~sphdyn.interactions.penalty_geometry`.
+    Scalars, so that the per-step loop allocates nothing."""
     nf = face.shape[0]
-    c = np.zeros(3)
+    c0 = c1 = c2 = 0.0
     for a in range(nf):
-        for k in range(3):
-            c[k] += x[face[a], k] / nf
-    n = np.zeros(3)
+        c0 += x[face[a], 0] / nf
+        c1 += x[face[a], 1] / nf
+        c2 += x[face[a], 2] / nf
     if nf == 2:
-        t0 = x[face[1], 0] - x[face[0], 0]
-        t1 = x[face[1], 1] - x[face[0], 1]
-        n[0], n[1] = t1, -t0
+        n0 = x[face[1], 1] - x[face[0], 1]
+        n1 = x[face[0], 0] - x[face[1], 0]
+        n2 = 0.0
     else:
-        d1 = x[face[2]] - x[face[0]]
-        d2 = x[face[3]] - x[face[1]]
-        n[0] = 0.5 * (d1[1] * d2[2] - d1[2] * d2[1])
-        n[1] = 0.5 * (d1[2] * d2[0] - d1[0] * d2[2])
-        n[2] = 0.5 * (d1[0] * d2[1] - d1[1] * d2[0])
-    area = math.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])
-    return c, n / area, area
+        a0 = x[face[2], 0] - x[face[0], 0]
+        a1 = x[face[2], 1] - x[face[0], 1]
+        a2 = x[face[2], 2] - x[face[0], 2]
+        b0 = x[face[3], 0] - x[face[1], 0]
+        b1 = x[face[3], 1] - x[face[1], 1]
+        b2 = x[face[3], 2] - x[face[1], 2]
+        n0 = 0.5 * (a1 * b2 - a2 * b1)
+        n1 = 0.5 * (a2 * b0 - a0 * b2)
+        n2 = 0.5 * (a0 * b1 - a1 * b0)
+    area = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+    return c0, c1, c2, n0 / area, n1 / area, n2 / area, area
+
+
+def face_geometry(x, face):
+    """:func:`face_frame` as arrays: centre (3,), unit normal (3,), area."""
+    c0, c1, c2, n0, n1, n2, area = face_frame(x, np.asarray(face, dtype=np.int64))
+    return np.array([c0, c1, c2]), np.array([n0, n1, n2]), area
 
 
 @njit(cache=True, error_model="numpy")
@@ -127,24 +140,28 @@ def mesh_blast(x, m, faces, elements, active, xc, w13, burst, tau, unload_away, 
         if active[elements[f]] == 0:
             force[f, 0] = force[f, 1] = force[f, 2] = 0.0
             continue
-        c, n, area = face_geometry(x, faces[f])
-        p = _pressure(c[0], c[1], c[2], n[0], n[1], n[2], xc, w13, burst, tau,
-                      unload_away, par)
+        c0, c1, c2, n0, n1, n2, area = face_frame(x, faces[f])
+        p = _pressure(c0, c1, c2, n0, n1, n2, xc, w13, burst, tau, unload_away, par)
+        force[f, 0] = -p * area * n0
+        force[f, 1] = -p * area * n1
+        force[f, 2] = -p * area * n2
         for k in range(3):
-            force[f, k] = -p * area * n[k]
             for a in range(nf):
                 a_out[faces[f, a], k] += force[f, k] / (nf * m[faces[f, a]])
 
 
 @njit(cache=True, error_model="numpy")
-def blast_work(force, items, v_mid, dt_kick):
+def blast_work(force, items, v_mid, dt_kick, impulse):
     r"""Work of the face forces over a kick [J]: :math:`\sum_f \mathbf f_f\cdot
     \bar{\mathbf v}_f\,\Delta t` with :math:`\bar{\mathbf v}_f` the mean
     mid-kick velocity of the face's items ``items[f]`` (nf,) (one particle,
-    or the face's nodes, which share its force equally)."""
+    or the face's nodes, which share its force equally); adds the kick's
+    impulse :math:`\sum_f \mathbf f_f\,\Delta t` to ``impulse`` (3,)."""
     w = 0.0
     nf = items.shape[1]
     for f in range(force.shape[0]):
+        for k in range(3):
+            impulse[k] += force[f, k] * dt_kick
         for a in range(nf):
             i = items[f, a]
             w += (force[f, 0] * v_mid[i, 0] + force[f, 1] * v_mid[i, 1]
@@ -257,9 +274,9 @@ class BlastLoad(InteractionBase):
                        a_out)
 
     def after_kick(self, dt_kick: float) -> None:
-        self._kick = blast_work(self.force, self.items, self.part.kin.v_mid, dt_kick)
+        self._kick = blast_work(self.force, self.items, self.part.kin.v_mid, dt_kick,
+                                self.impulse)
         self.work += self._kick
-        self.impulse += self.force.sum(axis=0) * dt_kick
 
     def external_work(self) -> float:
         return self._kick
