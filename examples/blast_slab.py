@@ -66,16 +66,6 @@ STANDOFFS = (0.1, 0.2, 0.3)
 CHARGE = 0.08098  # the charge's mass in the lattice, as blast_slab_empirical.toml [kg]
 
 
-def run(name: str, reuse: bool) -> Path:
-    """Run one model (unless ``reuse`` finds its output); its output folder."""
-    from sphdyn.simulation import run_deck
-
-    deck, overrides, _ = RUNS[name]
-    run_deck(ROOT / "examples" / deck, ROOT / "out" / name, overrides, reuse=reuse,
-             progress=True)
-    return ROOT / "out" / name
-
-
 def _frame(path: Path) -> dict:
     """Positions, displacements, damage and material of a frame's particles."""
     import h5py
@@ -310,11 +300,9 @@ def main() -> None:
 
     from sphdyn.io import read_history_csv
     from sphdyn.io.plots import markdown_table
+    from sphdyn.simulation import run_examples
 
-    done = {n for n in RUNS if (ROOT / "out" / n / "summary.json").exists()}
-    names = [n for n in RUNS if n in done] if a.reuse else \
-        [n for n in RUNS if n != "blast_slab" or a.full or n in done]
-    outs = {n: run(n, a.reuse or (n == "blast_slab" and not a.full)) for n in names}
+    outs = run_examples(ROOT, RUNS, "blast_slab", reuse=a.reuse, include_full=a.full)
 
     fig = plt.figure(figsize=(11, 11), layout="constrained")
     grid = fig.add_gridspec(3, 2, height_ratios=[1, 1, 1.1])

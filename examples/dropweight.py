@@ -43,16 +43,6 @@ RUNS = {
 }
 
 
-def run(name: str, reuse: bool) -> Path:
-    """Run one model (unless ``reuse`` finds its output); its output folder."""
-    from sphdyn.simulation import run_deck
-
-    deck, overrides, _ = RUNS[name]
-    run_deck(ROOT / "examples" / deck, ROOT / "out" / name, overrides, reuse=reuse,
-             progress=True)
-    return ROOT / "out" / name
-
-
 def side_damage(out: Path) -> tuple[np.ndarray, float]:
     """(nz, nx) largest damage of the concrete across the width at each point of
     the side at the last frame, and the lattice spacing [m]."""
@@ -155,11 +145,9 @@ def main() -> None:
     if a.gravity:
         gravity(a.reuse)
         return
-    done = {n for n in RUNS if (ROOT / "out" / n / "summary.json").exists()}
-    # --reuse: the runs found; otherwise the coarse pair (and --full the 6 mm run)
-    names = [n for n in RUNS if n in done] if a.reuse else \
-        [n for n in RUNS if n != "dropweight" or a.full or n in done]
-    outs = {n: run(n, a.reuse or (n == "dropweight" and not a.full)) for n in names}
+    from sphdyn.simulation import run_examples
+
+    outs = run_examples(ROOT, RUNS, "dropweight", reuse=a.reuse, include_full=a.full)
     fig = plt.figure(figsize=(11, 10), layout="constrained")
     grid = fig.add_gridspec(3, 1, height_ratios=[1, 1, 0.9])
     ax_s, ax_d = fig.add_subplot(grid[0]), fig.add_subplot(grid[1])

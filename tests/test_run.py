@@ -288,3 +288,26 @@ def test_run_deck_reuses_a_finished_run(tmp_path):
     assert run_deck(bad, tmp_path, reuse=True) == {"status": "completed", "steps": 7}
     with pytest.raises(DeckError):
         run_deck(bad, tmp_path)
+
+
+def test_run_examples_picks_the_runs_of_an_example_script(tmp_path, monkeypatch):
+    # the long run ("full") only with include_full, or read if found; --reuse
+    # reads what is found and runs nothing
+    import sphdyn.simulation as sim
+    calls = []
+    monkeypatch.setattr(sim, "run_deck", lambda deck, out, over, reuse, progress:
+                        calls.append((out.name, reuse)))
+    runs = {"coarse": ("c.toml", [], "c"), "full": ("f.toml", [], "f")}
+    assert list(sim.run_examples(tmp_path, runs, "full")) == ["coarse"]
+    assert calls == [("coarse", False)]
+    (tmp_path / "out" / "full").mkdir(parents=True)
+    (tmp_path / "out" / "full" / "summary.json").write_text("{}")
+    calls.clear()
+    assert list(sim.run_examples(tmp_path, runs, "full")) == ["coarse", "full"]
+    assert calls == [("coarse", False), ("full", True)]  # found: read, not run again
+    calls.clear()
+    assert list(sim.run_examples(tmp_path, runs, "full", reuse=True)) == ["full"]
+    assert calls == [("full", True)]
+    calls.clear()
+    sim.run_examples(tmp_path, runs, "full", include_full=True)
+    assert calls == [("coarse", False), ("full", False)]

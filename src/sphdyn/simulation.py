@@ -337,6 +337,25 @@ def _output_failure(exc: OSError, s) -> str:
             "from the last checkpoint or run again.")
 
 
+def run_examples(root, runs: dict, full: str, reuse: bool = False,
+                 include_full: bool = False) -> dict:
+    """The example scripts' runs: ``runs`` maps a name to ``(deck, overrides,
+    label)``, the deck a file in ``root/examples``, each run into
+    ``root/out/<name>``. With ``reuse`` only the runs found there are read;
+    otherwise every run is made except ``full`` (the long one), which is made
+    with ``include_full`` and else read if found. Returns {name: output folder}.
+    """
+    root = Path(root)
+    found = {n for n in runs if (root / "out" / n / "summary.json").exists()}
+    names = [n for n in runs if n in found] if reuse else \
+        [n for n in runs if n != full or include_full or n in found]
+    for n in names:
+        deck, overrides = runs[n][0], runs[n][1]
+        run_deck(root / "examples" / deck, root / "out" / n, overrides,
+                 reuse=reuse or (n == full and not include_full), progress=True)
+    return {n: root / "out" / n for n in names}
+
+
 def run_deck(path, outdir=None, overrides=None, reuse: bool = False, **kw) -> dict:
     """Load, validate and run a deck; the Python equivalent of ``sphdyn run``.
 
