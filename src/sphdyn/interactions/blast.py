@@ -158,14 +158,19 @@ def blast_work(force, items, v_mid, dt_kick, impulse):
     or the face's nodes, which share its force equally); adds the kick's
     impulse :math:`\sum_f \mathbf f_f\,\Delta t` to ``impulse`` (3,)."""
     w = 0.0
+    s0 = s1 = s2 = 0.0
     nf = items.shape[1]
     for f in range(force.shape[0]):
-        for k in range(3):
-            impulse[k] += force[f, k] * dt_kick
+        s0 += force[f, 0]
+        s1 += force[f, 1]
+        s2 += force[f, 2]
         for a in range(nf):
             i = items[f, a]
             w += (force[f, 0] * v_mid[i, 0] + force[f, 1] * v_mid[i, 1]
                   + force[f, 2] * v_mid[i, 2]) / nf
+    impulse[0] += s0 * dt_kick
+    impulse[1] += s1 * dt_kick
+    impulse[2] += s2 * dt_kick
     return w * dt_kick
 
 
