@@ -415,3 +415,80 @@ def test_element_fields_and_what_walls_see_of_the_nodes(integration):
     assert np.allclose(p.nodes.rho0, STEEL["density"])
     assert np.allclose(p.nodes.bulk_modulus, 210e9 / (3 * (1 - 0.6)))
     assert p.nodes.m.sum() == pytest.approx(STEEL["density"] * 0.002, rel=1e-12)
+
+
+# ------------------------------------------------------- vectorised hex passes
+@pytest.mark.parametrize("form,qh", [("viscous", 0.1), ("stiffness", 0.15),
+                                     ("viscous", 0.0)])
+def test_lane_passes_give_the_bits_of_the_element_by_element_passes(form, qh):
+    """The one-point hex8 passes of :mod:`.hex_lanes` (16 elements side by
+    side) against the element-by-element reference passes of :mod:`.solid`, on
+    a distorted block of 9 x 8 x 5 = 360 elements (two blocks of 256, the last
+    group padded: 104 = 6 x 16 + 8), random node velocities, random stresses,
+    some elements eroded, a stiffness-form history, and a few elements
+    compressed (bulk viscosity on): every output equal bit for bit (the same
+    operations in the same order, so no tolerance)."""
+    from sphdyn.parts.fem import hex_lanes
+    from sphdyn.parts.fem import solid as ref
+
+    rng = np.random.default_rng(5)
+    x, cells = distorted_block(3, (9, 8, 5), rng, amount=0.25)
+    p = part(x, cells, 3, hourglass=form, hourglass_coefficient=qh)
+    assert p.lanes is not None  # the part takes the lane passes
+    q, el, pts, s = p.nodes, p.el, p.pts, p.s
+    q.v = rng.normal(0.0, 5.0, q.v.shape)
+    q.v[cells[:40].ravel()] += -300.0 * (x[cells[:40].ravel()] - 0.5)  # compressed
+    q.x = x + 1e-3 * rng.normal(size=x.shape)
+    pts.sig = rng.normal(0.0, 1e8, pts.sig.shape)
+    el.hg = rng.normal(0.0, 1e3, el.hg.shape)
+    el.active[[3, 200, 259, 359]] = 0
+    dt, m = 1e-7, el.m
+    outs = []
+    for kind in ("lanes", "reference"):
+        L, rho = np.full_like(pts.L, 7.0), np.full_like(pts.rho, 7.0)  # untouched if eroded
+        e, e_av, hg, e_hg = pts.e.copy(), pts.e_av.copy(), el.hg.copy(), el.e_hg.copy()
+        vol, dt_el, fe = np.zeros(el.n), np.zeros(el.n), np.full_like(el.fe, 7.0)
+        if kind == "lanes":
+            hex_lanes.hex_strain_rate(q.x, q.v, el.conn, el.active, m, dt, L, rho, p.lanes)
+            hex_lanes.hex_forces(q.x, q.v, el.conn, el.active, pts.sig, L, rho, pts.c, e,
+                                 e_av, p.hg_form, qh, hg, e_hg, s.q1, s.q2, dt, vol, dt_el,
+                                 fe, p.lanes)
+        else:
+            ref.uniform_strain_rate(q.x, q.v, el.conn, el.active, m, dt, 3, p.tab, L, rho,
+                                    p.work)
+            ref.uniform_forces(q.x, q.v, el.conn, el.active, pts.sig, L, rho, pts.c, e, e_av,
+                               3, p.tab, p.gam, p.hg_form, qh, hg, e_hg, s.q1, s.q2, dt, vol,
+                               dt_el, fe, p.work)
+        outs.append((L, rho, e, e_av, hg, e_hg, vol, dt_el, fe))
+    for name, a, b in zip("L rho e e_av hg e_hg vol dt_el fe".split(), *outs):
+        assert np.array_equal(a, b), name
+    L, rho, e, e_av, hg, e_hg, vol, dt_el, fe = outs[0]
+    assert np.all(L[3] == 7.0) and np.all(fe[3] == 0.0) and dt_el[3] == np.inf
+    assert np.count_nonzero(e_av - pts.e_av) > 10  # bulk viscosity acted somewhere
+    if qh > 0.0:
+        assert np.count_nonzero(e_hg) > 300  # hourglass work in (almost) every element
+    else:
+        assert not e_hg.any() and np.array_equal(hg, el.hg)
+
+
+def test_simd_sqrt_is_the_ieee_square_root():
+    """The LLVM intrinsic of :mod:`sphdyn.simd` gives math.sqrt's bits (both
+    correctly rounded), NaN below zero, and keeps inf and signed zero."""
+    from numba import njit
+
+    from sphdyn.simd import sqrt
+
+    @njit
+    def roots(a, out):
+        for i in range(a.size):
+            out[i] = sqrt(a[i])
+
+    rng = np.random.default_rng(2)
+    a = np.concatenate([np.exp(rng.uniform(-700, 700, 20000)), [0.0, -0.0, np.inf, 4.0]])
+    out = np.empty_like(a)
+    roots(a, out)
+    assert np.array_equal(out, np.array([math.sqrt(v) for v in a]))
+    assert math.copysign(1.0, out[-3]) == -1.0 and out[-1] == 2.0
+    neg = np.empty(1)
+    roots(np.array([-1.0]), neg)
+    assert np.isnan(neg[0])

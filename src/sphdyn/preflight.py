@@ -33,7 +33,7 @@ PARTICLE_BYTES = 1000
 #: for the lists being rebuilt beside the old ones.
 PAIR_BYTES = 16
 #: Bytes per hex8 element of a generated mesh, node and point arrays included:
-#: 1.11 kB marginal peak RSS measured for one-point hex3d (BENCHMARKS.md),
+#: 1.12 kB marginal peak RSS measured for one-point hex3d (BENCHMARKS.md),
 #: rounded up. (The selective-reduced variant's eight points need about 3 kB
 #: more per element; the estimate does not count them yet.)
 ELEMENT_BYTES = 1600

@@ -11,7 +11,11 @@ coordinates, velocities, volume derivatives): :func:`uniform_strain_rate`
 (mid-step geometry, velocity gradient, density), the material update, then
 :func:`uniform_forces` (end-of-step geometry, volume, element step, forces).
 Nothing per element is stored between the passes but the point fields, so a
-hex8 costs about 1.1 kB with its node and point (BENCHMARKS.md).
+hex8 costs about 1.2 kB with its node and point (BENCHMARKS.md). The part
+runs the one-point hex8 through :mod:`.hex_lanes`, the same equations in the
+same order for 16 elements side by side (SIMD; the same bits, about 2x
+faster); the element-by-element passes here serve the quad4 and are the
+reference the lane passes are tested against.
 
 **Kinematics.** Velocities are at :math:`n+\tfrac12`, positions at
 :math:`n+1`. The velocity gradient is evaluated on the mid-step geometry
@@ -78,6 +82,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from ...simd import sqrt
 from .hex_gradient import hex_volume_gradient
 
 HG_VISCOUS = 0
@@ -151,7 +156,7 @@ def char_length(g, vol):
         s += g[I, 0] ** 2 + g[I, 1] ** 2 + g[I, 2] ** 2
     if s <= 0.0 or vol <= 0.0:
         return 0.0
-    return 2.0 * vol / math.sqrt(g.shape[0] * s)
+    return 2.0 * vol / sqrt(g.shape[0] * s)
 
 
 #: elements per block of the one-point loops: a block's thread keeps the
@@ -188,7 +193,7 @@ def element_step(ell, c, dkk, q1, q2):
     :math:`Q = Q_2 c + Q_1\ell|\dot\varepsilon_{kk}|` in compression (module
     docstring; the factor ``cfl`` is applied by the part)."""
     Q = q2 * c + (q1 * ell * -dkk if dkk < 0.0 else 0.0)
-    return ell / (Q + math.sqrt(Q * Q + c * c) + 1e-300)
+    return ell / (Q + sqrt(Q * Q + c * c) + 1e-300)
 
 
 @njit(cache=True, error_model="numpy", parallel=True)

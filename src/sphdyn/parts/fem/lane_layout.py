@@ -1,0 +1,37 @@
+r"""Layout of the lane scratch of the vectorised hex8 passes (:mod:`.hex_lanes`).
+
+The one-point hex8 passes work on :data:`LANES` elements side by side: every
+per-element quantity is a row of ``LANES`` contiguous doubles in one flat
+scratch per block of elements, so the compiled loops over the lanes are SIMD
+loops (the layout LS-DYNA's element blocks use). The rows below are offsets
+in units of ``LANES``; being module constants, Numba compiles them as
+literals, so the compiler sees fixed distances between the rows and needs no
+run-time alias checks.
+"""
+
+#: elements side by side (two AVX-512 or four AVX2 registers of doubles)
+LANES = 16
+
+X_ = 0  #: 24 rows: node coordinates relative to node 0, (I, k) -> X_ + 3 I + k [m]
+VN_ = 24  #: 24 rows: node velocities at n + 1/2 [m/s]
+G_ = 48  #: 24 rows: volume derivatives dV/dx_kI [m^2]
+VOL_ = 72  #: volume [m^3]
+INV_ = 73  #: 1 / volume (0 for a degenerate element) [1/m^3]
+L_ = 74  #: 9 rows: velocity gradient L_ij -> L_ + 3 i + j [1/s]
+SIG_ = 83  #: 9 rows: Cauchy stress [Pa]
+DKK_ = 92  #: trace of the element's L [1/s]
+RHO_ = 93  #: density [kg/m^3]
+C_ = 94  #: wave speed [m/s]
+HG_ = 95  #: 12 rows: stiffness-form hourglass forces (a, k) -> HG_ + 3 a + k [N]
+F_ = 107  #: 24 rows: element nodal forces [N]
+DT_ = 131  #: element stable step [s]
+Q_ = 132  #: bulk-viscosity pressure [Pa]
+HEAT_ = 133  #: bulk-viscosity heat of the step [J/kg]
+POWER_ = 134  #: hourglass power [W]
+FACE_ = 135  #: V^(2/3) [m^2]
+COEF_ = 136  #: hourglass coefficient a_h or k_h (0 without hourglass control)
+INVV_ = 137  #: 1 / V where hourglass control acts, else 0 [1/m^3]
+LB_ = 138  #: 9 rows: sum_I v_iI dV/dx_jI [m^3/s]
+M_ = 147  #: 9 rows: hourglass share M_ij = sum_a Q_ai h_aj / V [Pa]
+QA_ = 156  #: 12 rows: hourglass generalised forces (a, k) -> QA_ + 3 a + k [N]
+ROWS = 168  #: rows in all
