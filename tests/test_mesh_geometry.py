@@ -18,6 +18,7 @@ from sphdyn.geometry import (
     check_elements,
     element_jacobians,
     line_mesh,
+    polyline_mesh,
     read_mesh,
 )
 
@@ -123,6 +124,40 @@ def test_line_mesh():
     assert np.array_equal(m.points[-1], [0.3, 0.4, 0.0])
     assert m.node_set("start").tolist() == [0] and m.node_set("end").tolist() == [5]
     assert line_mesh([0, 0], [1, 0], 1).points.shape == (2, 3)
+
+
+def test_polyline_mesh_closed_stirrups_repeated():
+    """A closed rectangle 0.1 x 0.2 m in the y-z plane, 2 + 4 + 2 + 4
+    elements, three copies 0.25 m apart along x: corners exactly as given
+    and shared by their two segments, every element 0.05 m (the perimeter /
+    12), each copy one loop (every node in exactly two elements), the copies
+    shifted by k step and unconnected; start = end = each copy's first node."""
+    corners = [[0, 0, 0], [0, 0.1, 0], [0, 0.1, 0.2], [0, 0, 0.2]]
+    m = polyline_mesh(corners, [2, 4, 2, 4], closed=True, copies=3, step=[0.25, 0, 0])
+    assert m.kind == "line2" and m.cells.shape == (36, 2) and m.points.shape == (36, 3)
+    np.testing.assert_allclose(element_jacobians(m.points, m.cells, "line2"), 0.05,
+                               rtol=RTOL)
+    assert np.array_equal(m.points[[0, 2, 6, 8]], np.array(corners, float))
+    assert np.array_equal(np.bincount(m.cells.ravel()), np.full(36, 2))
+    assert np.array_equal(m.cells[11], [11, 0]) and np.array_equal(m.cells[12], [12, 13])
+    for k in range(3):
+        assert np.array_equal(m.points[12 * k:12 * (k + 1)], m.points[:12] + [0.25 * k, 0, 0])
+    assert m.node_set("start").tolist() == [0, 12, 24] == m.node_set("end").tolist()
+    open_ = polyline_mesh(corners[:3], [2, 4])  # an open bent bar: 7 nodes, ends apart
+    assert open_.points.shape == (7, 3) and open_.node_set("end").tolist() == [6]
+    assert np.array_equal(line_mesh([0, 0, 0], [1, 0, 0], 4).points,
+                          polyline_mesh([[0, 0, 0], [1, 0, 0]], [4]).points)
+
+
+def test_polyline_mesh_arguments_are_checked():
+    with pytest.raises(ValueError, match="at least 3 points"):
+        polyline_mesh([[0, 0, 0], [1, 0, 0]], [1, 1], closed=True)
+    with pytest.raises(ValueError, match="one element count per segment"):
+        polyline_mesh([[0, 0, 0], [1, 0, 0], [1, 1, 0]], [1])
+    with pytest.raises(ValueError, match="differ"):
+        polyline_mesh([[0, 0, 0], [1, 0, 0], [1, 0, 0]], [1, 1])
+    with pytest.raises(ValueError, match="nonzero step"):
+        polyline_mesh([[0, 0, 0], [1, 0, 0]], [1], copies=2)
 
 
 def test_generator_arguments_are_checked():

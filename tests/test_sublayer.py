@@ -328,3 +328,51 @@ def test_sublayer_without_stiffness_carries_no_stress_and_still_transfers_the_pu
             assert np.all(sph.p.sig[rows] == 0.0) and np.all(sph.p.c[rows] == 0.0)
             assert all(np.intersect1d(g.idx, rows).size == 0 for g in sph.groups)
     assert 5e3 < grips["none"] < 0.9 * grips["material"]
+
+
+STIRRUPS = """
+[[mesh]]
+name = "stirrups"
+material = "steel"
+element = "truss"
+line = { points = [["20 mm", "10 mm", "10 mm"], ["20 mm", "50 mm", "10 mm"], ["20 mm", "50 mm", "50 mm"], ["20 mm", "10 mm", "50 mm"]], closed = true, element_length = "10 mm", repeat = 4, step = ["20 mm", 0, 0] }
+section = { shape = "circle", diameter = "6 mm" }
+[mesh.sublayer]
+stiffness = "split"
+"""
+
+
+def test_closed_stirrups_from_a_deck_keep_their_mass_and_loops():
+    """Four closed 40 x 40 mm stirrups (16 trusses of 10 mm each) every 20 mm in
+    the pull-out block: 64 nodes, each in two elements (closed loops), copies
+    20 mm apart; nodes and particles carry rho A x 4 x 160 mm (1e-12), the
+    particles half of it, each on its node."""
+    st = build_stepper(loads_deck(deck_text(sets="") + STIRRUPS))
+    bar, sph = st.part("stirrups"), st.part("sph")
+    assert bar.kin.n == 64 and np.array_equal(np.bincount(bar.elements.conn.ravel()),
+                                               np.full(64, 2))
+    total = 7850.0 * np.pi * 0.003 ** 2 * 4 * 0.16
+    assert bar.kin.m.sum() == pytest.approx(total, rel=1e-12)
+    rows = np.flatnonzero(sph.p.body == 2)  # block, bar_sublayer, stirrups_sublayer
+    assert sph.p.m[rows].sum() == pytest.approx(0.5 * total, rel=1e-12)
+    assert np.array_equal(sph.p.x[rows], bar.kin.x)
+    np.testing.assert_allclose(np.unique(np.round(bar.kin.x[:, 0], 9)),
+                               [0.02, 0.04, 0.06, 0.08])
+
+
+@pytest.mark.parametrize("line,words", [
+    ('points = [["20 mm", "10 mm", "10 mm"], ["20 mm", "50 mm", "10 mm"]], closed = true',
+     ["at least 3 points"]),
+    ('start = ["20 mm", "10 mm", "10 mm"], points = [[0, 0, 0], [0, "1 mm", 0]]',
+     ["start and end, or points"]),
+    ('points = [["20 mm", "10 mm", "10 mm"], ["20 mm", "50 mm", "10 mm"]], repeat = 3',
+     ["nonzero step"]),
+    ('points = [["20 mm", "10 mm", "10 mm"], ["20 mm", "10 mm", "10 mm"], '
+     '["20 mm", "50 mm", "10 mm"]]', ["points 0 and 1 are the same"]),
+    ('start = ["20 mm", "10 mm", "10 mm"], end = ["20 mm", "50 mm", "10 mm"], closed = true',
+     ["closed joins the points"]),
+])
+def test_bad_polylines_are_refused_naming_the_line(tmp_path, capsys, line, words):
+    table = STIRRUPS.split("line = ")[1].split("\n")[0]
+    text = STIRRUPS.replace(table, f'{{ {line}, element_length = "10 mm" }}')
+    _bad(tmp_path, deck_text(sets="") + text, "mesh[1].line", words, capsys)

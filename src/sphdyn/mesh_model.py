@@ -19,7 +19,7 @@ from .deck import DeckError
 from .deck.errors import format_problem
 from .geometry import select
 from .geometry.convert import element_centroids, elements_to_particles, hybrid_points
-from .geometry.mesh import (MeshData, block_mesh, check_elements, line_mesh, prism_mesh,
+from .geometry.mesh import (MeshData, block_mesh, check_elements, polyline_mesh, prism_mesh,
                             read_mesh)
 
 #: Element kind of a solid mesh by dimension.
@@ -95,7 +95,9 @@ def _read(spec, where: str, dim: int) -> MeshData:
         m = spec.prism
         return prism_mesh(m.points, m.element_size, dim, m.axis, m.base, m.length)
     if spec.line is not None:
-        return line_mesh(spec.line.start, spec.line.end, spec.line.count)
+        ln = spec.line
+        return polyline_mesh(ln.corners, ln.counts, ln.closed, ln.repeat,
+                             ln.step if ln.step is not None else (0.0, 0.0, 0.0))
     try:
         mesh = read_mesh(spec.file, dim, kind=SOLID_KIND[dim])
     except (ValueError, OSError, KeyError, IndexError) as exc:

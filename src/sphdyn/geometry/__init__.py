@@ -22,6 +22,7 @@ from .mesh import (
     check_elements,
     element_jacobians,
     line_mesh,
+    polyline_mesh,
     prism_mesh,
     read_mesh,
 )
@@ -42,6 +43,7 @@ __all__ = [
     "MeshData",
     "block_mesh",
     "line_mesh",
+    "polyline_mesh",
     "prism_mesh",
     "read_mesh",
     "element_jacobians",

@@ -42,6 +42,7 @@ __all__ = [
     "MeshData",
     "block_mesh",
     "line_mesh",
+    "polyline_mesh",
     "prism_mesh",
     "read_mesh",
     "element_jacobians",
@@ -426,19 +427,79 @@ def line_mesh(start, end, n: int) -> MeshData:
         ``"all"``; node sets ``"all"``, ``"start"`` (node 0), ``"end"``
         (node n).
     """
-    p0 = _point(start, 2 if np.size(start) == 2 else 3, "start")
-    p1 = _point(end, 2 if np.size(end) == 2 else 3, "end")
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
-        raise ValueError(f"n must be a positive integer (number of elements), got {n!r}")
-    if np.array_equal(p0, p1):
-        raise ValueError(f"line start and end must differ, got {p0} twice")
-    t = np.linspace(0.0, 1.0, n + 1)[:, None]
-    points = p0 + t * (p1 - p0)
-    points[-1] = p1
-    cells = np.stack([np.arange(n), np.arange(1, n + 1)], axis=1)
-    return MeshData(points, cells, "line2",
-                    node_sets={"all": np.arange(n + 1), "start": [0], "end": [n]},
-                    element_sets={"all": np.arange(n)}, source="line_mesh")
+    return polyline_mesh([start, end], [n])
+
+
+def polyline_mesh(points, counts, closed: bool = False, copies: int = 1,
+                  step=(0.0, 0.0, 0.0)) -> MeshData:
+    """Line2 elements along a polyline (a bent bar, a closed stirrup), optionally
+    repeated at a constant step (stirrups along a beam).
+
+    Parameters
+    ----------
+    points : array_like, (P, 3) or (P, 2)
+        Corner points [m], P >= 2 (>= 3 if ``closed``); consecutive points
+        distinct (and the last distinct from the first if ``closed``).
+    counts : sequence of int
+        Equal elements on each segment (P - 1 segments, P if ``closed``: the
+        last joins the last point to the first).
+    closed : bool
+        Join the last point to the first (a loop).
+    copies : int
+        Number of copies, >= 1; copy ``k`` is shifted by ``k * step``.
+    step : array_like, (3,) or (2,)
+        Shift between copies [m] (must not be zero when ``copies > 1``).
+
+    Returns
+    -------
+    MeshData
+        Segments share their corner nodes; copies share nothing. Node ``0`` of
+        a copy is its first point. Element set ``"all"``; node sets ``"all"``,
+        ``"start"`` (each copy's first node), ``"end"`` (each copy's last node;
+        the first one for a closed loop).
+    """
+    dim = 2 if np.ndim(points) == 2 and np.shape(points)[1] == 2 else 3
+    pts = [_point(p, dim, f"points[{k}]") for k, p in enumerate(points)]
+    segs = len(pts) if closed else len(pts) - 1
+    if len(pts) < (3 if closed else 2):
+        raise ValueError(f"a {'closed ' if closed else ''}polyline needs at least "
+                         f"{3 if closed else 2} points, got {len(pts)}")
+    if len(counts) != segs:
+        raise ValueError(f"counts needs one element count per segment ({segs}), "
+                         f"got {len(counts)}")
+    for n in counts:
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+            raise ValueError(f"n must be a positive integer (number of elements), got {n!r}")
+    if isinstance(copies, bool) or not isinstance(copies, (int, np.integer)) or copies < 1:
+        raise ValueError(f"copies must be a positive integer, got {copies!r}")
+    shift = _point(step, dim, "step")
+    if copies > 1 and not np.any(shift):
+        raise ValueError("copies of a polyline need a nonzero step between them")
+    rows = []
+    for s in range(segs):
+        p0, p1 = pts[s], pts[(s + 1) % len(pts)]
+        if np.array_equal(p0, p1):
+            raise ValueError(f"line start and end must differ, got {p0} twice "
+                             f"(segment {s})")
+        t = np.linspace(0.0, 1.0, counts[s] + 1)[:-1, None]
+        rows.append(p0 + t * (p1 - p0))
+    if not closed:
+        rows.append(pts[-1][None, :])
+    one = np.concatenate(rows)  # corner points exactly as given
+    n = one.shape[0]
+    e = int(sum(counts))
+    first = np.arange(e)
+    cells = np.stack([first, (first + 1) % n if closed else first + 1], axis=1)
+    points_all = np.concatenate([one + k * shift for k in range(copies)])
+    cells_all = np.concatenate([cells + k * n for k in range(copies)])
+    starts = np.arange(copies) * n
+    ends = starts + (0 if closed else n - 1)
+    return MeshData(points_all, cells_all, "line2",
+                    node_sets={"all": np.arange(n * copies), "start": starts,
+                               "end": np.sort(ends)},
+                    element_sets={"all": np.arange(e * copies)},
+                    source="line_mesh" if len(pts) == 2 and not closed and copies == 1
+                    else "polyline_mesh")
 
 
 # --------------------------------------------------------------------------

@@ -64,33 +64,89 @@ class PrismMesh(PrismKeys):
 
 
 class LineMesh(Section):
-    """[mesh.line]: a straight line of beam or truss elements."""
+    """[mesh.line]: beam or truss elements along a straight line (start, end) or a
+    polyline through points (a bent bar; closed: a stirrup), optionally repeated
+    at a constant step (stirrups along a beam)."""
 
-    start: Position = Field(description="First node.")
-    end: Position = Field(description="Last node.")
+    start: Optional[Position] = Field(None, description="First node (a straight line; "
+                                                        "or give points).")
+    end: Optional[Position] = Field(None, description="Last node (a straight line).")
+    points: Optional[tuple[Position, ...]] = Field(
+        None, description="Corners of a polyline, at least 2 (3 if closed), instead of "
+                          "start and end.")
+    closed: bool = Field(False, description="Join the last point to the first (a "
+                                            "closed stirrup; points only).")
     divisions: Optional[integer("element count", lo=1)] = Field(
-        None, description="Number of elements (or give element_length).")
+        None, description="Number of elements on each segment (or give element_length).")
     element_length: Optional[PositiveLength] = Field(
-        None, description="Element length: the line gets the nearest whole number "
+        None, description="Element length: each segment gets the nearest whole number "
                           "of equal elements (or give divisions).")
+    repeat: integer("copy count", lo=1) = Field(
+        1, description="Number of copies of the line, each shifted by step from the "
+                       "last (stirrups along a beam).")
+    step: Optional[Position] = Field(
+        None, description="Shift between copies (with repeat > 1).")
 
     @model_validator(mode="after")
     def _has_length(self):
-        if self.start == self.end:
-            raise problem("start and end are the same point",
-                          "give two different end points of the line")
+        straight = self.start is not None or self.end is not None
+        if straight == (self.points is not None):
+            raise problem("a line needs start and end, or points (one of them)",
+                          "give start = [...] and end = [...] for a straight bar, or "
+                          "points = [[...], [...], ...] for a polyline")
+        if straight and (self.start is None or self.end is None):
+            raise problem("a straight line needs both start and end",
+                          f"add {'end' if self.end is None else 'start'} = [...]")
+        if straight and self.closed:
+            raise problem("closed joins the points of a polyline",
+                          "give points = [[...], ...] or remove closed")
+        corners = self.corners
+        need = 3 if self.closed else 2
+        if len(corners) < need:
+            raise problem(f"a {'closed ' if self.closed else ''}polyline needs at least "
+                          f"{need} points, got {len(corners)}",
+                          f"give {need} or more points")
+        for k, (p, q) in enumerate(self.segments_ends):
+            if p == q:
+                raise problem("start and end are the same point" if straight else
+                              f"points {k} and {(k + 1) % len(corners)} are the same",
+                              "give distinct consecutive points" if not straight else
+                              "give two different end points of the line")
         if (self.divisions is None) == (self.element_length is None):
             raise problem("a line needs divisions or element_length (one of them)",
                           "give divisions = 20 or element_length = \"25 mm\"")
+        if self.repeat > 1 and (self.step is None or not any(self.step)):
+            raise problem(f"repeat = {self.repeat} needs a nonzero step between the copies",
+                          "add step = [\"100 mm\", 0, 0]")
+        if self.repeat == 1 and self.step is not None:
+            raise problem("step means nothing without repeat > 1",
+                          "remove step or give repeat = 2 or more")
         return self
 
     @property
-    def count(self) -> int:
-        """The number of elements."""
+    def corners(self) -> list:
+        """The polyline's points (start and end for a straight line)."""
+        return list(self.points) if self.points is not None else [self.start, self.end]
+
+    @property
+    def segments_ends(self) -> list:
+        """(first, last) point of each segment."""
+        c = self.corners
+        return [(c[k], c[(k + 1) % len(c)]) for k in range(len(c) if self.closed else
+                                                             len(c) - 1)]
+
+    @property
+    def counts(self) -> list[int]:
+        """Elements on each segment."""
         if self.divisions is not None:
-            return self.divisions
-        length = sum((a - b) ** 2 for a, b in zip(self.start, self.end)) ** 0.5
-        return max(1, round(length / self.element_length))
+            return [self.divisions] * len(self.segments_ends)
+        return [max(1, round(sum((a - b) ** 2 for a, b in zip(p, q)) ** 0.5
+                             / self.element_length)) for p, q in self.segments_ends]
+
+    @property
+    def count(self) -> int:
+        """The number of elements, copies included."""
+        return self.repeat * sum(self.counts)
 
 
 class BeamSection(Section):
