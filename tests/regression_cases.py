@@ -96,7 +96,7 @@ CASES: dict[str, tuple[int, list[str]]] = {
     "blast_slab_empirical": (40, [o for o in BLAST_COARSE if "charge" not in o]),
     "dropweight": (40, ['body.beam.dx="36 mm"', 'body.ram.dx="25 mm"'] + [
         f'mesh.{b}.line.element_length="36 mm"' for b in ("bar_b1", "bar_b2", "bar_t1",
-                                                         "bar_t2")]),
+                                                         "bar_t2", "stirrups")]),
 }
 
 

@@ -138,3 +138,36 @@ def test_a_restarted_run_continues_the_gauges_and_gravity_bitwise(tmp_path):
         for col in a:
             assert np.array_equal(a[col], b[col]), (f, col)
     assert read_history_csv(tmp_path / "full/history.csv")["W_gravity_column"][-1] > 0.0
+
+
+def test_a_gauge_in_concrete_beside_a_bar_takes_the_concretes_spacing():
+    """A point gauge on the pull-out block (dx 10 mm) at a lattice cell's centre
+    on the bar's line: its nearest block particle is 8.66 mm away (half the
+    cell's diagonal), within the block's spacing of 10 mm; a bar particle sits
+    7.07 mm from that particle, which must not count as the block's spacing
+    (it did: the gauge was refused). A point 12 mm above the block's top
+    layer is still refused."""
+    from test_sublayer import deck_text
+
+    gauge = """
+[[gauge]]
+name = "g"
+type = "point"
+body = "block"
+point = ["10 mm", "30 mm", "30 mm"]
+quantities = ["displacement_z"]
+"""
+    deck = loads_deck(deck_text(sets="") + gauge)
+    st = build_stepper(deck)
+    sph = st.part("sph")
+    assert len(build_gauges(deck, st.parts)) == 1
+    x0 = sph.p.x0
+    block = np.flatnonzero(sph.p.body == 0)
+    bar = np.flatnonzero(sph.p.body == 1)
+    i = block[np.argmin(np.linalg.norm(x0[block] - [0.01, 0.03, 0.03], axis=1))]
+    assert np.linalg.norm(x0[i] - [0.01, 0.03, 0.03]) == pytest.approx(0.00866, abs=1e-5)
+    assert np.linalg.norm(x0[bar] - x0[i], axis=1).min() == pytest.approx(0.00707, abs=1e-5)
+    far = loads_deck(deck_text(sets="") + gauge.replace(
+        'point = ["10 mm", "30 mm", "30 mm"]', 'point = ["10 mm", "30 mm", "67 mm"]'))
+    with pytest.raises(DeckError, match="is not in body 'block'"):
+        build_gauges(far, build_stepper(far).parts)

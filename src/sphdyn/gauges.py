@@ -108,18 +108,20 @@ def _candidates(deck, parts, spec):
 
 def _nearest(deck, parts, spec, where: str, point) -> tuple[int, int]:
     """The item nearest to ``point`` at the start, within one spacing of it."""
-    best = (math.inf, -1, -1)
+    best = (math.inf, -1, -1, None)
     for pk, idx in _candidates(deck, parts, spec):
         if not idx.size:
             continue
         d = np.linalg.norm(parts[pk].kin.x0[idx] - np.asarray(point), axis=1)
         k = int(np.argmin(d))
         if d[k] < best[0]:
-            best = (float(d[k]), pk, int(idx[k]))
-    dist, pk, i = best
+            best = (float(d[k]), pk, int(idx[k]), idx)
+    dist, pk, i, idx = best
     if pk >= 0:
+        # the spacing among the gauge's own items (a bar's sublayer particles
+        # beside a concrete particle are not the concrete's spacing)
         x0 = parts[pk].kin.x0
-        others = np.delete(np.arange(parts[pk].kin.n), i)
+        others = idx[idx != i]
         spacing = float(np.min(np.linalg.norm(x0[others] - x0[i], axis=1))) \
             if others.size else math.inf
         if dist <= spacing:
