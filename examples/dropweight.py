@@ -22,7 +22,9 @@ against h(t) = g t^2 / 2, and the support reactions against the weight.
 
     python examples/dropweight.py [--reuse] [--full | --gravity]
 
-``--reuse`` draws the runs found in out/ and runs nothing.
+``--reuse`` draws the runs found in out/ and runs nothing. Runs of the decks
+as they were before their stirrups (:data:`EARLIER`), if found in out/, are
+drawn dashed for comparison.
 """
 
 from __future__ import annotations
@@ -40,6 +42,12 @@ RUNS = {
     "dropweight_coarse_rate": ("dropweight_coarse.toml", ["material.0.rate_effects=true"],
                                "dx 12 mm, rate effects"),
     "dropweight": ("dropweight.toml", [], "dx 6 mm, no rate effects"),
+}
+#: runs drawn dashed when found in out/ but not made by this script: the coarse
+#: deck as it was before its stirrups (git show 829f472:examples/dropweight_coarse.toml)
+EARLIER = {
+    "dropweight_coarse_nostirrups": "dx 12 mm, no stirrups (decks of 829f472)",
+    "dropweight_coarse_rate_nostirrups": "dx 12 mm, rate effects, no stirrups (829f472)",
 }
 
 
@@ -148,6 +156,10 @@ def main() -> None:
     from sphdyn.simulation import run_examples
 
     outs = run_examples(ROOT, RUNS, "dropweight", reuse=a.reuse, include_full=a.full)
+    labels = {name: RUNS[name][2] for name in outs}
+    for name, label in EARLIER.items():
+        if (ROOT / "out" / name / "summary.json").exists():
+            outs[name], labels[name] = ROOT / "out" / name, label
     fig = plt.figure(figsize=(11, 10), layout="constrained")
     grid = fig.add_gridspec(3, 1, height_ratios=[1, 1, 0.9])
     ax_s, ax_d = fig.add_subplot(grid[0]), fig.add_subplot(grid[1])
@@ -155,9 +167,10 @@ def main() -> None:
     for name, out in outs.items():
         strain = read_history_csv(out / "gauges" / "top_strain.csv")
         disp = read_history_csv(out / "gauges" / "midspan.csv")
-        label = RUNS[name][2]
-        ax_s.plot(1e3 * strain["time"], 1e6 * strain["strain"], label=label)
-        ax_d.plot(1e3 * disp["time"], 1e3 * disp["displacement_z"], label=label)
+        label = labels[name]
+        style = "--" if name in EARLIER else "-"
+        ax_s.plot(1e3 * strain["time"], 1e6 * strain["strain"], style, label=label)
+        ax_d.plot(1e3 * disp["time"], 1e3 * disp["displacement_z"], style, label=label)
         h = read_history_csv(out / "history.csv")
         summary = json.loads((out / "summary.json").read_text())
         k, j = np.argmin(disp["displacement_z"]), np.argmax(np.abs(strain["strain"]))
@@ -179,7 +192,7 @@ def main() -> None:
     ax = fig.add_subplot(grid[2])
     im = ax.imshow(img, origin="lower", cmap="inferno_r", vmin=0, vmax=1,
                    extent=(0, img.shape[1] * dx * 1e3, 0, img.shape[0] * dx * 1e3))
-    ax.set_title(f"Damage at the end, {RUNS[first][2]} (thesis Fig. 8.5; max across "
+    ax.set_title(f"Damage at the end, {labels[first]} (thesis Fig. 8.5; max across "
                  "the width)")
     ax.set_xlabel("x [mm]")
     ax.set_ylabel("z [mm]")
