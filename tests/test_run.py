@@ -228,7 +228,7 @@ def test_cli_bench_hvi_projects_the_event_time(capsys):
     assert main(["bench", "hvi", "--coarse", "--steps", "3"]) == 0
     rec = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
     assert rec["case"] == "hvi" and rec["deck"].endswith("dropweight_coarse.toml")
-    assert rec["particles"] == 35397 and rec["t_end"] == 0.02
+    assert rec["particles"] == 36177 and rec["t_end"] == 0.02  # 35,397 + 780 stirrup nodes
     assert rec["event_steps"] == pytest.approx(rec["t_end"] / rec["dt"], rel=1e-12)
     assert rec["projected_event_seconds"] == pytest.approx(
         rec["event_steps"] * rec["seconds"] / rec["steps"], rel=1e-12)
