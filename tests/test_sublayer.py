@@ -347,7 +347,9 @@ def test_closed_stirrups_from_a_deck_keep_their_mass_and_loops():
     the pull-out block: 64 nodes, each in two elements (closed loops), copies
     20 mm apart; nodes and particles carry rho A x 4 x 160 mm (1e-12), the
     particles half of it, each on its node."""
-    st = build_stepper(loads_deck(deck_text(sets="") + STIRRUPS))
+    deck = loads_deck(deck_text(sets="") + STIRRUPS)
+    assert deck.mesh[1].line.count == 4 * 16  # what the memory estimate counts
+    st = build_stepper(deck)
     bar, sph = st.part("stirrups"), st.part("sph")
     assert bar.kin.n == 64 and np.array_equal(np.bincount(bar.elements.conn.ravel()),
                                                np.full(64, 2))

@@ -497,9 +497,7 @@ def polyline_mesh(points, counts, closed: bool = False, copies: int = 1,
     return MeshData(points_all, cells_all, "line2",
                     node_sets={"all": np.arange(n * copies), "start": starts,
                                "end": np.sort(ends)},
-                    element_sets={"all": np.arange(e * copies)},
-                    source="line_mesh" if len(pts) == 2 and not closed and copies == 1
-                    else "polyline_mesh")
+                    element_sets={"all": np.arange(e * copies)}, source="polyline_mesh")
 
 
 # --------------------------------------------------------------------------

@@ -62,19 +62,30 @@ def gather_nodes(x, v, s, conn, lo, nl, S):
 
 
 @njit(cache=True, error_model="numpy")
+def velocity_moments(S, row):
+    r"""Rows ``row`` .. ``row + 8`` (i, j row-major): :math:`\sum_I v_{iI}\,
+    \partial V/\partial x_{jI}` [m^3/s] from rows VN_ and G_ (the velocity
+    gradient times V)."""
+    for i in range(3):
+        for j in range(3):
+            for l in range(LANES):
+                s = 0.0
+                for I in range(8):
+                    s += S[(VN_ + 3 * I + i) * LANES + l] * S[(G_ + 3 * I + j) * LANES + l]
+                S[(row + 3 * i + j) * LANES + l] = s
+
+
+@njit(cache=True, error_model="numpy")
 def rate_lanes(S):
     r"""Rows INV_ (1/V, 0 if V <= 0) and L_ (:math:`L_{ij} = \sum_I v_{iI}\,
     \partial V/\partial x_{jI} / V`) from rows VN_, G_, VOL_."""
+    velocity_moments(S, L_)
     for l in range(LANES):
         vm = S[VOL_ * LANES + l]
         inv = 1.0 / vm if vm > 0.0 else 0.0
         S[INV_ * LANES + l] = inv
-        for i in range(3):
-            for j in range(3):
-                s = 0.0
-                for I in range(8):
-                    s += S[(VN_ + 3 * I + i) * LANES + l] * S[(G_ + 3 * I + j) * LANES + l]
-                S[(L_ + 3 * i + j) * LANES + l] = s * inv
+        for r in range(9):
+            S[(L_ + r) * LANES + l] *= inv
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
@@ -104,8 +115,8 @@ def hex_strain_rate(x, v, conn, active, m_el, dt, L, rho, work):
 
 @njit(cache=True, error_model="numpy")
 def gather_fields(sig, L, rho, c, hg, lo, nl, stiffness, S):
-    """Rows SIG_, DKK_, RHO_, C_ (and HG_ for the stiffness form) of elements
-    ``lo`` .. ``lo + nl - 1``, padded as :func:`gather_nodes`."""
+    """Rows SIG_, DKK_, RHO_, C_ and FACE_ (viscous form) or HG_ (stiffness form)
+    of elements ``lo`` .. ``lo + nl - 1``, padded as :func:`gather_nodes`."""
     for l in range(LANES):
         e = lo + min(l, nl - 1)
         for i in range(3):
@@ -114,9 +125,9 @@ def gather_fields(sig, L, rho, c, hg, lo, nl, stiffness, S):
         S[DKK_ * LANES + l] = L[e, 0, 0] + L[e, 1, 1] + L[e, 2, 2]
         S[RHO_ * LANES + l] = rho[e]
         S[C_ * LANES + l] = c[e]
-        V = S[VOL_ * LANES + l]
-        S[FACE_ * LANES + l] = np.cbrt(V) ** 2  # V^(2/3) for the viscous form
-        if stiffness:
+        if not stiffness:  # V^(2/3) of the viscous form (a libm call: only if used)
+            S[FACE_ * LANES + l] = np.cbrt(S[VOL_ * LANES + l]) ** 2
+        else:
             for a in range(4):
                 for k in range(3):
                     S[(HG_ + 3 * a + k) * LANES + l] = hg[e, a, k]
@@ -159,14 +170,10 @@ def force_lanes(S, hg_form, qh, q1, q2, dt):
         S[INVV_ * LANES + l] = 1.0 / V if hourglass else 0.0
         S[POWER_ * LANES + l] = 0.0
     # hourglass_resultants: Lb = sum_I v_I (x) g_I (no 1/V), h_a = sum_J Gamma_aJ x_J / V
-    for i in range(3):
-        for j in range(3):
-            for l in range(LANES):
-                s = 0.0
-                for I in range(8):
-                    s += S[(VN_ + 3 * I + i) * LANES + l] * S[(G_ + 3 * I + j) * LANES + l]
-                S[(LB_ + 3 * i + j) * LANES + l] = s
-                S[(M_ + 3 * i + j) * LANES + l] = 0.0
+    velocity_moments(S, LB_)
+    for r in range(9):
+        for l in range(LANES):
+            S[(M_ + r) * LANES + l] = 0.0
     for a in range(4):
         for l in range(LANES):
             h0 = h1 = h2 = 0.0
