@@ -119,6 +119,44 @@ def test_raw_gradient_is_the_pair_sum_of_the_stored_factors(dim, kernel):
         assert np.all(F[lo + count[i]:hi] == 0.0)
 
 
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("kernel", ["cubic_spline", "quintic_spline"])
+def test_correction_is_the_inverse_moment_matrix_of_the_stored_factors(dim, kernel):
+    """With the correction, B_i = M_i^-1 with the moment matrix written out in
+    NumPy from the pass's stored factors, M_i = sum_j (m_j / rho_i) (x_j - x_i)
+    (x) F_ij (x_i - x_j) (symmetric: B is, exactly), and L_i = L_raw,i B_i, to
+    1e-12 relative (round-off of the sums and of a 3x3 inverse of condition
+    ~10). Both compiled forms of the pass: the 3D cubic spline's (constants)
+    and the general one (the quintic, and 2D). A wrong sign, weight or a
+    transposed entry of M fails it at O(1) on this jittered, unequal cloud."""
+    c = _cloud(dim, n_side=8 if dim == 3 else 12, kernel=kernel, jitter=0.3, seed=5)
+    rng = np.random.default_rng(11)
+    n = c["x"].shape[0]
+    c["h"] = c["h"] * rng.uniform(0.8, 1.2, n)
+    c["m"] = c["m"] * rng.uniform(0.5, 1.5, n)
+    c["rho"] = c["rho"] * rng.uniform(0.9, 1.1, n)
+    q = kernels.support(c["kid"])
+    c["nl"] = nl = build_neighbours(c["x"], c["h"], q, 0.2 * q * c["h"].max(), dim)
+    v = rng.normal(size=(n, 3))
+    v[:, dim:] = 0.0
+    L, B, F, count = _grad(c, v, True, with_factors=True)
+    assert np.array_equal(B, B.transpose(0, 2, 1))
+    x, m, rho = c["x"], c["m"], c["rho"]
+    for i in range(n):
+        lo = nl.offsets[i]
+        j = nl.idx[lo:lo + count[i]]
+        f = F[lo:lo + count[i]].astype(float) * (m[j] / rho[i])
+        d = x[i] - x[j]
+        M = -(d[:, :, None] * (f[:, None] * d)[:, None, :]).sum(axis=0)
+        M[dim:, :] = 0.0
+        M[:, dim:] = 0.0
+        M[dim:, dim:] = np.eye(3 - dim)
+        Q = np.linalg.inv(M)
+        assert np.abs(B[i] - Q).max() <= 1e-12 * np.abs(Q).max(), i
+        raw = ((v[j] - v[i])[:, :, None] * (f[:, None] * d)[:, None, :]).sum(axis=0)
+        assert np.abs(L[i] - raw @ Q).max() <= 1e-12 * np.abs(raw).max() * np.abs(Q).max(), i
+
 @pytest.mark.parametrize("dim", [1, 2, 3])
 @pytest.mark.parametrize("jitter", [0.0, 0.3])
 def test_linear_velocity_everywhere_with_correction(dim, jitter):

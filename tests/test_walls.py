@@ -93,6 +93,33 @@ def test_spring_acceleration_and_force_match_the_paper(dim, method, alpha):
     assert np.all(f[3] == 0.0) and np.abs(a[3] - 7.0).max() > 0.0  # zero mass: pushed, no force
 
 
+@pytest.mark.parametrize("dim", [1, 2, 3])
+def test_contact_decided_at_the_thickness_edge_as_the_formula_says(dim):
+    # The kernel rejects far particles by gap^d > 1.000001 f^d V before it
+    # takes the root t = f V^(1/d). Particles within 1e-3 .. 1e-15 relative
+    # of the edge, on both sides, must be in contact exactly when
+    # t - gap > 0 as NumPy evaluates it (same bits: the root and the
+    # subtraction are the kernel's), and far ones (gap 1.01 t) out.
+    rng = np.random.default_rng(dim)
+    n = 400
+    vol0 = (1e-3 * rng.uniform(0.5, 2.0, n)) ** dim
+    t = THICKNESS * vol0 ** (1.0 / dim)
+    rel = np.concatenate([rng.choice([-1.0, 1.0], n - 20) * 10.0 ** rng.uniform(-15, -3, n - 20),
+                          np.full(10, 0.01), np.zeros(10)])
+    gap = t * (1.0 + rel)
+    x = np.zeros((n, 3))
+    x[:, 1] = gap
+    one = np.ones(n)
+    a, f = np.zeros((n, 3)), np.zeros((n, 3))
+    count = wall_contact(x, np.zeros((n, 3)), one, vol0, 2400.0 * one, 1e10 * one, dim,
+                         np.zeros(3), np.array([0.0, 1.0, 0.0]), np.zeros(3), THICKNESS,
+                         STIFFNESS_MASS, 0.1, 0.0, DT, a, f)
+    touching = (THICKNESS * vol0 ** (1.0 / dim) - gap) > 0.0
+    assert 0 < touching.sum() < n - 10
+    assert count == touching.sum()
+    assert np.array_equal(a[:, 1] > 0.0, touching)
+
+
 def test_mass_spring_in_numbers():
     # The mass-based law in plain numbers, independent of the helper above:
     # alpha = 0.1, dt = 1e-7 s, penetration 0.1 mm -> a = 0.1 * 1e-4 / 1e-14

@@ -16,7 +16,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .base import InteractionBase
-from .wall_contact import STIFFNESS_BULK, STIFFNESS_MASS, bulk_contact_time_step, wall_contact
+from .wall_contact import (STIFFNESS_BULK, STIFFNESS_MASS, bulk_contact_time_step, column_sums,
+                           wall_contact)
 
 STIFFNESS = {"mass": STIFFNESS_MASS, "bulk": STIFFNESS_BULK}
 
@@ -96,7 +97,7 @@ class Wall(InteractionBase):
             p.x, p.v, p.m, p.vol0, p.rho0, getattr(p, self._kbulk_name), p.dim,
             w.point_at(t), w.normal, w.velocity_at(t), w.thickness_factor, w.method,
             w.alpha, w.friction, dt, a_out, p.wall_force))
-        self.total = p.wall_force.sum(axis=0)
+        column_sums(p.wall_force, self.total)
 
     def after_kick(self, dt_kick: float) -> None:
         self.impulse += self.total * dt_kick

@@ -74,6 +74,24 @@ def spring_acceleration(pen, method, alpha, dt, kbulk, vol0, rho0, dim):
     return k * pen / (rho0 * vol0)
 
 
+@njit(cache=True, error_model="numpy")
+def column_sums(a, out):
+    """``out[k] = sum_i a[i, k]`` for ``a`` (N, 3), row by row in order: the
+    bits of NumPy's ``a.sum(axis=0)`` (which adds a C-ordered array's rows in
+    turn), without its per-row inner-loop call (1 ms at 100k rows, a tenth
+    of a hex3d step). ``out`` (3,) out."""
+    s0 = 0.0
+    s1 = 0.0
+    s2 = 0.0
+    for i in range(a.shape[0]):
+        s0 += a[i, 0]
+        s1 += a[i, 1]
+        s2 += a[i, 2]
+    out[0] = s0
+    out[1] = s1
+    out[2] = s2
+
+
 @njit(cache=True, error_model="numpy", parallel=True)
 def wall_contact(x, v, m, vol0, rho, kbulk, dim, point, normal, wall_v,
                  thickness_factor, method, alpha, friction, dt, a_contact, force):
@@ -99,12 +117,20 @@ def wall_contact(x, v, m, vol0, rho, kbulk, dim, point, normal, wall_v,
     """
     n = x.shape[0]
     count = 0
+    # gap^d > f^d V (with a margin far above the root's rounding) means
+    # gap > f V^(1/d): out of contact without the root (a libm call per
+    # particle, most of the pass when few touch)
+    far = 1.000001 * thickness_factor ** dim
     for i in prange(n):
         force[i, 0] = 0.0
         force[i, 1] = 0.0
         force[i, 2] = 0.0
         gap = ((x[i, 0] - point[0]) * normal[0] + (x[i, 1] - point[1]) * normal[1]
                + (x[i, 2] - point[2]) * normal[2])
+        if gap > 0.0:
+            gd = gap if dim == 1 else (gap * gap if dim == 2 else gap * gap * gap)
+            if gd > far * vol0[i]:
+                continue
         pen = contact_thickness(vol0[i], dim, thickness_factor) - gap
         if pen <= 0.0:
             continue

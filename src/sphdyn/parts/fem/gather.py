@@ -27,24 +27,25 @@ def node_element_list(conn: np.ndarray, n_nodes: int) -> tuple[np.ndarray, np.nd
 def gather_loads(fe, col, offsets, slots, m, a):
     r"""Node accelerations :math:`\mathbf a_n = \sum_{(e, I)\ni n} \mathbf f_{eI} / m_n`.
 
-    ``fe`` (E, nen, k) element nodal loads; the three columns ``col:col+3``
+    ``fe`` (E, nen, k) element nodal loads (C-contiguous); the three columns ``col:col+3``
     are gathered (forces [N] with masses [kg]; for beams also moments [N m]
     with rotary inertias [kg m^2]); ``offsets`` (N+1,) and ``slots`` the
     node-to-element list (:func:`node_element_list`); ``m`` (N,); ``a``
     (N, 3) out (0 where m = 0).
     """
-    nen = fe.shape[1]
+    # slot s = e * nen + I is row s of fe seen as (E * nen, k): no integer
+    # division per slot (it cost more than the loads)
+    width = fe.shape[2]
+    flat = fe.reshape(fe.shape[0] * fe.shape[1] * width)
     for n in prange(a.shape[0]):
         f0 = 0.0
         f1 = 0.0
         f2 = 0.0
         for k in range(offsets[n], offsets[n + 1]):
-            s = slots[k]
-            e = s // nen
-            I = s - e * nen
-            f0 += fe[e, I, col]
-            f1 += fe[e, I, col + 1]
-            f2 += fe[e, I, col + 2]
+            at = slots[k] * width + col
+            f0 += flat[at]
+            f1 += flat[at + 1]
+            f2 += flat[at + 2]
         inv = 1.0 / m[n] if m[n] > 0.0 else 0.0
         a[n, 0] = f0 * inv
         a[n, 1] = f1 * inv

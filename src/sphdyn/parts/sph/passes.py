@@ -65,6 +65,124 @@ def stress_terms(sig, rho, B, P):
             for b in range(3):
                 P[i, a, b] = s0 * B[i, 0, b] + s1 * B[i, 1, b] + s2 * B[i, 2, b]
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _gradient_row(i, x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_scale, correct,
+                  F, L, B, count):
+    """Row ``i`` of :func:`velocity_gradient` (its docstring); inlined into
+    each of the pass's compiled forms, where ``kid``, ``dim`` and ``correct``
+    may be constants."""
+    qmax = support_nb(kid)
+    l00 = l01 = l02 = l10 = l11 = l12 = l20 = l21 = l22 = 0.0
+    # the moment matrix (symmetric: its upper triangle)
+    m00 = m01 = m02 = m11 = m12 = m22 = 0.0
+    xi0 = x[i, 0]
+    xi1 = x[i, 1]
+    xi2 = x[i, 2]
+    vi0 = v[i, 0]
+    vi1 = v[i, 1]
+    vi2 = v[i, 2]
+    three = dim == 3
+    hi = h[i]
+    irho = 1.0 / rho[i]
+    head = offsets[i]  # next slot of the row's head (pairs within the support)
+    for k in range(offsets[i], offsets[i + 1]):
+        j = idx[k]
+        d0 = xi0 - x[j, 0]
+        d1 = xi1 - x[j, 1]
+        d2 = xi2 - x[j, 2] if three else 0.0
+        r2 = d0 * d0 + d1 * d1 + d2 * d2
+        hij = support_scale * 0.5 * (hi + h[j])
+        if r2 >= (qmax * hij) ** 2:
+            F[k] = 0.0
+            continue
+        # grad_factor with one division: sigma / h^(d+2) * w'(q)/q
+        ih = 1.0 / hij
+        ih2 = ih * ih
+        if dim == 1:
+            scale = sigma * ih2 * ih
+        else:
+            scale = sigma * ih2 * ih2
+            if three:
+                scale *= ih
+        # stored in single precision, and used as stored from here on
+        fk = np.float64(np.float32(scale * dwdq_over_q(kid, np.sqrt(r2) * ih)))
+        if k != head:  # swap with the first skin pair of the row
+            idx[k] = idx[head]
+            F[k] = 0.0
+            idx[head] = j
+        F[head] = fk
+        head += 1
+        f = fk * (m[j] * irho)
+        if f == 0.0:
+            continue
+        g0 = f * d0
+        g1 = f * d1
+        u0 = v[j, 0] - vi0
+        u1 = v[j, 1] - vi1
+        # components unrolled: the in-plane terms here and the z terms
+        # below (3D only) have the same shape (a deliberate pair)
+        l00 += u0 * g0
+        l01 += u0 * g1
+        l10 += u1 * g0
+        l11 += u1 * g1
+        if correct:  # (x_j - x_i) = -d
+            m00 -= d0 * g0
+            m01 -= d0 * g1
+            m11 -= d1 * g1
+        if three:
+            g2 = f * d2
+            u2 = v[j, 2] - vi2
+            l02 += u0 * g2
+            l12 += u1 * g2
+            l20 += u2 * g0
+            l21 += u2 * g1
+            l22 += u2 * g2
+            if correct:
+                m02 -= d0 * g2
+                m12 -= d1 * g2
+                m22 -= d2 * g2
+    count[i] = head - offsets[i]
+    # Q = M^{-1} (symmetric, as M is): L_true = L_raw Q, B = Q^T = Q
+    q00 = q11 = q22 = 1.0
+    q01 = q02 = q12 = 0.0
+    if correct:
+        if dim < 3:
+            m02 = m12 = 0.0
+            m22 = 1.0
+        if dim == 1:
+            m01 = 0.0
+            m11 = 1.0
+        c00 = m11 * m22 - m12 * m12
+        c01 = m02 * m12 - m01 * m22
+        c02 = m01 * m12 - m02 * m11
+        det = m00 * c00 + m01 * c01 + m02 * c02
+        if abs(det) > _DET_TOL:
+            inv = 1.0 / det
+            q00 = c00 * inv
+            q01 = c01 * inv
+            q02 = c02 * inv
+            q11 = (m00 * m22 - m02 * m02) * inv
+            q12 = (m02 * m01 - m00 * m12) * inv
+            q22 = (m00 * m11 - m01 * m01) * inv
+    L[i, 0, 0] = l00 * q00 + l01 * q01 + l02 * q02
+    L[i, 0, 1] = l00 * q01 + l01 * q11 + l02 * q12
+    L[i, 0, 2] = l00 * q02 + l01 * q12 + l02 * q22
+    L[i, 1, 0] = l10 * q00 + l11 * q01 + l12 * q02
+    L[i, 1, 1] = l10 * q01 + l11 * q11 + l12 * q12
+    L[i, 1, 2] = l10 * q02 + l11 * q12 + l12 * q22
+    L[i, 2, 0] = l20 * q00 + l21 * q01 + l22 * q02
+    L[i, 2, 1] = l20 * q01 + l21 * q11 + l22 * q12
+    L[i, 2, 2] = l20 * q02 + l21 * q12 + l22 * q22
+    B[i, 0, 0] = q00
+    B[i, 0, 1] = q01
+    B[i, 0, 2] = q02
+    B[i, 1, 0] = q01
+    B[i, 1, 1] = q11
+    B[i, 1, 2] = q12
+    B[i, 2, 0] = q02
+    B[i, 2, 1] = q12
+    B[i, 2, 2] = q22
+
 
 @njit(cache=True, error_model="numpy", parallel=True)
 def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_scale, correct,
@@ -82,7 +200,18 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
     linear velocity field is differentiated exactly at every particle that
     has a non-degenerate neighbourhood (Randles & Libersky 1996). In 2D the
     z row and column of the moment matrix are set to the identity, in 1D
-    (uniaxial strain along x, every y and z zero) the y ones too.
+    (uniaxial strain along x, every y and z zero) the y ones too. The moment
+    matrix is symmetric, :math:`\sum_j (m_j/\rho_i) F_{ij}\, \mathbf d \otimes
+    \mathbf d` with :math:`\mathbf d = \mathbf x_i - \mathbf x_j`, so its six
+    distinct entries are summed (and ``B_i`` is symmetric), and only when the
+    correction is on.
+
+    Speed: the row's sums are kept in registers; the pass is compiled in
+    four forms (correction on or off, and the 3D cubic spline or any kernel
+    and dimension), picked outside the particle loop, so the common cases
+    carry no branch on the kernel or the dimension and no moment sums they
+    do not use (BENCHMARKS.md, 2026-11-26: a spilled sum cost more than its
+    arithmetic).
 
     The pass also stores the kernel-gradient factor of every pair,
 
@@ -127,127 +256,25 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
     count : (N,) int32 out, pairs within the support at the head of row i.
     """
     n = x.shape[0]
-    qmax = support_nb(kid)
-    for i in prange(n):
-        l00 = l01 = l02 = l10 = l11 = l12 = l20 = l21 = l22 = 0.0
-        m00 = m01 = m02 = m10 = m11 = m12 = m20 = m21 = m22 = 0.0
-        xi0 = x[i, 0]
-        xi1 = x[i, 1]
-        xi2 = x[i, 2]
-        vi0 = v[i, 0]
-        vi1 = v[i, 1]
-        vi2 = v[i, 2]
-        three = dim == 3
-        hi = h[i]
-        irho = 1.0 / rho[i]
-        head = offsets[i]  # next slot of the row's head (pairs within the support)
-        for k in range(offsets[i], offsets[i + 1]):
-            j = idx[k]
-            d0 = xi0 - x[j, 0]
-            d1 = xi1 - x[j, 1]
-            d2 = xi2 - x[j, 2] if three else 0.0
-            r2 = d0 * d0 + d1 * d1 + d2 * d2
-            hij = support_scale * 0.5 * (hi + h[j])
-            if r2 >= (qmax * hij) ** 2:
-                F[k] = 0.0
-                continue
-            # grad_factor with one division: sigma / h^(d+2) * w'(q)/q
-            ih = 1.0 / hij
-            ih2 = ih * ih
-            if dim == 1:
-                scale = sigma * ih2 * ih
-            else:
-                scale = sigma * ih2 * ih2
-                if three:
-                    scale *= ih
-            # stored in single precision, and used as stored from here on
-            fk = np.float64(np.float32(scale * dwdq_over_q(kid, np.sqrt(r2) * ih)))
-            if k != head:  # swap with the first skin pair of the row
-                idx[k] = idx[head]
-                F[k] = 0.0
-                idx[head] = j
-            F[head] = fk
-            head += 1
-            f = fk * (m[j] * irho)
-            if f == 0.0:
-                continue
-            g0 = f * d0
-            g1 = f * d1
-            u0 = v[j, 0] - vi0
-            u1 = v[j, 1] - vi1
-            # components unrolled: the in-plane terms here and the z terms
-            # below (3D only) have the same shape (a deliberate pair)
-            l00 += u0 * g0
-            l01 += u0 * g1
-            l10 += u1 * g0
-            l11 += u1 * g1
-            # (x_j - x_i) = -d
-            m00 -= d0 * g0
-            m01 -= d0 * g1
-            m10 -= d1 * g0
-            m11 -= d1 * g1
-            if three:
-                g2 = f * d2
-                u2 = v[j, 2] - vi2
-                l02 += u0 * g2
-                l12 += u1 * g2
-                l20 += u2 * g0
-                l21 += u2 * g1
-                l22 += u2 * g2
-                m02 -= d0 * g2
-                m12 -= d1 * g2
-                m20 -= d2 * g0
-                m21 -= d2 * g1
-                m22 -= d2 * g2
-        count[i] = head - offsets[i]
-        # inverse of the moment matrix M (L_true = L_raw M^{-1}, B = M^{-T})
-        q00 = 1.0
-        q01 = q02 = q10 = q12 = q20 = q21 = 0.0
-        q11 = 1.0
-        q22 = 1.0
+    # constants in the common forms (the cubic spline is kernel 0); the
+    # same row in each
+    if dim == 3 and kid == 0:
         if correct:
-            if dim < 3:
-                m02 = m12 = m20 = m21 = 0.0
-                m22 = 1.0
-            if dim == 1:
-                m01 = m10 = 0.0
-                m11 = 1.0
-            c00 = m11 * m22 - m12 * m21
-            c01 = m02 * m21 - m01 * m22
-            c02 = m01 * m12 - m02 * m11
-            det = m00 * c00 + m10 * c01 + m20 * c02
-            if abs(det) > _DET_TOL:
-                inv = 1.0 / det
-                q00 = c00 * inv
-                q01 = c01 * inv
-                q02 = c02 * inv
-                q10 = (m12 * m20 - m10 * m22) * inv
-                q11 = (m00 * m22 - m02 * m20) * inv
-                q12 = (m02 * m10 - m00 * m12) * inv
-                q20 = (m10 * m21 - m11 * m20) * inv
-                q21 = (m01 * m20 - m00 * m21) * inv
-                q22 = (m00 * m11 - m01 * m10) * inv
-        # L = L_raw Q with Q = M^{-1}
-        L[i, 0, 0] = l00 * q00 + l01 * q10 + l02 * q20
-        L[i, 0, 1] = l00 * q01 + l01 * q11 + l02 * q21
-        L[i, 0, 2] = l00 * q02 + l01 * q12 + l02 * q22
-        L[i, 1, 0] = l10 * q00 + l11 * q10 + l12 * q20
-        L[i, 1, 1] = l10 * q01 + l11 * q11 + l12 * q21
-        L[i, 1, 2] = l10 * q02 + l11 * q12 + l12 * q22
-        L[i, 2, 0] = l20 * q00 + l21 * q10 + l22 * q20
-        L[i, 2, 1] = l20 * q01 + l21 * q11 + l22 * q21
-        L[i, 2, 2] = l20 * q02 + l21 * q12 + l22 * q22
-        # B = Q^T
-        B[i, 0, 0] = q00
-        B[i, 0, 1] = q10
-        B[i, 0, 2] = q20
-        B[i, 1, 0] = q01
-        B[i, 1, 1] = q11
-        B[i, 1, 2] = q21
-        B[i, 2, 0] = q02
-        B[i, 2, 1] = q12
-        B[i, 2, 2] = q22
-
+            for i in prange(n):
+                _gradient_row(i, x, v, h, m, rho, offsets, idx, 0, sigma, 3, support_scale,
+                              True, F, L, B, count)
+        else:
+            for i in prange(n):
+                _gradient_row(i, x, v, h, m, rho, offsets, idx, 0, sigma, 3, support_scale,
+                              False, F, L, B, count)
+    elif correct:
+        for i in prange(n):
+            _gradient_row(i, x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_scale,
+                          True, F, L, B, count)
+    else:
+        for i in prange(n):
+            _gradient_row(i, x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_scale,
+                          False, F, L, B, count)
 
 @njit(cache=True, error_model="numpy", parallel=True)
 def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, dim, support_scale, alpha, beta,
