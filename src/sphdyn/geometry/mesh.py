@@ -496,7 +496,7 @@ def polyline_mesh(points, counts, closed: bool = False, copies: int = 1,
     ends = starts + (0 if closed else n - 1)
     return MeshData(points_all, cells_all, "line2",
                     node_sets={"all": np.arange(n * copies), "start": starts,
-                               "end": np.sort(ends)},
+                               "end": ends},
                     element_sets={"all": np.arange(e * copies)}, source="polyline_mesh")
 
 

@@ -30,11 +30,11 @@ import numpy as np
 from numba import njit, prange
 
 from ...geometry.shapes import hourglass_vectors
-from ...simd import sqrt
 from .hex_gradient import hex_volume_gradient_lanes
 from .lane_layout import (C_, COEF_, DKK_, DT_, F_, FACE_, G_, HEAT_, HG_, INV_, INVV_, L_, LANES,
                           LB_, M_, POWER_, Q_, QA_, RHO_, ROWS, SIG_, VN_, VOL_, X_)
-from .solid import HG_VISCOUS, block_count, block_span, bulk_viscosity, element_step
+from .solid import (HG_VISCOUS, block_count, block_span, bulk_viscosity, element_step,
+                     length_from_gradient)
 
 #: hourglass base vectors (4, 8) of the hex8, a compile-time constant
 GAMMA = hourglass_vectors(3)
@@ -156,7 +156,7 @@ def force_lanes(S, hg_form, qh, q1, q2, dt):
             g1 = S[(G_ + 3 * I + 1) * LANES + l]
             g2 = S[(G_ + 3 * I + 2) * LANES + l]
             bb += g0 * g0 + g1 * g1 + g2 * g2
-        ell = 2.0 * V / sqrt(8 * bb) if bb > 0.0 and V > 0.0 else 0.0  # char_length
+        ell = length_from_gradient(V, 8, bb)
         S[DT_ * LANES + l] = element_step(ell, c, dkk, q1, q2)
         q = bulk_viscosity(rho, c, ell, dkk, q1, q2)
         S[Q_ * LANES + l] = q

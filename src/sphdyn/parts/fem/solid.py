@@ -150,13 +150,22 @@ def volume_gradient(xl, dim, tab, g):
 
 @njit(cache=True, error_model="numpy")
 def char_length(g, vol):
-    r"""Characteristic length :math:`\ell = 2/\sqrt{n_{en}\sum b^2}`, :math:`b = g / V` [m]."""
+    r"""Characteristic length :math:`\ell = 2/\sqrt{n_{en}\sum b^2}`, :math:`b = g / V` [m]
+    (``g`` (nen, 3) the volume derivatives [m^2], ``vol`` [m^3])."""
     s = 0.0
     for I in range(g.shape[0]):
         s += g[I, 0] ** 2 + g[I, 1] ** 2 + g[I, 2] ** 2
+    return length_from_gradient(vol, g.shape[0], s)
+
+
+@njit(cache=True, error_model="numpy")
+def length_from_gradient(vol, nen, s):
+    r""":math:`\ell = 2 V/\sqrt{n_{en} s}` of :func:`char_length`, from ``s`` =
+    :math:`\sum_I |\partial V/\partial\mathbf x_I|^2` [m^4]; 0 for a degenerate
+    element (the lane passes sum ``s`` themselves)."""
     if s <= 0.0 or vol <= 0.0:
         return 0.0
-    return 2.0 * vol / sqrt(g.shape[0] * s)
+    return 2.0 * vol / sqrt(nen * s)
 
 
 #: elements per block of the one-point loops: a block's thread keeps the
