@@ -389,6 +389,35 @@ def test_group_kernel_matches_point_function_and_wave_speed():
     assert c[2] == pytest.approx(math.sqrt((K + 4 * G / 3) / 2400), rel=1e-12)
 
 
+def test_undamaged_wave_speed_switch_changes_the_wave_speed_only():
+    # wave_speed = "undamaged": c = sqrt((K + 4G/3)/rho) also where damage is
+    # 0.48-0.55 (tension, compression; LS-DYNA's constant moduli of a user material), the stress,
+    # damage and history bit for bit those of the default (damaged) run.
+    m = get_model("cscm")
+    runs = []
+    for switch in ("damaged", "undamaged"):
+        p = m.pack({**BASE, "wave_speed": switch})
+        n = 3
+        hist = np.tile(m.initial_history(p), (n, 1))
+        sig, L = np.zeros((n, 3, 3)), np.zeros((n, 3, 3))
+        L[:, 0, 0] = [2e-4, -3e-3, 1e-6]
+        rho = np.full(n, 2400.0)
+        e, c, dmg = np.zeros(n), np.zeros(n), np.zeros(n)
+        for _ in range(10):
+            m.update(np.arange(n), L, 1.0, rho, sig, e, c, dmg, hist, p, np.full(n, 0.01))
+        runs.append((sig, dmg, hist, e, c))
+    for a, b in zip(runs[0][:4], runs[1][:4]):
+        assert np.array_equal(a, b)
+    K, G = p[1], p[2]
+    dmg, c = runs[1][1], runs[1][4]
+    assert dmg[0] > 0.5 and dmg[1] > 0.4
+    assert np.array_equal(c, np.full(3, math.sqrt((K + 4 * G / 3) / 2400)))
+    assert runs[0][4][0] == pytest.approx(math.sqrt((1 - dmg[0]) * (K + 4 * G / 3) / 2400),
+                                          rel=1e-12)
+    with pytest.raises(ValueError, match="wave_speed"):
+        m.pack({**BASE, "wave_speed": "elastic"})
+
+
 @pytest.mark.parametrize("bhat", [-math.pi / 6, 0.1, math.pi / 6])
 def test_meridian_slope_is_the_derivative_of_the_meridian(bhat):
     # meridian_radius_slope: the value bit for bit that of meridian_radius,
@@ -580,3 +609,8 @@ def test_deck_keys_reach_the_parameters():
     assert g.params[mod.P_RATE_R0] == 0.0 and g0.params[mod.P_RATE_R0] == 1.0
     with pytest.raises(DeckError, match="recovery"):
         loads_deck(base.replace('model = "cscm"', 'model = "cscm"\nrecovery = 5'))
+    g = build_model(loads_deck(base.replace('model = "cscm"', 'model = "cscm"\n'
+                                            'wave_speed = "undamaged"'))).groups[0]
+    assert g.params[mod.P_WAVE_UNDAMAGED] == 1.0 and g0.params[mod.P_WAVE_UNDAMAGED] == 0.0
+    with pytest.raises(DeckError, match="wave_speed"):
+        loads_deck(base.replace('model = "cscm"', 'model = "cscm"\nwave_speed = "elastic"'))

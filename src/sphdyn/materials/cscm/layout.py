@@ -31,7 +31,8 @@ P_LI2B = _NEXT + 8       # derived: Li2(-B)
 P_RECOV_VOL = _NEXT + 9  # 1.0: RECOV option 2 (10-11), recovery needs compressive volume strain too
 P_RETRACT = _NEXT + 10   # 1.0: the cap retracts with dilation (ITRETRC = 1)
 P_RATE_R0 = _NEXT + 11   # 1.0: damage thresholds raised by the rate factor (with IRATE)
-N_PARAMS = _NEXT + 12
+P_WAVE_UNDAMAGED = _NEXT + 12  # 1.0: wave speed from the undamaged moduli
+N_PARAMS = _NEXT + 13
 
 HISTORY_NAMES = (
     "kappa", "plastic_vol_strain", "damage_brittle", "damage_ductile",

@@ -18,7 +18,8 @@ from ..registry import schema_defaults
 from .defaults import PARAM_NAMES, default_parameters
 from .layout import (H_KAPPA, H_RF, H_RFMAX, HISTORY_NAMES, N_PARAMS, P_DMAX_POWER,
                      P_ERODE, P_ERODE_STRAIN, P_INCRE, P_IRATE, P_J1APEX, P_KAPPA0,
-                     P_LI2B, P_RATE_R0, P_RECOV, P_RECOV_VOL, P_RETRACT, PARAM_INDEX)
+                     P_LI2B, P_RATE_R0, P_RECOV, P_RECOV_VOL, P_RETRACT, P_WAVE_UNDAMAGED,
+                     PARAM_INDEX)
 from .schema import CscmParams
 from .surface import kappa_from_cap, shear_surface
 
@@ -72,8 +73,9 @@ def cscm_parameters(values: dict) -> dict:
     pressure, or [10, 11]: option 2 = RECOV - 10 on the signs of pressure
     and volume strain), ``cap_retraction`` (ITRETRC), ``rate_thresholds``
     (with rate effects the damage thresholds scale with the dynamic
-    strength ratio, choice [D]). An absent key takes the default of the deck
-    table :class:`~sphdyn.materials.cscm.schema.CscmParams`. Two keys the
+    strength ratio, choice [D]), ``wave_speed`` ("damaged" or "undamaged").
+    An absent key takes the default of the deck table
+    :class:`~sphdyn.materials.cscm.schema.CscmParams`. Two keys the
     deck does not offer: ``incre`` (sub-increment strain limit, default from
     the strength, see :func:`pack_cscm`) and ``dmax_power`` (default 1).
     """
@@ -92,6 +94,10 @@ def cscm_parameters(values: dict) -> dict:
     out["density"] = get_float(values, "density", min_value=0.0, min_inclusive=False)
     for switch in ("rate_effects", "erode", "cap_retraction", "rate_thresholds"):
         out[switch] = bool(values.get(switch, default[switch]))
+    out["wave_speed"] = values.get("wave_speed", default["wave_speed"])
+    if out["wave_speed"] not in ("damaged", "undamaged"):
+        raise ValueError("material parameter 'wave_speed' must be \"damaged\" or "
+                         f"\"undamaged\", got {out['wave_speed']!r}")
     out["erode_strain"] = get_float(values, "erode_strain",
                                     default=default["erode_strain"], min_value=0.0)
     recov = get_float(values, "recovery", default=default["recovery"], min_value=0.0,
@@ -115,7 +121,7 @@ def pack_cscm(values: dict) -> np.ndarray:
 
     Layout ``[density, K, G] + PARAM_NAMES + [irate, erode, erode_strain,
     recovery, incre, dmax_power, kappa0, J1_apex, Li2(-B), recovery_mode,
-    cap_retraction, rate_thresholds]``. The default
+    cap_retraction, rate_thresholds, wave_speed_undamaged]``. The default
     sub-increment limit is ``incre = 0.25 (alpha - lamda) / (2 G)``, a quarter
     of the tensor shear strain at which the TXC surface is reached at zero
     pressure (LS-DYNA's INCRE default formula is not known, notes sec. 1.3:
@@ -133,6 +139,7 @@ def pack_cscm(values: dict) -> np.ndarray:
     p[P_RECOV_VOL] = 1.0 if v["recovery"] >= 10.0 else 0.0
     p[P_RETRACT] = 1.0 if v["cap_retraction"] else 0.0
     p[P_RATE_R0] = 1.0 if v["rate_thresholds"] else 0.0
+    p[P_WAVE_UNDAMAGED] = 1.0 if v["wave_speed"] == "undamaged" else 0.0
     p[P_DMAX_POWER] = v["dmax_power"]
     p[P_INCRE] = v.get("incre", 0.25 * (v["alpha"] - v["lamda"]) / (2.0 * v["G"]))
     p[P_J1APEX] = _apex(p)

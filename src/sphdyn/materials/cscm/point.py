@@ -20,7 +20,7 @@ from .layout import (H_DB, H_DD, H_EPS, H_ERODED, H_EV, H_KAPPA, H_R0C, H_R0T, H
                      P_DMAX_POWER, P_ERODE, P_ERODE_STRAIN, P_ETA0C, P_ETA0T, P_GFC,
                      P_GFS, P_GFT, P_INCRE, P_IRATE, P_J1APEX, P_LI2B, P_NC, P_NT,
                      P_OVERC, P_OVERT, P_PWRC, P_PWRT, P_RATE_R0, P_RECOV,
-                     P_RECOV_VOL, P_REPOW, P_RETRACT, P_SRATE)
+                     P_RECOV_VOL, P_REPOW, P_RETRACT, P_SRATE, P_WAVE_UNDAMAGED)
 from .projection import project_on_meridian, yield_fraction
 from .surface import (cap_from_compaction, invariants, j1_radius, kappa_from_cap, meridian,
                       meridian_radius, surely_elastic)
@@ -262,7 +262,9 @@ def cscm_update(idx, L, dt, rho, sig, e, c, damage, hist, params, size):
     :func:`cscm_point`; energy increment; ``damage[i]`` = total damage;
     ``c[i] = sqrt((1-d)(K + 4G/3)/rho)`` with the damaged moduli (``sqrt(K/rho)``
     with the undamaged K for an eroded point, which keeps a compressive
-    pressure). Shapes/units: ``base.KERNEL_SIGNATURE_DOC``.
+    pressure), or ``sqrt((K + 4G/3)/rho)`` with the switch ``wave_speed =
+    "undamaged"`` (``P_WAVE_UNDAMAGED``; eroded points as before).
+    Shapes/units: ``base.KERNEL_SIGNATURE_DOC``.
 
     The particles are dealt round-robin to ``N_STRIPES`` interleaved stripes
     (stripe ``t`` takes ``idx[t], idx[t + N_STRIPES], ...``) and the stripes
@@ -297,5 +299,7 @@ def _update_particle(i, L, dt, rho, sig, e, c, damage, hist, params, size):
     e[i] += energy_increment(s_old, s_new, d, dt, rho[i])
     if h[H_ERODED] > 0.0:
         c[i] = p_wave_speed(K, 0.0, rho[i])
+    elif params[P_WAVE_UNDAMAGED] > 0.0:
+        c[i] = p_wave_speed(K, G, rho[i])
     else:
         c[i] = p_wave_speed((1.0 - dmg) * K, (1.0 - dmg) * G, rho[i])

@@ -147,6 +147,14 @@ class CscmParams(MaterialSection):
         True, description="With rate_effects: the damage thresholds rise with "
                           "the dynamic strength ratio (docs/cscm.md, choice "
                           "[D]); false keeps them static.")
+    wave_speed: Literal["damaged", "undamaged"] = Field(
+        "damaged", description="Wave speed of the time step and of the "
+                               "viscosities (artificial, bulk, hourglass): "
+                               "sqrt((1-d)(K+4G/3)/rho) of the damaged moduli, "
+                               "or \"undamaged\" sqrt((K+4G/3)/rho), as LS-DYNA "
+                               "takes a user material's elastic moduli (a failed "
+                               "element keeps its hourglass and bulk viscosity; "
+                               "docs/cscm.md).")
     incre: Optional[real("strain increment", lo=0, lo_open=True)] = Field(
         None, description="Maximum strain sub-increment (default a quarter "
                           "of the zero-pressure shear yield strain).")
