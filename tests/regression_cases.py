@@ -136,11 +136,12 @@ def write(names: list[str], out: Path = DATA) -> None:
 
 def fresh_numba_env() -> dict:
     """The environment of a run whose kernels are all compiled in the process:
-    one thread and an empty Numba cache directory. A kernel loaded from
-    Numba's on-disk cache can differ in the last bits from one compiled in
-    the process (fastmath contraction across an inlined helper, seen in the
-    total-Lagrangian and coupling kernels), so the stored results and the
-    test both run this way."""
+    one thread and an empty Numba cache directory (no file of another
+    process's compiled kernels is read). A kernel loaded from the cache once
+    differed in the last bits from one compiled in the process (the
+    total-Lagrangian pair loops' fastmath licences, since removed;
+    tests/test_reproducible.py checks both ways agree); the stored results
+    and the test still both run this way."""
     env = dict(os.environ, NUMBA_NUM_THREADS="1")
     env["NUMBA_CACHE_DIR"] = tempfile.mkdtemp(prefix="sphdyn-regression-numba-")
     return env

@@ -18,6 +18,12 @@ pair factors stored in single precision (deliberate: memory; L and B are
 summed from the rounded factors, see passes.velocity_gradient). The decks
 whose results changed were rewritten; the others are bitwise as before. BENCHMARKS.md gives the effect on the coarse drop-weight's
 history.
+2026-11-26 (later): the total-Lagrangian pair loops lost their fastmath
+licences (a kernel compiled in the process and the same kernel loaded from
+the cache rounded differently: tests/test_reproducible.py); the ten decks with
+a total-Lagrangian body (beams, drop-weights, penetrations, rings) moved by
+round-off (1e-12 of each array's largest value and below; columns that vanish
+by symmetry by their own size) and were rewritten.
 """
 
 import subprocess

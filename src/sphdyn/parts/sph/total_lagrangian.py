@@ -35,13 +35,14 @@ from ...kernels import dwdq_over_q, kernel_value, support_nb
 
 _DET_TOL = 1e-12
 
-# Floating-point licences of the pair loops: reassociation (the sums may be
-# reordered and vectorised), fused multiply-add, reciprocal multiplication
-# and signed-zero freedom. No "nnan"/"ninf": NaN must still propagate to the
-# guards. Results differ from strict IEEE order at round-off level and stay
-# deterministic for a given build (restarts remain bitwise). Measured gain
-# on the 2D rings: about 1.5x on the force pass.
-PAIR_FASTMATH = {"reassoc", "contract", "arcp", "nsz"}
+# No floating-point licences (fastmath) in the pair loops: with reassociation
+# and contraction, LLVM's choices for a kernel compiled in the process differ
+# from those of the same kernel loaded from Numba's on-disk cache, so the same
+# deck gave other last bits in a fresh process than after a run had filled the
+# cache (the 600 m/s penetration then stopped in one and ran through in the
+# other: tests/test_reproducible.py). Strict IEEE order costs the 2D rings'
+# force pass about a third (BENCHMARKS.md).
+PAIR_FASTMATH = False
 
 
 @njit(cache=True, error_model="numpy")
