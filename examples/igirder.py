@@ -16,9 +16,10 @@ out/igirder_fem and out/igirder_sph with --reuse) and writes
 With ``--variants`` it also runs variants of the SPH model (deck overrides
 of :data:`VARIANTS`: the sublayer particles coupling only; a mass ratio of
 0.25) and of the FEM reference (:data:`FEM_VARIANTS`: selective-reduced
-hexes; one-point hexes of 5 mm, about an hour) into out/igirder_<variant>; variants found there are drawn dashed
-(dotted: FEM) and listed in the table, whose differences are taken to
-each FEM reference found.
+hexes; one-point hexes of 5 mm, 35 minutes alone) into
+out/igirder_<variant>; variants found there are drawn dashed (dotted: FEM)
+and listed in the table, whose differences are taken to each FEM reference
+found.
 
 The curves are averaged over a sliding window of 0.5 ms (about a tenth of
 the first bending period) before they are compared: the load rises in
