@@ -14,7 +14,6 @@ contact, eroded elements become particles).
 import os
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -24,8 +23,7 @@ CASES = ("rings_gray2001_total_lagrangian", "penetration_sph")
 
 def test_compiled_and_cached_kernels_give_the_same_bits(tmp_path):
     script = Path(__file__).with_name("regression_cases.py")
-    env = dict(os.environ, NUMBA_NUM_THREADS="1",
-               NUMBA_CACHE_DIR=tempfile.mkdtemp(prefix="sphdyn-repro-", dir=tmp_path))
+    env = dict(os.environ, NUMBA_NUM_THREADS="1", NUMBA_CACHE_DIR=str(tmp_path / "cache"))
     runs = []
     for k in range(2):
         out = tmp_path / f"run{k}"

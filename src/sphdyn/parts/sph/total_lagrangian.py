@@ -35,14 +35,13 @@ from ...kernels import dwdq_over_q, kernel_value, support_nb
 
 _DET_TOL = 1e-12
 
-# No floating-point licences (fastmath) in the pair loops: with reassociation
-# and contraction, LLVM's choices for a kernel compiled in the process differ
-# from those of the same kernel loaded from Numba's on-disk cache, so the same
-# deck gave other last bits in a fresh process than after a run had filled the
-# cache (the 600 m/s penetration then stopped in one and ran through in the
-# other: tests/test_reproducible.py). Strict IEEE order: the 2D rings' run
-# (17,608 particles) as fast as with the licences (BENCHMARKS.md).
-PAIR_FASTMATH = False
+# The pair loops carry no floating-point licences (fastmath): with
+# reassociation and contraction, LLVM's code for a kernel compiled in the
+# process and the same kernel loaded from Numba's on-disk cache rounded
+# differently, so a deck's last bits depended on whether the cache was warm
+# (the 600 m/s penetration stopped in one process and ran through in another:
+# tests/test_reproducible.py). Strict IEEE order costs the 2D rings nothing
+# measurable (BENCHMARKS.md).
 
 
 @njit(cache=True, error_model="numpy")
@@ -157,7 +156,7 @@ def reference_gradients(rows, X, h0, vol, offsets, idx, kid, sigma, dim, support
         gsum[i, 2] = s2
 
 
-@njit(cache=True, error_model="numpy", parallel=True, fastmath=PAIR_FASTMATH)
+@njit(cache=True, error_model="numpy", parallel=True)
 def deformation_gradient(rows, x, v, X, vol, offsets, idx, fac, B0, dim, Fdef, Finv, L):
     r"""Deformation gradient and velocity gradient from the reference kernel.
 
@@ -356,7 +355,7 @@ def _viscous_hourglass(fk, hk, d0, d1, d2, w0, w1, w2, s0, s1, s2, hij, csum, rh
     return mj * pi_ij * fk, coef
 
 
-@njit(cache=True, error_model="numpy", parallel=True, fastmath=PAIR_FASTMATH)
+@njit(cache=True, error_model="numpy", parallel=True)
 def tl_forces(rows, x, v, X, m, rho, rho0, c, h0, vol, offsets, idx, fac, hgk, gsum,
               P, Q, B0, Fdef, dim, av_alpha, av_beta, support_scale, a, dedt_av):
     r"""Acceleration of the total-Lagrangian scheme with hourglass control.
