@@ -24,6 +24,12 @@ the cache rounded differently: tests/test_reproducible.py); the ten decks with
 a total-Lagrangian body (beams, drop-weights, penetrations, rings) moved by
 round-off (1e-12 of each array's largest value and below; columns that vanish
 by symmetry by their own size) and were rewritten.
+2026-11-26 (session 8): igirder_sph, whose deck's sublayer moved to
+``stiffness = "axial"`` (deliberate, docs/examples.md), and igirder_fem,
+whose 40 coarse steps carry only round-off (the load ramps over 32 ms: the
+reactions are 1e-8 N) that this day's environment (numba 0.68.1, numpy
+2.4.6) rounds otherwise, the last commit's code included (checked on a
+clean worktree); every other case bitwise.
 """
 
 import subprocess

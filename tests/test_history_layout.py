@@ -30,6 +30,13 @@ def test_layout_puts_the_longest_first_shares_a_family_and_appends_the_rest():
     # a list that starts the columns so far shares them (one family)
     names, first = history_layout([_fake("a"), _fake("a", "b"), _fake("c")])
     assert names == ["a", "b", "c"] and first == {("a", "b"): 0, ("a",): 0, ("c",): 2}
+    # a run further on shares too: j2's plastic strain is the uniaxial bar's
+    # first column, behind CSCM's
+    from sphdyn.materials.uniaxial import UNIAXIAL
+    names, first = history_layout([j2, cscm, UNIAXIAL])
+    n = len(cscm.history_names)
+    assert names == list(cscm.history_names) + list(UNIAXIAL.history_names)
+    assert first[UNIAXIAL.history_names] == first[j2.history_names] == n
     # one name in two places cannot be found by name: refused
     with pytest.raises(ValueError, match=r"\['b'\] of two material models"):
         history_layout([_fake("a", "b"), _fake("b", "c")])

@@ -15,8 +15,12 @@ What is pinned here, with its tolerance:
   0.1 % at the end (quasi-static), the energy balance closes within 0.3 %
   of the external work, and the bar particles stay evenly spaced on their
   nodes (no clumping: the symptom of the tensile instability);
+* the particles' stiffness: "split" and "axial" divide the bar's E A between
+  elements and particles (1e-12); "axial" stresses act along the bar only;
+  every choice passes the pull-out's force and closes its books;
 * bad input: a bar outside the concrete, a mass ratio of 0, a sublayer on a
-  solid mesh: refused naming the field.
+  solid mesh, a split of a material that cannot be scaled: refused naming
+  the field.
 """
 
 from __future__ import annotations
@@ -252,8 +256,10 @@ def test_stress_scaled_j2_carries_the_same_fraction_of_the_stress_at_every_strai
     assert np.abs(scaled - f * full).max() < 1e-12 * np.abs(full).max()
 
 
-def test_split_stiffness_is_refused_for_a_bar_material_it_cannot_scale(tmp_path, capsys):
-    text = deck_text(ratio='0.5\nstiffness = "split"', sets="").replace(
+@pytest.mark.parametrize("stiffness", ["split", "axial"])
+def test_split_stiffness_is_refused_for_a_bar_material_it_cannot_scale(tmp_path, capsys,
+                                                                       stiffness):
+    text = deck_text(ratio=f'0.5\nstiffness = "{stiffness}"', sets="").replace(
         'model = "elastic"\ndensity = 7850.0\nE = "200 GPa"\nnu = 0.3',
         'model = "cscm"\ndensity = 7850.0\nfc = "30 MPa"\naggregate_size = "10 mm"')
     assert 'model = "cscm"\ndensity = 7850.0' in text
@@ -279,13 +285,16 @@ def test_zero_mass_ratio_and_a_solid_sublayer_are_refused(tmp_path, capsys):
         loads_deck(solid)
 
 
-def test_restart_with_a_sublayer_bar_is_bitwise(tmp_path):
+@pytest.mark.parametrize("stiffness", ["material", "axial"])
+def test_restart_with_a_sublayer_bar_is_bitwise(tmp_path, stiffness):
     """Stopped and restarted from its checkpoint, the pull-out gives the same
-    history, the bond-force column included, to the last bit."""
-    full = Simulation.from_deck(loads_deck(deck_text(t_end="0.6 ms")), tmp_path / "full")
+    history, the bond-force column included, to the last bit (the uniaxial
+    bar's axial stress and plastic strain are history columns)."""
+    text = deck_text(t_end="0.6 ms", ratio=f'0.5\nstiffness = "{stiffness}"')
+    full = Simulation.from_deck(loads_deck(text), tmp_path / "full")
     full.run()
     part = Simulation.from_deck(
-        loads_deck(deck_text(t_end="0.6 ms").replace("vtk = false",
+        loads_deck(text.replace("vtk = false",
                                                      "vtk = false\ncheckpoint_every = 200")),
         tmp_path / "part")
     part.run(max_steps=700)
@@ -306,15 +315,20 @@ def test_bar_particles_take_the_concretes_density():
     assert np.allclose(p.vol0[rows], p.m[rows] / 2400.0, rtol=1e-15)
 
 
-def test_sublayer_without_stiffness_carries_no_stress_and_still_transfers_the_pull(tmp_path):
-    """[mesh.sublayer] stiffness = "none": the bar's particles are in no
-    material group (stress and wave speed stay zero) and still pass the pull
-    to the concrete: the grip's, the bond's and the plate's forces agree
-    (1e-3, as with the material's stiffness). Without the particles' own steel
-    (a second bar of 0.5 x 7850/2400 = 1.6 times the bar's area through the
-    kernel) the same 0.2 mm pull needs less force."""
+def test_each_particle_stiffness_transfers_the_pull_and_orders_the_force(tmp_path):
+    """Every [mesh.sublayer] stiffness passes the pull to the concrete: the
+    grip's, the bond's and the plate's forces agree (1e-3) and the energy
+    closes (3e-3 of the work). "none": the particles are in no material group
+    (stress and wave speed stay zero). "axial": their stress acts along the
+    bar only (the off-axis components exactly zero, the bar along x) and
+    their wave speed is the bar's, sqrt(E (rho_c/rho_s) / rho), sqrt(E/rho_s)
+    at the seated density (1e-12). The same 0.2 mm
+    pull needs less force the less steel acts through the kernel: the full
+    steel (a second bar of 0.5 x 7850/2400 = 1.6 times the bar's area) >
+    split (the bar once, with the steel's transverse and shear stiffness in
+    the particles) > axial (the bar once, along it only) > none."""
     grips = {}
-    for stiffness in ("material", "none"):
+    for stiffness in ("material", "split", "axial", "none"):
         text = deck_text(ratio=f'0.5\nstiffness = "{stiffness}"')
         sim = Simulation.from_deck(loads_deck(text), tmp_path / stiffness)
         sim.run()
@@ -322,12 +336,48 @@ def test_sublayer_without_stiffness_carries_no_stress_and_still_transfers_the_pu
         grip = grips[stiffness] = h["grip_reaction_x"][-1]
         assert h["F_bar_sublayer_x"][-1] == pytest.approx(-grip, rel=1e-3)
         assert h["plate_reaction_x"][-1] == pytest.approx(-grip, rel=1e-3)
+        assert abs(h["E_total"][-1]) < 3e-3 * h["W_external"][-1]
         sph = sim.stepper.part("sph")
         rows = np.flatnonzero(sph.p.body == 1)
         if stiffness == "none":
             assert np.all(sph.p.sig[rows] == 0.0) and np.all(sph.p.c[rows] == 0.0)
             assert all(np.intersect1d(g.idx, rows).size == 0 for g in sph.groups)
-    assert 5e3 < grips["none"] < 0.9 * grips["material"]
+        if stiffness == "axial":
+            sig = sph.p.sig[rows]
+            assert np.abs(sig[:, 0, 0]).max() > 1e6
+            off = sig.copy()
+            off[:, 0, 0] = 0.0
+            assert np.all(off == 0.0)
+            young = 200e9 * 2400.0 / 7850.0  # the steel's, scaled to the seated density
+            assert np.allclose(sph.p.c[rows], np.sqrt(young / sph.p.rho[rows]), rtol=1e-12)
+    assert grips["material"] > grips["split"] > grips["axial"] > grips["none"] > 5e3
+
+
+def test_axial_stiffness_splits_the_bar_as_split_does():
+    """[mesh.sublayer] stiffness = "axial" (r = 0.25): the elements as with
+    "split" ((1 - r) of the steel's moduli and density, 1e-12); the particles
+    form one group of the uniaxial bar model with the steel's Young's modulus
+    times rho_c / rho_s (an elastic bar: no yield), so the bar counts once along
+    its axis (1e-12), and their direction columns hold the bar's axis after
+    the first step."""
+    from sphdyn.materials.uniaxial import H_DIRECTION, UNIAXIAL, young
+
+    r, E, rho_s, rho_c = 0.25, 200e9, 7850.0, 2400.0
+    st = build_stepper(loads_deck(deck_text(ratio=f'{r}\nstiffness = "axial"', sets="")))
+    bar, sph = st.part("bar"), st.part("sph")
+    p = sph.p
+    rows = np.flatnonzero(p.body == 1)
+    assert bar.E == pytest.approx((1 - r) * E, rel=1e-12)
+    own = [g for g in sph.groups if np.intersect1d(g.idx, rows).size]
+    assert len(own) == 1 and own[0].model is UNIAXIAL and np.array_equal(own[0].idx, rows)
+    assert young(own[0].params) == pytest.approx(rho_c / rho_s * E, rel=1e-12)
+    assert own[0].params[3] == np.inf
+    A, L = np.pi * 0.005 ** 2, 0.12
+    total = bar.E * A * L + np.sum(p.m[rows] / p.rho0[rows]) * young(own[0].params)
+    assert total == pytest.approx(E * A * L, rel=1e-12)
+    st.step()
+    col = own[0].column + H_DIRECTION
+    assert np.array_equal(p.hist[rows, col:col + 3], np.tile([1.0, 0.0, 0.0], (rows.size, 1)))
 
 
 STIRRUPS = """

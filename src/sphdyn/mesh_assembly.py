@@ -64,7 +64,7 @@ def mesh_part(deck, mm: MeshModel):
         if spec.sublayer is not None:  # the elements carry (1 - r) of the bar's mass
             keep = 1.0 - spec.sublayer.mass_ratio
             mat = deck.material[int(mm.mat[0])]
-            if spec.sublayer.stiffness == "split":  # ... and of its stiffness
+            if spec.sublayer.stiffness in ("split", "axial"):  # ... and of its stiffness
                 values = mat.stress_scaled(keep)  # (model checked by build_model)
             else:
                 values = dict(mat.values())

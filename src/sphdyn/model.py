@@ -25,6 +25,7 @@ from .deck.errors import format_problem
 from .detonation import light_explosives
 from .preflight import checked_lattices, support_radius
 from .materials import MaterialGroup, get_model, history_layout
+from .materials.uniaxial import UNIAXIAL, uniaxial_params
 from .mesh_model import MeshModel, build_meshes, mesh_node_set
 from .probes import Probe, quantity
 from .state import Particles
@@ -203,7 +204,9 @@ def build_model(deck) -> Model:
     mat_index = {m.name: k for k, m in enumerate(deck.material)}
     models = {m.name: get_model(m.model) for m in deck.material}
     params = {name: models[name].pack(m.values()) for name, m in mats.items()}
-    hist_names, first = history_layout(models.values())
+    axial = [UNIAXIAL] if any(mm.spec.sublayer.stiffness == "axial"
+                              for mm in sublayer_meshes(meshes)) else []
+    hist_names, first = history_layout([*models.values(), *axial])
     n_hist = len(hist_names)
 
     density_of = np.array([m.density for m in deck.material])
@@ -452,6 +455,9 @@ def _sublayer_groups(deck, meshes, particles: Particles, body_names: list[str],
       :math:`r A L_n`, the bar's share ``mass_ratio`` = r, and the elements
       carry the rest (:func:`sphdyn.mesh_assembly.mesh_part`). The particles'
       wave speed is the steel's, :math:`\sqrt{(\rho_c/\rho_s) M/\rho_c}`.
+    * ``"axial"``: as ``"split"``, with the uniaxial bar model
+      (:mod:`sphdyn.materials.uniaxial`) on those scaled parameters: the
+      stress acts along the bar only; wave speed :math:`\sqrt{E/\rho_s}`.
     """
     for mm in sublayer_meshes(meshes):
         stiffness = mm.spec.sublayer.stiffness
@@ -459,18 +465,21 @@ def _sublayer_groups(deck, meshes, particles: Particles, body_names: list[str],
             continue
         rows = np.flatnonzero(particles.body == body_names.index(f"{mm.name}_sublayer"))
         groups = [replace(g, idx=np.setdiff1d(g.idx, rows)) for g in groups]
-        if stiffness == "split":
+        if stiffness in ("split", "axial"):
             k = int(mm.mat[0])
             mat = deck.material[k]
             model = models[mat.name]
             if model.name not in SPLIT_MODELS:
                 raise DeckError([format_problem(
                     f"mesh[{mm.index}] '{mm.name}'.sublayer.stiffness",
-                    f"\"split\" scales the bar material's stresses, which model "
+                    f"\"{stiffness}\" scales the bar material's stresses, which model "
                     f"'{model.name}' does not allow", "use a bar material of model "
                     f"{' or '.join(SPLIT_MODELS)}, or stiffness = \"material\" or \"none\"")])
             values = mat.stress_scaled(float(particles.rho0[rows[0]]) / mat.density)
-            groups.append(MaterialGroup(f"{mat.name}@{mm.name}", model, model.pack(values),
+            packed = model.pack(values)
+            if stiffness == "axial":
+                model, packed = UNIAXIAL, uniaxial_params(model.name, packed)
+            groups.append(MaterialGroup(f"{mat.name}@{mm.name}", model, packed,
                                         rows.astype(np.int64), k,
                                         first[model.history_names]))
     return groups

@@ -43,12 +43,21 @@ particles by the ratio :math:`r` (the particles' share, :math:`0 < r < 1`;
 equal, 0.5, by default, as the thesis found best): the elements carry the
 density :math:`(1 - r)\rho_s` and each node's particle the mass
 :math:`r\,m^{lumped}_n` of the full density (:func:`sublayer_masses`).
+
+With ``stiffness = "axial"`` the particles' stress acts along the bar only
+(:mod:`sphdyn.materials.uniaxial`); the coupling writes each particle's bar
+direction into its history before each material update
+(:func:`bar_directions`).
 """
 
 from __future__ import annotations
 
-import numpy as np
+import math
 
+import numpy as np
+from numba import njit, prange
+
+from ..materials.uniaxial import H_DIRECTION, UNIAXIAL
 from ..state import BC_FREE, BC_SLAVE
 from .base import InteractionBase
 from .slaves import follow_masters, pass_on, set_pair_gradient, set_pairs_off
@@ -69,6 +78,43 @@ def sublayer_masses(x, conn, area, density, ratio):
     np.add.at(m, conn[:, 0], 0.5 * density * area * L)
     np.add.at(m, conn[:, 1], 0.5 * density * area * L)
     return ratio * m
+
+
+@njit(cache=True, error_model="numpy", parallel=True)
+def bar_directions(x, conn, offsets, slots, nodes, rows, hist, col):
+    r"""Unit direction of the bar at each of its nodes, into ``hist[rows[k],
+    col:col+3]``: :math:`\mathbf t_n \propto \sum_{e \ni n} \pm\mathbf u_e`, the
+    unit vectors :math:`\mathbf u_e` of the node's elements, each turned to
+    point as the first one (a bar's elements need no common orientation; the
+    stress :math:`s\,\mathbf t\otimes\mathbf t` does not depend on the sign).
+    On a straight bar it is the bar's axis; at a bend, the bisector.
+
+    ``x`` (N, 3) node positions [m], ``conn`` (E, 2), ``offsets`` (N+1,) and
+    ``slots`` the node-to-element list (slot ``2 e + I``), ``nodes`` and
+    ``rows`` (n,) each particle's node and row, ``hist`` (P, nh) out.
+    """
+    for k in prange(nodes.shape[0]):
+        n = nodes[k]
+        t0 = t1 = t2 = 0.0
+        r0 = r1 = r2 = 0.0  # the first element's direction
+        for j in range(offsets[n], offsets[n + 1]):
+            e = slots[j] // 2
+            a, b = conn[e, 0], conn[e, 1]
+            u0, u1, u2 = x[b, 0] - x[a, 0], x[b, 1] - x[a, 1], x[b, 2] - x[a, 2]
+            norm = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
+            u0, u1, u2 = u0 / norm, u1 / norm, u2 / norm
+            if j == offsets[n]:
+                r0, r1, r2 = u0, u1, u2
+            elif u0 * r0 + u1 * r1 + u2 * r2 < 0.0:
+                u0, u1, u2 = -u0, -u1, -u2
+            t0 += u0
+            t1 += u1
+            t2 += u2
+        norm = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
+        i = rows[k]
+        hist[i, col] = t0 / norm
+        hist[i, col + 1] = t1 / norm
+        hist[i, col + 2] = t2 / norm
 
 
 class SublayerCoupling(InteractionBase):
@@ -108,6 +154,10 @@ class SublayerCoupling(InteractionBase):
         self._mask(0, p.n)
         p.on_grow(self._mask)
         sph_part.pair_filters.append(self._pairs_off)
+        axial = [g for g in sph_part.groups if g.model is UNIAXIAL
+                 and np.isin(rows, g.idx).all()]
+        # the uniaxial bar's direction columns in the part's history, or -1
+        self.direction = axial[0].column + H_DIRECTION if axial else -1
         self.constrain(0.0, 0.0)
 
     def _mask(self, n_old: int, n_new: int) -> None:
@@ -122,6 +172,10 @@ class SublayerCoupling(InteractionBase):
                           p.v, p.m, p.rho, p.B, p.B, False, self.L_own)
         p.L[self.rows] -= self.L_own
         set_pairs_off(self.rows, self.own, sph.nl.offsets, sph.nl.idx, sph.F)
+        if self.direction >= 0:  # before the material update reads them
+            q = self.line
+            bar_directions(q.kin.x, q.elements.conn, q.ptr, q.ent, self.nodes, self.rows,
+                           p.hist, self.direction)
 
     def constrain(self, t: float, dt: float) -> None:
         p, q = self.part.p, self.line.kin

@@ -30,6 +30,7 @@ from .j2 import J2, J2Params, j2_point, j2_update
 from .cscm import CSCM, CscmParams, cscm_point, cscm_update
 from .explosive import HIGH_EXPLOSIVE, ExplosiveParams
 from .gas import GAS, GasParams
+from .uniaxial import UNIAXIAL, uniaxial_params
 
 __all__ = [
     "ENTRY_POINT_GROUP",
@@ -63,4 +64,6 @@ __all__ = [
     "ExplosiveParams",
     "GAS",
     "GasParams",
+    "UNIAXIAL",
+    "uniaxial_params",
 ]

@@ -67,12 +67,13 @@ def history_layout(models) -> tuple[list[str], dict[tuple[str, ...], int]]:
     """One history array for items of several material models.
 
     The models' column lists (``history_names``) are laid side by side: the
-    longest first, at column 0; a list that is the start of the columns so
-    far shares them (models of one family); any other follows the last
-    column. Returns the names of the columns and, per list of names, its
-    first column (:attr:`MaterialGroup.column`). Each item's model sees its
-    own columns from 0 (:meth:`MaterialGroup.history`), the others of its
-    row stay at zero. ``ValueError`` if a name would sit in two columns.
+    longest first, at column 0; a list that is a run of the columns so far
+    shares them (models of one family: j2's plastic strain is the first
+    column of the uniaxial bar's); any other follows the last column.
+    Returns the names of the columns and, per list of names, its first
+    column (:attr:`MaterialGroup.column`). Each item's model sees its own
+    columns from 0 (:meth:`MaterialGroup.history`), the others of its row
+    stay at zero. ``ValueError`` if a name would sit in two columns.
     """
     layouts = []
     for m in models:
@@ -81,8 +82,10 @@ def history_layout(models) -> tuple[list[str], dict[tuple[str, ...], int]]:
     names: list[str] = []
     first: dict[tuple[str, ...], int] = {}
     for layout in sorted(layouts, key=len, reverse=True):
-        if tuple(names[:len(layout)]) == layout:
-            first[layout] = 0
+        at = [s for s in range(len(names) - len(layout) + 1)
+              if tuple(names[s:s + len(layout)]) == layout]
+        if at:  # a run of the columns so far: shared
+            first[layout] = at[0]
             continue
         clash = sorted(set(layout) & set(names))
         if clash:
@@ -138,6 +141,9 @@ class MaterialModel:
         explosive's chemical energy, burned mass times ``E0 / rho0``), from
         their history rows ``hist`` (n, nh) and masses ``m`` (n,). The energy
         balance counts it as supplied (``E_chemical``).
+    modulus : callable or None
+        ``modulus(params) -> float``: the modulus M [Pa] of the model's wave
+        speed ``sqrt(M / rho)``; None: the P-wave modulus ``K + 4G/3``.
     """
 
     name: str
@@ -151,6 +157,7 @@ class MaterialModel:
     fluid: bool = False
     initial_state: Callable[[np.ndarray], tuple[float, float]] | None = None
     released_energy: Callable[[np.ndarray, np.ndarray, np.ndarray], float] | None = None
+    modulus: Callable[[np.ndarray], float] | None = None
 
     @property
     def n_history(self) -> int:
@@ -178,9 +185,9 @@ class MaterialModel:
         """Elastic shear modulus G [Pa]."""
         return float(params[P_G])
 
-    @staticmethod
-    def wave_speed(params: np.ndarray, rho: float) -> float:
-        """Longitudinal (P-wave) speed ``c = sqrt((K + 4G/3) / rho)`` [m/s].
+    def wave_speed(self, params: np.ndarray, rho: float) -> float:
+        """Longitudinal (P-wave) speed ``c = sqrt((K + 4G/3) / rho)`` [m/s], or
+        ``sqrt(M / rho)`` with the model's own ``modulus``.
 
         Parameters
         ----------
@@ -189,6 +196,8 @@ class MaterialModel:
         rho : float
             Density [kg/m^3], > 0.
         """
+        if self.modulus is not None:
+            return math.sqrt(self.modulus(params) / rho)
         return math.sqrt((params[P_K] + 4.0 * params[P_G] / 3.0) / rho)
 
 

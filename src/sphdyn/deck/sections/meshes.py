@@ -278,13 +278,16 @@ class Sublayer(Section):
     body: Optional[reference_to("body")] = Field(
         None, description="The concrete body the bar lies in (default: any): every "
                           "node must have one of its particles within its support.")
-    stiffness: Literal["material", "split", "none"] = Field(
+    stiffness: Literal["material", "split", "axial", "none"] = Field(
         "material", description="material: the particles carry their material's "
         "stress, so the bar's stiffness also acts through the kernel (each line of "
         "particles is a second bar of area mass_ratio A rho_steel / rho_concrete); "
         "split: the bar's stiffness and strength are split as its mass, the elements "
         "carry 1 - mass_ratio of them and the particles mass_ratio (their stresses "
         "scaled by rho_concrete / rho_steel), so the bar counts once; "
+        "axial: split, and the particles' stress acts along the bar only (a uniaxial "
+        "stress from the strain rate along the bar, as the elements': no transverse "
+        "or shear stiffness of steel in the concrete); "
         "none: coupling only, the particles carry no stress and the bar's stiffness "
         "is counted once, in the elements (docs/examples.md, \"igirder\").")
 
