@@ -15,9 +15,9 @@ out/igirder_fem and out/igirder_sph with --reuse) and writes
 
 With ``--variants`` it also runs variants of the SPH model (deck overrides
 of :data:`VARIANTS`: the sublayer particles coupling only; a mass ratio of
-0.25; the particles with the split steel's full 3D stress) and of the FEM reference (:data:`FEM_VARIANTS`: selective-reduced
-hexes; one-point hexes of 5 mm, 35 minutes alone) into
-out/igirder_<variant>; variants found there are drawn dashed (dotted: FEM)
+0.25; the particles with the split steel's full 3D stress) and of the FEM
+reference (:data:`FEM_VARIANTS`: selective-reduced hexes; one-point hexes of
+5 mm, 35 minutes alone) into out/igirder_<variant>; variants found there are drawn dashed (dotted: FEM)
 and listed in the table, whose differences are taken to each FEM reference
 found. Each drawing keeps its curves in docs/figures/igirder_curves.csv; with
 ``--reuse`` a variant whose output folder is gone is drawn from there (the
@@ -63,12 +63,18 @@ FEM_VARIANTS = {
 }
 
 
+def finished(out: Path) -> bool:
+    """The run in ``out`` reached its end (an interrupted one leaves a summary too)."""
+    summary = out / "summary.json"
+    return summary.exists() and json.loads(summary.read_text())["status"] == "completed"
+
+
 def run(model: str, reuse: bool) -> Path:
     """Run one deck or variant (unless ``reuse`` finds its output); its output folder."""
     from sphdyn.simulation import run_deck
 
     out = ROOT / "out" / f"igirder_{model}"
-    if not (reuse and (out / "summary.json").exists()):
+    if not (reuse and finished(out)):
         if model in VARIANTS:
             overrides = [o.format(bar=b) for o in VARIANTS[model][1] for b in BARS]
             run_deck(ROOT / "examples" / "igirder_sph.toml", out, overrides=overrides,
@@ -196,12 +202,12 @@ def main() -> None:
     fig.axes[-1].set_xlabel("x [mm]")
     fig.colorbar(im, ax=fig.axes[:2], shrink=0.8, label="damage (max across the width)")
     for name in (*FEM_VARIANTS, *VARIANTS):
-        if a.variants or (ROOT / "out" / f"igirder_{name}" / "summary.json").exists():
+        if a.variants or finished(ROOT / "out" / f"igirder_{name}"):
             out = run(name, not a.variants or a.reuse)
             curves[name] = curve(out)
             rows.append(table_row(name, out, *curves[name]))
-        elif a.reuse and saved_curve(name) is not None:  # its run is gone: the curve
-            curves[name] = saved_curve(name)
+        elif a.reuse and (saved := saved_curve(name)) is not None:  # its run is gone
+            curves[name] = saved
     ax = fig.add_subplot(grid[2])
     labels = {"fem": "pure FEM (one-point hexes)", "sph": "SPH + sublayer (axial, ratio 0.5)",
               **{k: v[0] for k, v in {**FEM_VARIANTS, **VARIANTS}.items()}}

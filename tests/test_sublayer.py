@@ -358,8 +358,8 @@ def test_axial_stiffness_splits_the_bar_as_split_does():
     "split" ((1 - r) of the steel's moduli and density, 1e-12); the particles
     form one group of the uniaxial bar model with the steel's Young's modulus
     times rho_c / rho_s (an elastic bar: no yield), so the bar counts once along
-    its axis (1e-12), and their direction columns hold the bar's axis after
-    the first step."""
+    its axis (1e-12), their wave speed is the bar's from the start (1e-12),
+    and their direction columns hold the bar's axis after the first step."""
     from sphdyn.materials.uniaxial import H_DIRECTION, UNIAXIAL, young
 
     r, E, rho_s, rho_c = 0.25, 200e9, 7850.0, 2400.0
@@ -372,6 +372,8 @@ def test_axial_stiffness_splits_the_bar_as_split_does():
     assert len(own) == 1 and own[0].model is UNIAXIAL and np.array_equal(own[0].idx, rows)
     assert young(own[0].params) == pytest.approx(rho_c / rho_s * E, rel=1e-12)
     assert own[0].params[3] == np.inf
+    # the first step's wave speed is the bar's (MaterialModel.modulus), 1e-12
+    assert np.allclose(p.c[rows], np.sqrt(young(own[0].params) / rho_c), rtol=1e-12)
     A, L = np.pi * 0.005 ** 2, 0.12
     total = bar.E * A * L + np.sum(p.m[rows] / p.rho0[rows]) * young(own[0].params)
     assert total == pytest.approx(E * A * L, rel=1e-12)

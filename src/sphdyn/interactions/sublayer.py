@@ -87,7 +87,8 @@ def bar_directions(x, conn, offsets, slots, nodes, rows, hist, col):
     unit vectors :math:`\mathbf u_e` of the node's elements, each turned to
     point as the first one (a bar's elements need no common orientation; the
     stress :math:`s\,\mathbf t\otimes\mathbf t` does not depend on the sign).
-    On a straight bar it is the bar's axis; at a bend, the bisector.
+    On a straight bar it is the bar's axis; at a bend, the mean tangent (it
+    bisects the two elements' directions).
 
     ``x`` (N, 3) node positions [m], ``conn`` (E, 2), ``offsets`` (N+1,) and
     ``slots`` the node-to-element list (slot ``2 e + I``), ``nodes`` and

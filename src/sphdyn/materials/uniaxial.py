@@ -59,7 +59,8 @@ HISTORY_NAMES = ("plastic_strain", "axial_stress", "bar_x", "bar_y", "bar_z")
 H_PLASTIC, H_STRESS, H_DIRECTION = 0, 1, 2
 
 
-def young(params: np.ndarray) -> float:
+@njit(cache=True, error_model="numpy")
+def young(params):
     """Young's modulus :math:`E = 9KG/(3K + G)` [Pa] of a packed vector."""
     K, G = params[P_K], params[P_G]
     return 9.0 * K * G / (3.0 * K + G)
@@ -97,8 +98,7 @@ def uniaxial_update(idx, L, dt, rho, sig, e, c, damage, hist, params, size):
     per ``i`` in ``idx`` the axial rate ``t . D t`` with ``t = hist[i, 2:5]``,
     :func:`axial_return`, ``sig[i] = s t t^T``, the energy increment and
     ``c[i] = sqrt(E / rho[i])``. ``damage`` and ``size`` are not used."""
-    K, G = params[P_K], params[P_G]
-    E = 9.0 * K * G / (3.0 * K + G)
+    E = young(params)
     sy, H = params[P_YIELD], params[P_HARDENING]
     for k in prange(idx.shape[0]):
         i = idx[k]
