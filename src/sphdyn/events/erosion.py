@@ -32,10 +32,15 @@ The new particles join their material's group of the SPH part, in the body
 ``body`` (an updated-Lagrangian body), and meet the remaining elements
 through any penalty coupling of the two parts, whose master faces follow
 the erosion (:meth:`~sphdyn.interactions.PenaltyCoupling.mesh_changed`).
-Until the next step computes their forces, their acceleration is the one
-their element's nodes had there, :math:`\sum_I N_I(\xi_o)\mathbf a_I`: the
-nodes keep theirs, so the rate of momentum of nodes and particles is that of
-the nodes before (:math:`\sum_o N_I(\xi_o)\, m_e/n_p = m_e/n_{en}`). The
+An element that fails gives no force in the step it fails in (LS-DYNA's
+practice; a crushed element's last force is the artefact it fails for): its
+nodal forces leave its nodes' accelerations first
+(:meth:`~sphdyn.parts.fem.SolidPart.withdraw_forces`; they sum to zero, so
+the momentum rate is unchanged). Until the next step computes their forces,
+the particles' acceleration is then the one their element's nodes have
+there, :math:`\sum_I N_I(\xi_o)\mathbf a_I`: the nodes keep theirs, so the
+rate of momentum of nodes and particles is that of the nodes before
+(:math:`\sum_o N_I(\xi_o)\, m_e/n_p = m_e/n_{en}`). The
 energies moved and removed are taken at the velocities after the coming
 half kick, :math:`\mathbf v + \tfrac{\Delta t}2\mathbf a`, where the
 stepper books its kinetic energy.
@@ -54,7 +59,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry.shapes import corner_signs, shape_functions
-from ..parts.fem.erosion_criteria import REASONS, erosion_flags, reference_gradients
+from ..parts.fem.erosion_criteria import (BY_TIME_STEP, REASONS, erosion_flags,
+                                          reference_gradients)
 from ..parts.fem.solid import block_scratch
 from ..state import BC_FREE
 
@@ -172,7 +178,15 @@ class ElementErosion:
         for code in np.unique(self.flags[new]):
             self.count[REASONS[int(code)]] += int(np.sum(self.flags[new] == code))
         dt_half = 0.5 * stepper.dt_prev  # the coming half kick
+        # a degenerate element (its step collapsed, crushed below
+        # MIN_VOLUME_RATIO or inverted) gives no force in its last step: that
+        # force is the artefact it fails for; what its loads held at the half
+        # kick's time level stays in its energy
+        degenerate = new[(self.flags[new] == BY_TIME_STEP)
+                         | (el.vol[new] < MIN_VOLUME_RATIO * el.vol0[new])]
+        held = s.withdraw_forces(degenerate, dt_half)
         m, kinetic, internal = s.element_books(new, dt_half)
+        internal[np.searchsorted(new, degenerate)] += held
         born = (self._particles(new, dt_half, kinetic, internal) if self.to == "particles"
                 else None)
         s.erode(new)
