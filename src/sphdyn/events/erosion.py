@@ -32,15 +32,18 @@ The new particles join their material's group of the SPH part, in the body
 ``body`` (an updated-Lagrangian body), and meet the remaining elements
 through any penalty coupling of the two parts, whose master faces follow
 the erosion (:meth:`~sphdyn.interactions.PenaltyCoupling.mesh_changed`).
-An element that fails gives no force in the step it fails in (LS-DYNA's
-practice; a crushed element's last force is the artefact it fails for): its
-nodal forces leave its nodes' accelerations first
+A degenerate element (eroded by the time-step rule, crushed below
+:data:`MIN_VOLUME_RATIO` of its volume, or inverted) gives no force in the
+step it fails in (LS-DYNA's practice; its last force is the artefact it
+fails for): its nodal forces leave its nodes' accelerations first
 (:meth:`~sphdyn.parts.fem.SolidPart.withdraw_forces`; they sum to zero, so
-the momentum rate is unchanged). Until the next step computes their forces,
-the particles' acceleration is then the one their element's nodes have
-there, :math:`\sum_I N_I(\xi_o)\mathbf a_I`: the nodes keep theirs, so the
-rate of momentum of nodes and particles is that of the nodes before
-(:math:`\sum_o N_I(\xi_o)\, m_e/n_p = m_e/n_{en}`). The
+the momentum rate is unchanged), and the kinetic energy they held at the
+coming half kick's time level goes with its internal energy. An element
+eroded at a sane shape keeps its loads for the step. Until the next step
+computes their forces, the particles' acceleration is then the one their
+element's nodes have there, :math:`\sum_I N_I(\xi_o)\mathbf a_I`: the
+nodes keep theirs, so the rate of momentum of nodes and particles is that of
+the nodes before (:math:`\sum_o N_I(\xi_o)\, m_e/n_p = m_e/n_{en}`). The
 energies moved and removed are taken at the velocities after the coming
 half kick, :math:`\mathbf v + \tfrac{\Delta t}2\mathbf a`, where the
 stepper books its kinetic energy.

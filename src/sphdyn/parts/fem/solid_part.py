@@ -285,9 +285,10 @@ class SolidPart:
         \Delta t_{1/2}\mathbf a'_n|^2)`, each node's split equally among the
         withdrawn elements on it.
 
-        An element that fails in a step gives no force in it (LS-DYNA's
-        practice): a crushed element's last force is the artefact it fails
-        for (at 800 m/s in the penetration deck, 1e12 m/s^2 on its nodes and
+        For an element that fails degenerate (crushed, inverted, its step
+        collapsed), which then gives no force in the step it fails in
+        (LS-DYNA's practice): its last force is the artefact it fails for
+        (at 800 m/s in the penetration deck, 1e12 m/s^2 on its nodes and
         44 kJ of kinetic energy from nothing). Each element's loads sum to
         zero (stress divergence, hourglass and bulk viscosity alike), so the
         momentum rate of the nodes is unchanged to round-off. The stepper
