@@ -18,10 +18,11 @@ of :data:`VARIANTS`: the sublayer particles coupling only; a mass ratio of
 0.25; the particles with the split steel's full 3D stress; corrected kernel
 gradients) and of the FEM reference (:data:`FEM_VARIANTS`: selective-reduced
 hexes; one-point hexes of 5 mm, 35 minutes alone) into out/igirder_<variant>;
-variants found there are drawn dashed (dotted: FEM) and listed in the table, whose differences are taken to each FEM reference
-found. Each drawing keeps its curves in docs/figures/igirder_curves.csv; with
-``--reuse`` a variant whose output folder is gone is drawn from there (the
-5 mm FEM girder takes 35 minutes to rerun).
+variants found there are drawn dashed (dotted: FEM) and listed in the table,
+whose differences are taken to each FEM reference found. Each drawing keeps
+its curves in docs/figures/igirder_curves.csv; with ``--reuse`` a variant
+whose output folder is gone is drawn from there (the 5 mm FEM girder takes
+35 minutes to rerun).
 
 The curves are averaged over a sliding window of 0.5 ms (about a tenth of
 the first bending period) before they are compared: the load rises in
