@@ -419,12 +419,15 @@ def test_undamaged_wave_speed_switch_changes_the_wave_speed_only():
 
 
 @pytest.mark.parametrize("bhat", [-math.pi / 6, 0.1, math.pi / 6])
-def test_meridian_slope_is_the_derivative_of_the_meridian(bhat):
-    # meridian_radius_slope: the value bit for bit that of meridian_radius,
-    # the slope against a central difference (step 1e-4 of |J1| + alpha:
-    # truncation ~h^2 F''', round-off ~eps F / h, both below 1e-6 of the
-    # slope scale) on the tensile part (Rubin ratios held, J1 < 0), the shear
-    # part (J1 in (0, L)) and the cap (L, X), with a hardened cap.
+def test_meridian_slope_and_curvature_are_the_derivatives_of_the_meridian(bhat):
+    # meridian_radius_curvature: the value bit for bit that of
+    # meridian_radius (value and slope those of meridian_radius_slope), the
+    # slope against a central difference of the value and the curvature
+    # against one of the slope (step 1e-4 of |J1| + alpha: truncation
+    # ~h^2 F''', round-off ~eps F / h, both below 1e-6 of the slope's scale
+    # and 1e-5 of the curvature) on the tensile part (Rubin ratios held,
+    # J1 < 0), the shear part (J1 in (0, L)) and the cap (L, X), with a
+    # hardened cap.
     p = packed()
     kappa = 60e6
     m = cscm.meridian(bhat, kappa, p)
@@ -434,13 +437,17 @@ def test_meridian_slope_is_the_derivative_of_the_meridian(bhat):
                              np.linspace(L, X, 12)[1:-2]])
     scale = cscm.shear_surface(0.0, p) / abs(apex)
     for J1 in points:
-        F, dF = cscm.meridian_radius_slope(J1, m, p)
+        F, dF, d2F = cscm.meridian_radius_curvature(J1, m, p)
         assert F == cscm.meridian_radius(J1, m, p)
+        assert (F, dF) == cscm.meridian_radius_slope(J1, m, p)
         h = 1e-4 * (abs(J1) + p[cscm.P_ALPHA])
         fd = (cscm.meridian_radius(J1 + h, m, p) - cscm.meridian_radius(J1 - h, m, p)) / (2 * h)
         assert dF == pytest.approx(fd, rel=1e-6, abs=1e-6 * scale)
-    assert cscm.meridian_radius_slope(apex - 1.0, m, p) == (0.0, 0.0)
-    assert cscm.meridian_radius_slope(X + 1.0, m, p) == (0.0, 0.0)
+        fd2 = (cscm.meridian_radius_slope(J1 + h, m, p)[1]
+               - cscm.meridian_radius_slope(J1 - h, m, p)[1]) / (2 * h)
+        assert d2F == pytest.approx(fd2, rel=1e-5, abs=1e-6 * scale / abs(apex))
+    assert cscm.meridian_radius_curvature(apex - 1.0, m, p) == (0.0, 0.0, 0.0)
+    assert cscm.meridian_radius_curvature(X + 1.0, m, p) == (0.0, 0.0, 0.0)
 
 
 def test_sure_elastic_test_never_passes_a_yielding_stress():
@@ -510,6 +517,65 @@ def test_fast_return_equals_global_closest_point():
             assert abs(fast[1] - glob[1]) < 1e-6 * ext
             checked += 1
     assert checked == 1500
+
+
+def test_return_near_the_kink_takes_the_nearer_piece():
+    # The meridian has a convex kink at J1 = 0 (the Rubin ratios start to
+    # vary), so for a trial with J1_apex < J1t < 0 above the meridian phi may
+    # have a minimum on each side of it. The return takes the nearer of the
+    # two (Newton on the trial's piece, _piece_minimum right of the kink):
+    # 3000 trials there (rt up to e x F(J1t), three caps, any Lode angle)
+    # reach the global search's distance to 1e-9. The return before
+    # 2026-11-27 (one bracketing search across the kink) was farther on
+    # some (0.03-18 % in phi; this test fails on it).
+    p = packed()
+    K, G = p[cscm.P_K], p[cscm.P_G]
+    rng = np.random.default_rng(9)
+    apex = p[cscm.P_J1APEX]
+    for kappa in (cscm.kappa0(p), 60e6, 150e6):
+        for _ in range(1000):
+            bhat = rng.uniform(-math.pi / 6, math.pi / 6)
+            J1t = rng.uniform(apex, 0.0)
+            m = cscm.meridian(bhat, kappa, p)
+            rt = cscm.meridian_radius(J1t, m, p) * math.exp(rng.uniform(0.0, 1.0))
+            phi = [(j - J1t) ** 2 / (9 * K) + (r - rt) ** 2 / G
+                   for j, r in (cscm.project(J1t, rt, bhat, kappa, K, G, p),
+                                cscm.project_global(J1t, rt, bhat, kappa, K, G, p))]
+            assert phi[0] <= phi[1] * (1 + 1e-9) + 1e-30
+
+
+def test_newton_return_equals_the_bracketing_one():
+    # The fast path's Newton iteration (exact curvature of the meridian) must
+    # land on the root of dphi/dJ1 that the bracketing search + regula falsi
+    # finds, to the tolerance both stop at (1e-11 (|J1t| + alpha) each, so
+    # 2.5e-11 here), with F the meridian's value there, bit for bit; and it
+    # must converge by itself (not hand over to the bracketing search) for
+    # nearly all trials above the meridian: 1000 random ones (shear and cap
+    # sides, three Lode angles, initial and hardened caps).
+    from sphdyn.materials.cscm import projection as proj
+    p = packed()
+    K, G = p[cscm.P_K], p[cscm.P_G]
+    rng = np.random.default_rng(3)
+    apex = p[cscm.P_J1APEX]
+    converged = tried = 0
+    for kappa in (cscm.kappa0(p), 60e6):
+        for _ in range(500):
+            bhat = rng.uniform(-math.pi / 6, math.pi / 6)
+            m = cscm.meridian(bhat, kappa, p)
+            J1t = rng.uniform(apex, m[3])
+            Ft = cscm.meridian_radius(J1t, m, p)
+            rt = Ft * rng.uniform(1.001, 2.0)
+            g0, gp0, F0, dF0 = proj._dphi_curvature(J1t, J1t, rt, m, K, G, p)
+            if not Ft > 0.0 or g0 == 0.0:
+                continue
+            tried += 1
+            J1n, Fn = proj._newton(J1t, g0, gp0, F0, apex, m[3], J1t, rt, m, K, G, p)
+            J1b = proj._bracket(J1t, g0, dF0, apex, m[3], J1t, rt, m, K, G, p)
+            if J1n == J1n:
+                converged += 1
+                assert Fn == cscm.meridian_radius(J1n, m, p)
+                assert abs(J1n - J1b) <= 2.5e-11 * (abs(J1t) + p[cscm.P_ALPHA])
+    assert tried > 900 and converged >= 0.99 * tried
 
 
 def test_recovery_option_2_needs_compressive_volume_strain():

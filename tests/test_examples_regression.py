@@ -33,6 +33,11 @@ clean worktree); every other case bitwise.
 2026-11-26 (session 9): igirder_fem's case now ramps the load over 2 ms
 instead of the deck's 32 ms (its 40 steps move the load 0.2 mm: a load
 reaction of 5.1 kN instead of round-off), rewritten for that.
+2026-11-27 (issue 17): the CSCM return by Newton's method with the
+meridian's exact curvature, and a trial between the apex and J1 = 0 taking
+the nearer of the two pieces' closest points (deliberate, docs/cscm.md:
+returns move within the 1e-11 tolerance, or to the nearer piece); the 15
+decks with a plastic CSCM point in their steps were rewritten.
 """
 
 import subprocess

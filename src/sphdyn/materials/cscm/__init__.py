@@ -52,13 +52,13 @@ from .layout import *  # noqa: F401,F403  (P_* parameter and H_* history indices
 from .layout import HISTORY_NAMES, N_PARAMS
 from .packing import cscm_parameters, dilog_neg, initial_history, kappa0, pack_cscm
 from .point import N_STRIPES, cscm_point, cscm_update
-from .projection import (NGOLDEN, NSCAN, project, project_global, project_on_meridian,
-                         yield_fraction)
+from .projection import (NGOLDEN, NSCAN, project, project_from_trial, project_global,
+                         project_on_meridian, yield_fraction)
 from .schema import CscmParams
 from .surface import (cap_from_compaction, cap_function, invariants, j1_radius,
-                      kappa_from_cap, meridian, meridian_radius, meridian_radius_slope,
-                      rubin_factor, rubin_q,
-                      shear_surface, surely_elastic, surface_radius, yield_function)
+                      kappa_from_cap, meridian, meridian_radius, meridian_radius_curvature,
+                      meridian_radius_slope, rubin_factor, rubin_q, shear_surface,
+                      surely_elastic, surface_radius, yield_function)
 
 CSCM = register(MaterialModel(
     name="cscm",

@@ -21,9 +21,9 @@ from .layout import (H_DB, H_DD, H_EPS, H_ERODED, H_EV, H_KAPPA, H_R0C, H_R0T, H
                      P_GFS, P_GFT, P_INCRE, P_IRATE, P_J1APEX, P_LI2B, P_NC, P_NT,
                      P_OVERC, P_OVERT, P_PWRC, P_PWRT, P_RATE_R0, P_RECOV,
                      P_RECOV_VOL, P_REPOW, P_RETRACT, P_SRATE, P_WAVE_UNDAMAGED)
-from .projection import project_on_meridian, yield_fraction
+from .projection import project_from_trial, yield_fraction
 from .surface import (cap_from_compaction, invariants, j1_radius, kappa_from_cap, meridian,
-                      meridian_radius, surely_elastic)
+                      meridian_radius_curvature, surely_elastic)
 
 N_STRIPES = 64  # interleaved work stripes of the group kernel (load balance)
 
@@ -103,13 +103,16 @@ def cscm_point(h, deps, dt, p, size):
         if not elastic:
             J1t, rt, bhat, dev = invariants(trial)
             mer = meridian(bhat, kappa, p)
-            ft = meridian_radius(J1t, mer, p)
+            # the meridian's value (and slope and curvature, which the
+            # return starts from) at the trial's J1
+            ft_slopes = meridian_radius_curvature(J1t, mer, p)
+            ft = ft_slopes[0]
             elastic = (p[P_J1APEX] <= J1t <= mer[3]
                        and rt * rt - ft * ft <= 1e-12 * (p[P_ALPHA] ** 2))
         if elastic:
             svp = trial
         else:
-            J1p, rp = project_on_meridian(J1t, rt, mer, K, G, p)
+            J1p, rp = project_from_trial(J1t, rt, ft_slopes, mer, K, G, p)
             fac = rp / rt if rt > 0.0 else 0.0
             mp = -J1p / 3.0
             sP = (fac * dev[0] + mp, fac * dev[1] + mp, fac * dev[2] + mp,

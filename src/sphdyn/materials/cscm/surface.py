@@ -238,74 +238,121 @@ def meridian_radius(J1, m, p):
 
 @njit(cache=True, error_model="numpy")
 def meridian_radius_slope(J1, m, p):
-    r""":func:`meridian_radius` ``F(J1)`` (the same value, bit for bit) and its
-    exact slope ``F' = dF/dJ1`` [-], by the chain rule through
-    :math:`F = \Re(Q_1, Q_2, \hat\beta)\, F_f\, \sqrt{F_c}`:
+    """:func:`meridian_radius` ``F(J1)`` (the same value, bit for bit) and its
+    exact slope ``F' = dF/dJ1`` [-]: the first two of
+    :func:`meridian_radius_curvature` (the compiler drops the rest)."""
+    F, dF, _ = meridian_radius_curvature(J1, m, p)
+    return F, dF
+
+
+@njit(cache=True, error_model="numpy")
+def meridian_radius_curvature(J1, m, p):
+    r""":func:`meridian_radius` ``F(J1)`` (the same value, bit for bit), its
+    exact slope ``F'`` [-] and curvature ``F''`` [1/Pa], by the chain rule
+    through :math:`F = \Re(Q_1, Q_2, \hat\beta)\, F_f\, \sqrt{F_c}`:
 
     .. math::
         F_f' = \lambda\beta e^{-\beta J_1} + \theta,\quad
-        Q_i' = \lambda_i\beta_i e^{-\beta_i J_1} + \theta_i\ (J_1 > 0,\ 0\ \text{else}),
-        \quad (\sqrt{F_c})' = -\frac{t}{(X - L)\sqrt{1 - t^2}},\
-        t = \frac{J_1 - L}{X - L},
+        F_f'' = -\lambda\beta^2 e^{-\beta J_1},\quad
+        Q_i' = \lambda_i\beta_i e^{-\beta_i J_1} + \theta_i,\quad
+        Q_i'' = -\lambda_i\beta_i^2 e^{-\beta_i J_1}\ (J_1 > 0,\ 0\ \text{else}),
 
-    and :math:`\Re' ` through every intermediate of :func:`rubin_factor`
-    (``a``, ``b``, ``b0``, ``b1``, ``b2``; forward-mode differentiation
-    written out). Zero outside ``(J1_apex, X)`` and where ``Ff <= 0``, like
-    the value; :math:`-\infty`-like at the cap's end ``X``. Used by the
-    return (:mod:`.projection`): one evaluation per iteration instead of the
-    two of a difference quotient. Notes sec. 1.4-1.7.
+        c = \sqrt{1 - t^2},\ t = \frac{J_1 - L}{X - L}:\quad
+        c' = -\frac{t}{(X - L)\,c},\quad c'' = -\frac{1}{(X - L)^2 c^3},
+
+    and :math:`\Re`, :math:`\Re'`, :math:`\Re''` through every intermediate of
+    :func:`rubin_factor` (``a``, ``b``, ``b0``, ``b1``, ``b2``; forward-mode
+    differentiation to second order written out: a root ``y = (-u + sqrt(D))
+    / (2 w)`` of ``w y^2 + u y + v`` has ``2 w y' = -u' + sqrt(D)' - 2 w' y``
+    and ``2 w y'' = -u'' + sqrt(D)'' - 2 w'' y - 4 w' y'``). Zero outside
+    ``(J1_apex, X)`` and where ``Ff <= 0``, like the value; slope
+    :math:`-\infty`-like at the cap's end ``X``. Used by the return
+    (:mod:`.projection`): the slope in ``dphi/dJ1``, the curvature in its
+    Newton steps. Notes sec. 1.4-1.7.
     """
     cb, sb, L, X = m
     if J1 <= p[P_J1APEX] or J1 >= X:
-        return 0.0, 0.0
+        return 0.0, 0.0, 0.0
     e = math.exp(-p[P_BETA] * J1)
     ff = p[P_ALPHA] - p[P_LAMDA] * e + p[P_THETA] * J1
     if ff <= 0.0:
-        return 0.0, 0.0
+        return 0.0, 0.0, 0.0
     dff = p[P_LAMDA] * p[P_BETA] * e + p[P_THETA]
+    d2ff = -p[P_LAMDA] * p[P_BETA] * p[P_BETA] * e
     x = J1 if J1 > 0.0 else 0.0
     e1 = math.exp(-p[P_B1] * x)
     e2 = math.exp(-p[P_B2] * x)
     q1 = p[P_A1] - p[P_L1] * e1 + p[P_T1] * x
     q2 = p[P_A2] - p[P_L2] * e2 + p[P_T2] * x
-    dq1 = p[P_L1] * p[P_B1] * e1 + p[P_T1] if J1 > 0.0 else 0.0
-    dq2 = p[P_L2] * p[P_B2] * e2 + p[P_T2] if J1 > 0.0 else 0.0
-    # Rubin factor (as _rubin_cs) with the derivative of each intermediate
+    dq1 = dq2 = d2q1 = d2q2 = 0.0
+    if J1 > 0.0:
+        dq1 = p[P_L1] * p[P_B1] * e1 + p[P_T1]
+        dq2 = p[P_L2] * p[P_B2] * e2 + p[P_T2]
+        d2q1 = -p[P_L1] * p[P_B1] * p[P_B1] * e1
+        d2q2 = -p[P_L2] * p[P_B2] * p[P_B2] * e2
+    # Rubin factor (as _rubin_cs) with the first and second derivative of
+    # each intermediate
     a0 = 2.0 * q1 * q1 * (q2 - 1.0)
     da0 = 4.0 * q1 * dq1 * (q2 - 1.0) + 2.0 * q1 * q1 * dq2
+    d2a0 = (4.0 * (dq1 * dq1 + q1 * d2q1) * (q2 - 1.0) + 8.0 * q1 * dq1 * dq2
+            + 2.0 * q1 * q1 * d2q2)
     a1 = math.sqrt(3.0) * q2 + 2.0 * q1 * (q2 - 1.0)
     da1 = math.sqrt(3.0) * dq2 + 2.0 * dq1 * (q2 - 1.0) + 2.0 * q1 * dq2
-    a2 = q2
-    da2 = dq2
-    disc = a1 * a1 - 4.0 * a2 * a0
-    sq = math.sqrt(max(disc, 0.0))
-    dsq = (a1 * da1 - 2.0 * (da2 * a0 + a2 * da0)) / sq if disc > 0.0 else 0.0
-    a = (-a1 + sq) / (2.0 * a2)
-    da = (-da1 + dsq - 2.0 * da2 * a) / (2.0 * a2)
-    b = (2.0 * q1 + a) ** 2 - 3.0
-    db = 2.0 * (2.0 * q1 + a) * (2.0 * dq1 + da)
+    d2a1 = math.sqrt(3.0) * d2q2 + 2.0 * d2q1 * (q2 - 1.0) + 4.0 * dq1 * dq2 + 2.0 * q1 * d2q2
+    a, da, d2a = _quadratic_root(q2, dq2, d2q2, a1, da1, d2a1, a0, da0, d2a0)
+    u = 2.0 * q1 + a
+    du = 2.0 * dq1 + da
+    b = u * u - 3.0
+    db = 2.0 * u * du
+    d2b = 2.0 * du * du + 2.0 * u * (2.0 * d2q1 + d2a)
     b0 = -(3.0 + b - a * a) / 4.0
     db0 = -(db - 2.0 * a * da) / 4.0
+    d2b0 = -(d2b - 2.0 * da * da - 2.0 * a * d2a) / 4.0
     cs = cb - a * sb
     dcs = -da * sb
+    d2cs = -d2a * sb
     b1 = a * cs
     db1 = da * cs + a * dcs
+    d2b1 = d2a * cs + 2.0 * da * dcs + a * d2cs
     b2 = cs * cs + b * sb * sb
     db2 = 2.0 * cs * dcs + db * sb * sb
-    disc = b1 * b1 - 4.0 * b2 * b0
-    sq = math.sqrt(max(disc, 0.0))
-    dsq = (b1 * db1 - 2.0 * (db2 * b0 + b2 * db0)) / sq if disc > 0.0 else 0.0
-    rub = (-b1 + sq) / (2.0 * b2)
-    drub = (-db1 + dsq - 2.0 * db2 * rub) / (2.0 * b2)
+    d2b2 = 2.0 * (dcs * dcs + cs * d2cs) + d2b * sb * sb
+    rub, drub, d2rub = _quadratic_root(b2, db2, d2b2, b1, db1, d2b1, b0, db0, d2b0)
     r = rub * ff
     dr = drub * ff + rub * dff
+    d2r = d2rub * ff + 2.0 * drub * dff + rub * d2ff
     if J1 <= L:
-        return r, dr
+        return r, dr, d2r
+    k = 1.0 / (X - L)
     t = (J1 - L) / (X - L)
     c = math.sqrt(max(1.0 - t * t, 0.0))
     if c <= 0.0:
-        return 0.0, -1e300
-    return r * c, dr * c - r * t / ((X - L) * c)
+        return 0.0, -1e300, -1e300
+    dc = -t * k / c
+    d2c = -k * k / (c * c * c)
+    return r * c, dr * c + r * dc, d2r * c + 2.0 * dr * dc + r * d2c
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _quadratic_root(w, dw, d2w, u, du, d2u, v, dv, d2v):
+    """The root ``y = (-u + sqrt(u^2 - 4 w v)) / (2 w)`` of ``w y^2 + u y + v``
+    (discriminant clipped at 0, as :func:`_rubin_cs`) and its first two
+    derivatives from those of ``w, u, v``: with ``D = u^2 - 4 w v``,
+    ``s = sqrt(D)``, ``s' = D'/(2 s)``, ``s'' = (D'' - 2 s'^2)/(2 s)``,
+    ``y' = (-u' + s' - 2 w' y)/(2 w)``, ``y'' = (-u'' + s'' - 2 w'' y - 4 w' y')/(2 w)``
+    (``s' = s'' = 0`` where ``D <= 0``)."""
+    D = u * u - 4.0 * w * v
+    s = math.sqrt(max(D, 0.0))
+    ds = d2s = 0.0
+    if D > 0.0:
+        dD = 2.0 * u * du - 4.0 * (dw * v + w * dv)
+        d2D = 2.0 * (du * du + u * d2u) - 4.0 * (d2w * v + 2.0 * dw * dv + w * d2v)
+        ds = dD / (2.0 * s)
+        d2s = (d2D - 2.0 * ds * ds) / (2.0 * s)
+    y = (-u + s) / (2.0 * w)
+    dy = (-du + ds - 2.0 * dw * y) / (2.0 * w)
+    d2y = (-d2u + d2s - 2.0 * d2w * y - 4.0 * dw * dy) / (2.0 * w)
+    return y, dy, d2y
 
 
 @njit(cache=True, error_model="numpy")
