@@ -21,11 +21,14 @@ above where its particles touch the beam's (it falls onto the beam after
 sqrt(2 h / g) = 4.5 ms), 8 ms; writes docs/figures/dropweight_gravity.png: the ram's fall
 against h(t) = g t^2 / 2, and the support reactions against the weight.
 
-    python examples/dropweight.py [--reuse] [--full | --gravity]
+    python examples/dropweight.py [--reuse] [--full | --gravity] [--variants]
 
 ``--reuse`` draws the runs found in out/ and runs nothing. Runs of the decks
 as they were before their stirrups (:data:`EARLIER`), if found in out/, are
-drawn dashed for comparison.
+drawn dashed for comparison; ``--variants`` also runs :data:`VARIANTS` (the
+coarse deck with the sublayer's stiffness ``"axial"``, 20-30 minutes), drawn
+dotted whenever found in out/. A second table gives how far the damage
+spreads beyond the middle of the beam (:func:`damage_spread`).
 """
 
 from __future__ import annotations
@@ -43,6 +46,17 @@ RUNS = {
     "dropweight_coarse_rate": ("dropweight_coarse.toml", ["material.0.rate_effects=true"],
                                "dx 12 mm, rate effects"),
     "dropweight": ("dropweight.toml", [], "dx 6 mm, no rate effects"),
+}
+#: the sublayer meshes of the decks (bars and stirrups)
+SUBLAYERS = ("bar_b1", "bar_b2", "bar_t1", "bar_t2", "stirrups")
+#: variants run with ``--variants`` and drawn dotted when found in out/:
+#: run name: (deck, overrides, label)
+VARIANTS = {
+    # the sublayer particles' stress along the bar only (the I-girder's deck):
+    # how much of the damage inside the beam is the split particles' bond zone
+    "dropweight_coarse_axial": ("dropweight_coarse.toml",
+                                [f'mesh.{m}.sublayer.stiffness="axial"' for m in SUBLAYERS],
+                                "dx 12 mm, sublayer axial"),
 }
 #: runs drawn dashed when found in out/ but not made by this script: the coarse
 #: deck as it was before its stirrups (git show 829f472:examples/dropweight_coarse.toml)
@@ -72,6 +86,27 @@ def side_damage(out: Path, face: bool) -> tuple[np.ndarray, float]:
         layer = x0[:, 1] < x0[:, 1].min() + 0.5 * dx
         x0, d = x0[layer], d[layer]
     return side_view_max(x0, d, dx), dx
+
+
+def damage_spread(out: Path) -> tuple[float, ...]:
+    """How far the damage spreads beyond the middle (x = 600-900 mm) at the
+    end: of the side face's particles there, the fractions cracked through
+    (damage > 0.9) and nearly intact (< 0.1); of the largest damage across
+    the width, the mean and the same two fractions; and its mean over the
+    overhangs beyond the supports (x < 100 or > 1400 mm, where the moment is
+    nil)."""
+    values = []
+    for face in (True, False):
+        img, dx = side_damage(out, face)
+        x = (np.arange(img.shape[1]) + 0.5) * dx
+        side = img[:, (x < 0.6) | (x > 0.9)]
+        side = side[np.isfinite(side)]
+        values += [float(np.mean(side > 0.9)), float(np.mean(side < 0.1))]
+        if not face:
+            values.insert(2, float(side.mean()))
+            over = img[:, (x < 0.1) | (x > 1.4)]
+            values.append(float(np.nanmean(over)))
+    return tuple(values)
 
 
 #: the gravity variant: the ram at rest, 0.1 mm above where its particles
@@ -147,6 +182,8 @@ def main() -> None:
     ap.add_argument("--full", action="store_true", help="also run the dx 6 mm deck")
     ap.add_argument("--gravity", action="store_true",
                     help="the gravity variant instead (module docstring)")
+    ap.add_argument("--variants", action="store_true",
+                    help="also run the variants of VARIANTS (the sublayer axial)")
     a = ap.parse_args()
 
     import matplotlib
@@ -159,10 +196,16 @@ def main() -> None:
     if a.gravity:
         gravity(a.reuse)
         return
-    from sphdyn.simulation import run_examples
+    from sphdyn.simulation import run_deck, run_examples
 
     outs = run_examples(ROOT, RUNS, "dropweight", reuse=a.reuse, include_full=a.full)
     labels = {name: RUNS[name][2] for name in outs}
+    for name, (deck, overrides, label) in VARIANTS.items():
+        if a.variants and not a.reuse:
+            run_deck(ROOT / "examples" / deck, ROOT / "out" / name, overrides, reuse=True,
+                     progress=True)
+        if (ROOT / "out" / name / "summary.json").exists():
+            outs[name], labels[name] = ROOT / "out" / name, label
     for name, label in EARLIER.items():
         if (ROOT / "out" / name / "summary.json").exists():
             outs[name], labels[name] = ROOT / "out" / name, label
@@ -174,7 +217,7 @@ def main() -> None:
         strain = read_history_csv(out / "gauges" / "top_strain.csv")
         disp = read_history_csv(out / "gauges" / "midspan.csv")
         label = labels[name]
-        style = "--" if name in EARLIER else "-"
+        style = "--" if name in EARLIER else (":" if name in VARIANTS else "-")
         ax_s.plot(1e3 * strain["time"], 1e6 * strain["strain"], style, label=label)
         ax_d.plot(1e3 * disp["time"], 1e3 * disp["displacement_z"], style, label=label)
         h = read_history_csv(out / "history.csv")
@@ -217,6 +260,12 @@ def main() -> None:
         print(f"| {label} | {1e3 * d:.2f} | {1e3 * td:.2f} | {1e6 * e:.0f} | "
               f"{1e3 * te:.2f} | {1e-3 * f:.1f} | {steps} | {wall:.0f} | {err:.4f} | "
               f"{status} |")
+    print("\n| model (outside x = 600-900 mm) | face: damage > 0.9 | face: < 0.1 "
+          "| across the width: mean | > 0.9 | < 0.1 | overhangs: mean |")
+    print("|---|---|---|---|---|---|---|")
+    for name, out in outs.items():
+        print(f"| {labels[name]} | " + " | ".join(f"{v:.2f}" for v in damage_spread(out))
+              + " |")
 
 
 if __name__ == "__main__":
