@@ -20,9 +20,9 @@ gradients) and of the FEM reference (:data:`FEM_VARIANTS`: selective-reduced
 hexes; one-point hexes of 5 mm, 35 minutes alone) into out/igirder_<variant>;
 variants found there are drawn dashed (dotted: FEM) and listed in the table,
 whose differences are taken to each FEM reference found. Each drawing keeps
-its curves in docs/figures/igirder_curves.csv; with ``--reuse`` a variant
-whose output folder is gone is drawn from there (the 5 mm FEM girder takes
-35 minutes to rerun).
+its curves in docs/figures/igirder_curves.csv; with ``--reuse`` (which runs
+nothing, ``--variants`` or not) a variant whose run is gone or unfinished is
+drawn from there (the 5 mm FEM girder takes 35 minutes to rerun).
 
 The curves are averaged over a sliding window of 0.5 ms (about a tenth of
 the first bending period) before they are compared: the load rises in
@@ -206,8 +206,8 @@ def main() -> None:
     fig.axes[-1].set_xlabel("x [mm]")
     fig.colorbar(im, ax=fig.axes[:2], shrink=0.8, label="damage (max across the width)")
     for name in (*FEM_VARIANTS, *VARIANTS):
-        if a.variants or finished(ROOT / "out" / f"igirder_{name}"):
-            out = run(name, not a.variants or a.reuse)
+        if finished(ROOT / "out" / f"igirder_{name}") or (a.variants and not a.reuse):
+            out = run(name, not a.variants or a.reuse)  # --reuse never runs one
             curves[name] = curve(out)
             rows.append(table_row(name, out, *curves[name]))
         elif a.reuse and (saved := saved_curve(name)) is not None:  # its run is gone
