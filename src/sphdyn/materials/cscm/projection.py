@@ -87,9 +87,7 @@ def project_from_trial(J1t, rt, Ft_slopes, m, K, G, p):
                 # the piece right of the kink may hold a nearer minimum (and
                 # holds the only one if Newton ran into the kink)
                 J1b, Fb = _piece_minimum(0.0, X, J1t, rt, m, K, G, p)
-                if J1 != J1 or _phi(J1b, Fb, J1t, rt, K, G) < _phi(J1, F, J1t, rt, K, G):
-                    return J1b, Fb
-                return J1, F
+                return _nearer(J1, F, J1b, Fb, J1t, rt, K, G)
             if J1 == J1:  # not NaN: converged
                 return J1, F
             J1 = _bracket(J1t, g0, dF, apex, X, J1t, rt, m, K, G, p)
@@ -99,10 +97,18 @@ def project_from_trial(J1t, rt, Ft_slopes, m, K, G, p):
         J1, F = _piece_minimum(apex, 0.0 if kink else X, J1t, rt, m, K, G, p)
         if kink:
             J1b, Fb = _piece_minimum(0.0, X, J1t, rt, m, K, G, p)
-            if _phi(J1b, Fb, J1t, rt, K, G) < _phi(J1, F, J1t, rt, K, G):
-                return J1b, Fb
+            return _nearer(J1, F, J1b, Fb, J1t, rt, K, G)
         return J1, F
     return _project_global(J1t, rt, m, K, G, p)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _nearer(J1a, Fa, J1b, Fb, J1t, rt, K, G):
+    """Of two meridian points, the one nearer the trial in the energy norm
+    (:func:`_phi`): the second if the first is NaN (not found) or farther."""
+    if J1a != J1a or _phi(J1b, Fb, J1t, rt, K, G) < _phi(J1a, Fa, J1t, rt, K, G):
+        return J1b, Fb
+    return J1a, Fa
 
 
 @njit(cache=True, error_model="numpy")
