@@ -484,6 +484,44 @@ def test_sure_elastic_test_never_passes_a_yielding_stress():
     assert inside > 500 and said > 0.8 * inside
 
 
+def test_pressure_free_elastic_bound():
+    # surely_elastic() first compares sqrt(J2') with P_R0_ELASTIC for J1 >= 0
+    # (no exponentials). (1) The bound is its formula, 0.999 min(Q1(0), Q2(0), 1)
+    # Ff(0), written out from the parameters (a wrong factor fails here).
+    # (2) It is sufficient: 20,000 random stresses with 0 <= J1 <= L and
+    # sqrt(J2') up to 1.5 r0 (three fc, initial and hardened caps): every one
+    # below r0 is also elastic by the exponential test alone (the bound
+    # switched off) and by yield_function, so the decisions, and the
+    # results, are those of the test without it. (3) A surface that may
+    # decrease with J1 gets no bound: theta < 0, and the default fits at
+    # fc = 80 MPa (their Q1, Q2 have beta_i < 0 and theta_i < 0).
+    for fc in (20e6, 43.1e6):
+        p = packed(fc=fc)
+        r0 = 0.999 * min(p[cscm.P_A1] - p[cscm.P_L1], p[cscm.P_A2] - p[cscm.P_L2], 1.0) * (
+            p[cscm.P_ALPHA] - p[cscm.P_LAMDA])
+        assert p[cscm.P_R0_ELASTIC] == pytest.approx(r0, rel=1e-14) and r0 > 0.1 * fc / 43.1
+        off = p.copy()
+        off[cscm.P_R0_ELASTIC] = 0.0
+        rng = np.random.default_rng(5)
+        below = 0
+        for kappa in (cscm.kappa0(p), 60e6):
+            for _ in range(10000):
+                J1 = rng.uniform(0.0, max(kappa, cscm.kappa0(p)))
+                dev = rng.normal(size=6)
+                dev[:3] -= dev[:3].mean()
+                nrm = math.sqrt(0.5 * (dev[:3] @ dev[:3]) + dev[3:] @ dev[3:])
+                r = rng.uniform(0.0, 1.5) * r0
+                s = tuple(dev * r / nrm - np.array([J1 / 3] * 3 + [0.0] * 3))
+                if r < r0:
+                    below += 1
+                    assert cscm.surely_elastic(s, kappa, p)
+                    assert cscm.surely_elastic(s, kappa, off)
+                    assert cscm.yield_function(s, kappa, p) <= 0.0
+        assert below > 10000
+    assert packed(theta=-1e-3)[cscm.P_R0_ELASTIC] == 0.0
+    assert packed(fc=80e6)[cscm.P_R0_ELASTIC] == 0.0
+
+
 def test_fast_return_equals_global_closest_point():
     # project() takes a local bracketing path when the trial lies above the
     # meridian or in tension beyond the apex; it must find the same closest

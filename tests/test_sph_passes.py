@@ -6,8 +6,8 @@ import pytest
 from sphdyn import kernels
 from sphdyn.geometry import box_lattice
 from sphdyn.neighbours import build_neighbours
-from sphdyn.parts.sph.passes import (forces, stress_terms,
-                               update_density_and_h, velocity_gradient, xsph_velocity)
+from sphdyn.parts.sph.passes import (forces, gradient_scratch, stress_terms,
+                                     update_density_and_h, velocity_gradient, xsph_velocity)
 
 
 def _cloud(dim, n_side=12, dx=0.01, hfac=1.3, kernel="cubic_spline", jitter=0.0,
@@ -46,7 +46,7 @@ def _grad(c, v, correct, with_factors=False):
     F = np.zeros(nl.idx.size, dtype=np.float32)  # as the part stores them
     count = np.zeros(n, np.int32)
     velocity_gradient(c["x"], v, c["h"], c["m"], c["rho"], nl.offsets, nl.idx, c["kid"], c["sigma"],
-                      c["dim"], 1.0, correct, F, L, B, count)
+                      c["dim"], 1.0, correct, F, L, B, count, gradient_scratch(nl.offsets))
     return (L, B, F, count) if with_factors else (L, B)
 
 
@@ -548,3 +548,42 @@ def test_history_counts_particles_held_at_a_density_limit():
     p.rho[1] = 3.0 * p.rho0[1]
     p.rho[2] = 0.51 * p.rho0[2]  # inside
     assert part.columns()["density_limited"] == 2.0
+
+
+@pytest.mark.parametrize("correct", [False, True])
+def test_buffered_gradient_rows_give_the_pair_by_pair_bits(correct):
+    # The 3D cubic-spline forms of velocity_gradient work rows through a row
+    # buffer (kernel factors in SIMD); a row longer than the buffer takes the
+    # pair-by-pair row (_gradient_row). A zero-width buffer sends every row
+    # there, so the two are compared bit for bit: L, B, the stored factors,
+    # the counts and the partitioned list, on a jittered cloud with varied h,
+    # zero-mass particles, a Verlet skin and rows shuffled out of order (so the
+    # partition moves pairs), and with a buffer that takes only some rows.
+    c = _cloud(3, n_side=9, jitter=0.3, hfac=1.3, seed=4)
+    n = c["x"].shape[0]
+    rng = np.random.default_rng(8)
+    h = c["h"] * rng.uniform(0.9, 1.1, n)
+    m = c["m"].copy()
+    m[rng.choice(n, 20, replace=False)] = 0.0
+    v = rng.normal(size=(n, 3))
+    nl = build_neighbours(c["x"], h, kernels.support(0), 0.3, 3)
+    for i in range(n):
+        row = nl.idx[nl.offsets[i]:nl.offsets[i + 1]]
+        row[:] = rng.permutation(row)
+    lengths = np.diff(nl.offsets)
+    results = []
+    for width in (None, 0, int(np.median(lengths))):
+        scratch = gradient_scratch(nl.offsets) if width is None else np.zeros((64, 13, width))
+        idx = nl.idx.copy()
+        F = np.zeros(idx.size, np.float32)
+        L = np.zeros((n, 3, 3))
+        B = np.zeros((n, 3, 3))
+        count = np.zeros(n, np.int32)
+        velocity_gradient(c["x"], v, h, m, c["rho"], nl.offsets, idx, 0, c["sigma"], 3, 1.0,
+                          correct, F, L, B, count, scratch)
+        results.append((L, B, F, count, idx))
+    assert (count := results[0][3]).min() > 10 and (lengths - count).min() > 0  # skin pairs
+    assert not np.array_equal(results[0][4], nl.idx)  # the partition moved pairs
+    for other in results[1:]:
+        for a, b in zip(results[0], other):
+            assert np.array_equal(a, b)

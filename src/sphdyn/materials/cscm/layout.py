@@ -2,7 +2,7 @@
 
 Parameter vector: the common block ``[density, K, G]``, then
 :data:`~sphdyn.materials.cscm.defaults.PARAM_NAMES`, then the switches and
-derived values ``P_IRATE`` ... ``P_RATE_R0`` (``N_PARAMS`` in all). History
+derived values ``P_IRATE`` ... ``P_R0_ELASTIC`` (``N_PARAMS`` in all). History
 row: :data:`HISTORY_NAMES`, indexed by the ``H_*`` constants.
 """
 
@@ -32,7 +32,8 @@ P_RECOV_VOL = _NEXT + 9  # 1.0: RECOV option 2 (10-11), recovery needs compressi
 P_RETRACT = _NEXT + 10   # 1.0: the cap retracts with dilation (ITRETRC = 1)
 P_RATE_R0 = _NEXT + 11   # 1.0: damage thresholds raised by the rate factor (with IRATE)
 P_WAVE_UNDAMAGED = _NEXT + 12  # 1.0: wave speed from the undamaged moduli
-N_PARAMS = _NEXT + 13
+P_R0_ELASTIC = _NEXT + 13  # derived: sqrt(J2') below which J1 >= 0 is surely elastic
+N_PARAMS = _NEXT + 14
 
 HISTORY_NAMES = (
     "kappa", "plastic_vol_strain", "damage_brittle", "damage_ductile",

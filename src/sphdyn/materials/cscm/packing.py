@@ -18,10 +18,10 @@ from ..registry import schema_defaults
 from .defaults import PARAM_NAMES, default_parameters
 from .layout import (H_KAPPA, H_RF, H_RFMAX, HISTORY_NAMES, N_PARAMS, P_DMAX_POWER,
                      P_ERODE, P_ERODE_STRAIN, P_INCRE, P_IRATE, P_J1APEX, P_KAPPA0,
-                     P_LI2B, P_RATE_R0, P_RECOV, P_RECOV_VOL, P_RETRACT, P_WAVE_UNDAMAGED,
-                     PARAM_INDEX)
+                     P_LI2B, P_R0_ELASTIC, P_RATE_R0, P_RECOV, P_RECOV_VOL, P_RETRACT,
+                     P_WAVE_UNDAMAGED, PARAM_INDEX)
 from .schema import CscmParams
-from .surface import kappa_from_cap, shear_surface
+from .surface import elastic_radius_bound, kappa_from_cap, shear_surface
 
 
 def dilog_neg(B: float) -> float:
@@ -149,6 +149,7 @@ def pack_cscm(values: dict) -> np.ndarray:
     if not p[P_KAPPA0] > p[P_J1APEX]:
         raise ValueError("cscm: X0 is too small (initial cap inside the tensile apex)")
     p[P_LI2B] = dilog_neg(v["B"])
+    p[P_R0_ELASTIC] = elastic_radius_bound(p)
     return p
 
 

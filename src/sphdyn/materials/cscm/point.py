@@ -26,6 +26,7 @@ from .surface import (cap_from_compaction, invariants, j1_radius, kappa_from_cap
                       meridian_radius_curvature, surely_elastic)
 
 N_STRIPES = 64  # interleaved work stripes of the group kernel (load balance)
+STRIPE_RUN = 32  # consecutive particles per visit of a stripe (memory locality)
 
 
 @njit(cache=True, error_model="numpy")
@@ -82,13 +83,10 @@ def cscm_point(h, deps, dt, p, size):
     if dt > 0.0:
         rate = math.sqrt(2.0 / 3.0 * ddot6(deps, deps)) / dt
     h[H_RATE] = rate
-    eta_t = eta_c = eta_s = 0.0
-    if irate and rate > 1e-12:
-        # fluidities eta_t = eta0t/rate^nt, eta_c = eta0c/rate^nc,
-        # eta_s = srate eta_t (notes 1.11 [R]), constant over the step
-        eta_t = p[P_ETA0T] / rate ** p[P_NT]
-        eta_c = p[P_ETA0C] / rate ** p[P_NC]
-        eta_s = p[P_SRATE] * eta_t
+    viscous = irate and rate > 1e-12
+    # fluidities (constant over the step), formed at the step's first
+    # plastic sub-step: most points are elastic and need none
+    eta_t = eta_c = eta_s = -1.0
     rf = 1.0
     for _ in range(n):
         eps = (eps[0] + de[0], eps[1] + de[1], eps[2] + de[2],
@@ -119,7 +117,13 @@ def cscm_point(h, deps, dt, p, size):
                   fac * dev[3], fac * dev[4], fac * dev[5])
             gam = 1.0
             over = 0.0
-            if irate and rate > 1e-12:
+            if viscous:
+                if eta_t < 0.0:
+                    # eta_t = eta0t/rate^nt, eta_c = eta0c/rate^nc,
+                    # eta_s = srate eta_t (notes 1.11 [R])
+                    eta_t = p[P_ETA0T] / rate ** p[P_NT]
+                    eta_c = p[P_ETA0C] / rate ** p[P_NC]
+                    eta_s = p[P_SRATE] * eta_t
                 # Duvaut-Lions fluidity, interpolated with trans (notes 1.11 [R])
                 # (eta_t, eta_c, eta_s depend on the step's rate only)
                 if J1t < 0.0:
@@ -269,16 +273,22 @@ def cscm_update(idx, L, dt, rho, sig, e, c, damage, hist, params, size):
     "undamaged"`` (``P_WAVE_UNDAMAGED``; eroded points as before).
     Shapes/units: ``base.KERNEL_SIGNATURE_DOC``.
 
-    The particles are dealt round-robin to ``N_STRIPES`` interleaved stripes
-    (stripe ``t`` takes ``idx[t], idx[t + N_STRIPES], ...``) and the stripes
-    to the threads: plastic points cost ten times more than elastic ones and
-    cluster in space (the contact zone), which a contiguous split of ``idx``
-    would give to one thread. Each particle writes only its own rows.
+    The particles are dealt round-robin, in runs of ``STRIPE_RUN``
+    consecutive ones, to ``N_STRIPES`` interleaved stripes (stripe ``t``
+    takes ``idx[32 t : 32 t + 32]``, then the run ``64 x 32`` further on,
+    ...) and the stripes to the threads: plastic points cost ten times more
+    than elastic ones and cluster in space (the contact zone), which a
+    contiguous split of ``idx`` would give to one thread. The runs keep the
+    history rows (24 doubles each) read in order, which the hardware
+    prefetches; particle by particle (a stride of 64 rows) every row was a
+    cache miss (BENCHMARKS.md, 2026-11-27 later). Each particle writes only
+    its own rows, so the order changes no result.
     """
     n = idx.shape[0]
     for t in prange(N_STRIPES):
-        for k in range(t, n, N_STRIPES):
-            _update_particle(idx[k], L, dt, rho, sig, e, c, damage, hist, params, size)
+        for k0 in range(t * STRIPE_RUN, n, N_STRIPES * STRIPE_RUN):
+            for k in range(k0, min(k0 + STRIPE_RUN, n)):
+                _update_particle(idx[k], L, dt, rho, sig, e, c, damage, hist, params, size)
 
 
 @njit(cache=True, error_model="numpy")

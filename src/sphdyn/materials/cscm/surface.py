@@ -11,8 +11,8 @@ from numba import njit
 
 from ..base import ddot6
 from .layout import (P_A1, P_A2, P_ALPHA, P_B1, P_B2, P_BETA, P_D1, P_D2, P_J1APEX,
-                     P_KAPPA0, P_L1, P_L2, P_LAMDA, P_R, P_T1, P_T2, P_THETA, P_W,
-                     P_X0)
+                     P_KAPPA0, P_L1, P_L2, P_LAMDA, P_R, P_R0_ELASTIC, P_T1, P_T2, P_THETA,
+                     P_W, P_X0)
 
 
 @njit(cache=True, error_model="numpy")
@@ -382,12 +382,17 @@ def surely_elastic(s, kappa, p):
     (TXC) (tested over the fits' range), so ``sqrt(J2') < min(Q1, Q2, 1) Ff``
     (with a 1e-9 margin for round-off) is elastic. False means "check
     fully" (:func:`yield_function`), not "plastic". Saves the Lode angle,
-    its cosine and sine and the cap for most elastic points.
+    its cosine and sine and the cap for most elastic points. Before the
+    exponentials, a cheaper bound for ``J1 >= 0``: ``sqrt(J2') <``
+    ``P_R0_ELASTIC`` (:func:`elastic_radius_bound`), which implies the test
+    above.
     """
     J1, r = j1_radius(s)
     L = kappa if kappa > p[P_KAPPA0] else p[P_KAPPA0]
     if not (p[P_J1APEX] < J1 <= L):
         return False
+    if J1 >= 0.0 and r < p[P_R0_ELASTIC]:
+        return True  # below the bound at J1 = 0 (elastic_radius_bound), no exp
     ff = shear_surface(J1, p)
     q1, q2 = rubin_q(J1, p)
     return r < min(q1, q2, 1.0) * ff * (1.0 - 1e-9)
@@ -401,3 +406,30 @@ def j1_radius(s):
     d0, d1, d2 = s[0] - m, s[1] - m, s[2] - m
     J2 = 0.5 * (d0 * d0 + d1 * d1 + d2 * d2) + s[3] * s[3] + s[4] * s[4] + s[5] * s[5]
     return -3.0 * m, math.sqrt(J2)
+
+
+def elastic_radius_bound(p):
+    r"""``sqrt(J2')`` below which a stress with ``0 <= J1 <= L`` is surely elastic
+    (packed as ``P_R0_ELASTIC``; called once per material, in Python).
+
+    Where ``Ff``, ``Q1`` and ``Q2`` do not decrease with ``J1`` (``lamda beta
+    >= 0`` and ``theta >= 0`` for each, as in every fit of notes sec. 1.5-1.6),
+    :func:`surely_elastic`'s bound ``min(Q1, Q2, 1) Ff (1 - 1e-9)`` is smallest
+    at ``J1 = 0``:
+
+    .. math:: r_0 = 0.999\,\min(Q_1(0), Q_2(0), 1)\,F_f(0) = 0.999
+              \min(\alpha_1 - \lambda_1, \alpha_2 - \lambda_2, 1)(\alpha - \lambda)
+
+    (the 0.1 % margin covers the round-off of the functions at other ``J1``
+    many times over). 0 (the bound never applies) for a surface that may
+    decrease, or an ``r0`` below ``1e-6 alpha`` (a bound lost in round-off).
+    """
+    rising = True
+    for a, t, lam, b in ((P_ALPHA, P_THETA, P_LAMDA, P_BETA), (P_A1, P_T1, P_L1, P_B1),
+                         (P_A2, P_T2, P_L2, P_B2)):
+        rising = rising and p[lam] * p[b] >= 0.0 and p[t] >= 0.0
+    q1, q2 = rubin_q(0.0, p)
+    r0 = 0.999 * min(q1, q2, 1.0) * shear_surface(0.0, p)
+    if not rising or not r0 > 1e-6 * abs(p[P_ALPHA]):
+        return 0.0
+    return float(r0)

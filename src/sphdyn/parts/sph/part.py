@@ -40,8 +40,8 @@ from ...neighbours import build_neighbours, mean_neighbours, update_neighbours
 from ...state import BC_FIXED, Particles
 from ..base import register_part
 from .artificial_stress import artificial_stress_forces, artificial_stress_tensor
-from .passes import (forces, stress_terms, update_density_and_h, velocity_gradient,
-                     xsph_velocity)
+from .passes import (forces, gradient_scratch, stress_terms, update_density_and_h,
+                     velocity_gradient, xsph_velocity)
 from .swegle import FLAG_FRACTION, REL_STRESS_TOL, count_unstable, stress_scale, swegle_indicator
 from .tl_scheme import TotalLagrangian
 
@@ -134,6 +134,9 @@ class SPHPart:
         self.density_limits = np.array(settings.density_limits, float).reshape(-1, 2)
         # pair gradient factors of the current list (float32, see velocity_gradient)
         self.F = self._F_buf = np.zeros(0, dtype=np.float32)
+        # row buffers of velocity_gradient, sized for the list they were made for
+        self._scratch = None
+        self._scratch_list = None
         #: callables run after every pass of :meth:`_gradients` (before the
         #: stress divergence): a coupling may zero pair factors ``F`` there
         self.pair_filters: list = []
@@ -388,9 +391,12 @@ class SPHPart:
                 self._F_buf = np.empty(int(need * 1.1), dtype=np.float32)
             self.F = self._F_buf[:need]
         if self.has_ul:
+            if self._scratch_list != (id(nl), nl.n_builds):  # after a rebuild
+                self._scratch = gradient_scratch(nl.offsets, self._scratch)
+                self._scratch_list = (id(nl), nl.n_builds)
             velocity_gradient(p.x, p.v, p.h, p.m, p.rho, nl.offsets, nl.idx, k.kid, k.sigma,
                               self.dim, k.support_scale, self.s.correction, self.F, p.L,
-                              p.B, p.n_support)
+                              p.B, p.n_support, self._scratch)
         if self.tl is not None:
             self.tl.velocity_gradient(p)
         for f in self.pair_filters:

@@ -43,6 +43,7 @@ import numpy as np
 from numba import njit, prange
 
 from ...kernels import dwdq_over_q, kernel_value, support_nb
+from ...simd import sqrt as simd_sqrt
 
 # Determinant below which the correction matrix is treated as singular
 # (isolated particle or a neighbourhood on a line); the raw gradient is used then.
@@ -142,6 +143,16 @@ def _gradient_row(i, x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sca
                 m12 -= d1 * g2
                 m22 -= d2 * g2
     count[i] = head - offsets[i]
+    _finish_row(i, dim, correct, l00, l01, l02, l10, l11, l12, l20, l21, l22,
+                m00, m01, m02, m11, m12, m22, L, B)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _finish_row(i, dim, correct, l00, l01, l02, l10, l11, l12, l20, l21, l22,
+                m00, m01, m02, m11, m12, m22, L, B):
+    """Row ``i``'s ``L`` and ``B`` from its sums (:func:`velocity_gradient`):
+    the correction ``Q = M^-1`` of the moment matrix ``M`` (upper triangle
+    ``m..``) when ``correct``, and ``L = L_raw Q``, ``B = Q``."""
     # Q = M^{-1} (symmetric, as M is): L_true = L_raw Q, B = Q^T = Q
     q00 = q11 = q22 = 1.0
     q01 = q02 = q12 = 0.0
@@ -184,9 +195,139 @@ def _gradient_row(i, x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sca
     B[i, 2, 2] = q22
 
 
+#: rows of a chunk's row buffer in :func:`_buffered_row` (pair ``t`` of the
+#: row within the support in column ``t``): x_i - x_j, r^2, h_j, v_j - v_i,
+#: m_j / rho_i, then the pair's m_j F_ij / rho_i and its gradient g
+_D0, _D1, _D2, _R2, _HJ, _U0, _U1, _U2, _WM, _FW, _G0, _G1, _G2 = range(13)
+_ROWS = 13
+#: contiguous particle chunks of the buffered pass (each a row buffer)
+GRADIENT_CHUNKS = 64
+
+
+def gradient_scratch(offsets, scratch=None):
+    """Row buffers (GRADIENT_CHUNKS, 13, width) of :func:`velocity_gradient`'s
+    buffered forms, ``width`` the longest row of the CSR list ``offsets``
+    ((N + 1,)): ``scratch`` itself when it is wide enough (called after each
+    neighbour rebuild; a longer row than the buffer is worked without it)."""
+    width = int(np.max(np.diff(offsets))) if offsets.shape[0] > 1 else 0
+    if scratch is not None and scratch.shape[2] >= width:
+        return scratch
+    return np.zeros((GRADIENT_CHUNKS, _ROWS, int(width * 1.2) + 8))
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _buffered_row(i, x, v, h, m, rho, offsets, idx, sigma, support_scale, correct, F, L, B,
+                  count, W):
+    """Row ``i`` of :func:`velocity_gradient` for the 3D cubic spline, the same
+    operations in the same order as :func:`_gradient_row` (the same bits),
+    in three loops over the row buffer ``W`` (13, width): (1) gather and
+    partition, (2) the kernel factors and the pair gradients, pair by pair
+    independent, which the compiler turns into SIMD instructions, (3) the
+    row's sums, in the row's order."""
+    xi0 = x[i, 0]
+    xi1 = x[i, 1]
+    xi2 = x[i, 2]
+    vi0 = v[i, 0]
+    vi1 = v[i, 1]
+    vi2 = v[i, 2]
+    hi = h[i]
+    irho = 1.0 / rho[i]
+    o = offsets[i]
+    head = o
+    for k in range(o, offsets[i + 1]):
+        j = idx[k]
+        d0 = xi0 - x[j, 0]
+        d1 = xi1 - x[j, 1]
+        d2 = xi2 - x[j, 2]
+        r2 = d0 * d0 + d1 * d1 + d2 * d2
+        hj = h[j]
+        if r2 >= (2.0 * (support_scale * 0.5 * (hi + hj))) ** 2:
+            F[k] = 0.0
+            continue
+        if k != head:  # swap with the first skin pair of the row
+            idx[k] = idx[head]
+            F[k] = 0.0
+            idx[head] = j
+        t = head - o
+        head += 1
+        W[_D0, t] = d0
+        W[_D1, t] = d1
+        W[_D2, t] = d2
+        W[_R2, t] = r2
+        W[_HJ, t] = hj
+        W[_U0, t] = v[j, 0] - vi0
+        W[_U1, t] = v[j, 1] - vi1
+        W[_U2, t] = v[j, 2] - vi2
+        W[_WM, t] = m[j] * irho
+    c = head - o
+    count[i] = c
+    for t in range(c):
+        ih = 1.0 / (support_scale * 0.5 * (hi + W[_HJ, t]))
+        ih2 = ih * ih
+        scale = sigma * ih2 * ih2
+        scale *= ih
+        q = simd_sqrt(W[_R2, t]) * ih
+        a = 2.0 - q
+        # dwdq_over_q of the cubic spline (kernel 0), both pieces formed
+        w = 9.0 * q - 12.0 if q < 1.0 else (-3.0 * a * a / q if q < 2.0 else 0.0)
+        fk = np.float64(np.float32(scale * w))
+        F[o + t] = fk
+        f = fk * W[_WM, t]
+        W[_FW, t] = f
+        W[_G0, t] = f * W[_D0, t]
+        W[_G1, t] = f * W[_D1, t]
+        W[_G2, t] = f * W[_D2, t]
+    l00 = l01 = l02 = l10 = l11 = l12 = l20 = l21 = l22 = 0.0
+    m00 = m01 = m02 = m11 = m12 = m22 = 0.0
+    for t in range(c):
+        if W[_FW, t] == 0.0:
+            continue
+        g0 = W[_G0, t]
+        g1 = W[_G1, t]
+        g2 = W[_G2, t]
+        u0 = W[_U0, t]
+        u1 = W[_U1, t]
+        u2 = W[_U2, t]
+        l00 += u0 * g0
+        l01 += u0 * g1
+        l10 += u1 * g0
+        l11 += u1 * g1
+        if correct:
+            m00 -= W[_D0, t] * g0
+            m01 -= W[_D0, t] * g1
+            m11 -= W[_D1, t] * g1
+        l02 += u0 * g2
+        l12 += u1 * g2
+        l20 += u2 * g0
+        l21 += u2 * g1
+        l22 += u2 * g2
+        if correct:
+            m02 -= W[_D0, t] * g2
+            m12 -= W[_D1, t] * g2
+            m22 -= W[_D2, t] * g2
+    _finish_row(i, 3, correct, l00, l01, l02, l10, l11, l12, l20, l21, l22,
+                m00, m01, m02, m11, m12, m22, L, B)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _buffered_chunk(t, x, v, h, m, rho, offsets, idx, sigma, support_scale, correct, F, L, B,
+                    count, work):
+    """Chunk ``t`` of :data:`GRADIENT_CHUNKS` (contiguous particles) of the
+    buffered pass; a row longer than the buffer takes :func:`_gradient_row`."""
+    n = x.shape[0]
+    W = work[t]
+    for i in range(t * n // GRADIENT_CHUNKS, (t + 1) * n // GRADIENT_CHUNKS):
+        if offsets[i + 1] - offsets[i] <= W.shape[1]:
+            _buffered_row(i, x, v, h, m, rho, offsets, idx, sigma, support_scale, correct,
+                          F, L, B, count, W)
+        else:
+            _gradient_row(i, x, v, h, m, rho, offsets, idx, 0, sigma, 3, support_scale,
+                          correct, F, L, B, count)
+
+
 @njit(cache=True, error_model="numpy", parallel=True)
 def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_scale, correct,
-                      F, L, B, count):
+                      F, L, B, count, work):
     r"""Velocity gradient with optional Randles-Libersky renormalisation.
 
     .. math::
@@ -211,7 +352,11 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
     and dimension), picked outside the particle loop, so the common cases
     carry no branch on the kernel or the dimension and no moment sums they
     do not use (BENCHMARKS.md, 2026-11-26: a spilled sum cost more than its
-    arithmetic).
+    arithmetic). The 3D cubic-spline forms work each row through a row
+    buffer (:func:`_buffered_row`): the kernel factors and pair gradients of
+    a row's pairs, independent of each other, are formed in SIMD
+    instructions; the sums keep the row's order, so the bits are those of
+    the pair-by-pair row (BENCHMARKS.md, 2026-11-27 later).
 
     The pass also stores the kernel-gradient factor of every pair,
 
@@ -254,19 +399,21 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
     B : (N, 3, 3) out, correction matrix applied to kernel gradients
         (identity when ``correct`` is False).
     count : (N,) int32 out, pairs within the support at the head of row i.
+    work : (GRADIENT_CHUNKS, 13, width) scratch of the buffered forms
+        (:func:`gradient_scratch`).
     """
     n = x.shape[0]
     # constants in the common forms (the cubic spline is kernel 0); the
     # same row in each
     if dim == 3 and kid == 0:
         if correct:
-            for i in prange(n):
-                _gradient_row(i, x, v, h, m, rho, offsets, idx, 0, sigma, 3, support_scale,
-                              True, F, L, B, count)
+            for t in prange(GRADIENT_CHUNKS):
+                _buffered_chunk(t, x, v, h, m, rho, offsets, idx, sigma, support_scale, True,
+                                F, L, B, count, work)
         else:
-            for i in prange(n):
-                _gradient_row(i, x, v, h, m, rho, offsets, idx, 0, sigma, 3, support_scale,
-                              False, F, L, B, count)
+            for t in prange(GRADIENT_CHUNKS):
+                _buffered_chunk(t, x, v, h, m, rho, offsets, idx, sigma, support_scale, False,
+                                F, L, B, count, work)
     elif correct:
         for i in prange(n):
             _gradient_row(i, x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_scale,
