@@ -9,7 +9,7 @@ from sphdyn.geometry import box_lattice
 from sphdyn.neighbours import build_neighbours
 from stepping import build_stepper
 from sphdyn.parts.sph.artificial_stress import artificial_stress_forces, artificial_stress_tensor
-from sphdyn.parts.sph.passes import pair_scratch, velocity_gradient
+from sphdyn.parts.sph.passes import gradient_scratch, velocity_gradient
 
 RHO = 1000.0
 EPS = 0.3
@@ -86,7 +86,7 @@ def _cloud(dim, n_side=8, dx=0.01, hfac=1.3, jitter=0.2, seed=0):
     B = np.zeros((n, 3, 3))
     velocity_gradient(x, np.zeros((n, 3)), h, m, rho, nl.offsets, nl.idx, kid,
                       kernels.normalisation(kid, dim), dim, 1.0, False, F, L, B,
-                      np.zeros(n, np.int32), pair_scratch(nl.offsets))
+                      np.zeros(n, np.int32), gradient_scratch(nl.offsets))
     sig = rng.normal(scale=1e6, size=(n, 3, 3))
     sig = 0.5 * (sig + sig.transpose(0, 2, 1))
     if dim == 2:

@@ -6,7 +6,7 @@ import pytest
 from sphdyn import kernels
 from sphdyn.geometry import box_lattice
 from sphdyn.neighbours import build_neighbours
-from sphdyn.parts.sph.passes import (forces, pair_scratch, stress_terms,
+from sphdyn.parts.sph.passes import (forces, gradient_scratch, stress_terms,
                                      update_density_and_h, velocity_gradient, xsph_velocity)
 
 
@@ -46,7 +46,7 @@ def _grad(c, v, correct, with_factors=False):
     F = np.zeros(nl.idx.size, dtype=np.float32)  # as the part stores them
     count = np.zeros(n, np.int32)
     velocity_gradient(c["x"], v, c["h"], c["m"], c["rho"], nl.offsets, nl.idx, c["kid"], c["sigma"],
-                      c["dim"], 1.0, correct, F, L, B, count, pair_scratch(nl.offsets))
+                      c["dim"], 1.0, correct, F, L, B, count, gradient_scratch(nl.offsets))
     return (L, B, F, count) if with_factors else (L, B)
 
 
@@ -189,7 +189,7 @@ def _forces(c, sig, v=None, correct=False, alpha=0.0, beta=0.0, cs=1000.0):
     stress_terms(sig, c["rho"], B, P)
     forces(c["x"], v, c["m"], c["rho"], c["h"], np.full(n, cs), P, F,
            nl.offsets, count, nl.idx, c["dim"], 1.0, np.full(n, alpha), np.full(n, beta),
-           a, dedt, np.zeros(n), pair_scratch(nl.offsets))
+           a, dedt, np.zeros(n))
     return a, dedt
 
 
@@ -242,8 +242,7 @@ def test_rows_hold_the_pairs_within_the_support_first(dim):
     a_all, heat_all = np.zeros_like(a_head), np.zeros_like(heat_head)
     forces(x, v, c["m"], c["rho"], h, np.full(x.shape[0], 1000.0), P, F, nl.offsets,
            np.diff(nl.offsets).astype(np.int32), nl.idx, dim, 1.0, np.ones(x.shape[0]),
-           np.full(x.shape[0], 2.0), a_all, heat_all, np.zeros(x.shape[0]),
-           pair_scratch(nl.offsets))
+           np.full(x.shape[0], 2.0), a_all, heat_all, np.zeros(x.shape[0]))
     assert np.array_equal(a_head, a_all) and np.array_equal(heat_head, heat_all)
 
 
@@ -506,7 +505,7 @@ def test_pair_stress_and_viscosity_match_their_formulas(alpha, beta, approach):
     alphas, betas = alpha * np.array([0.5, 1.5]), beta * np.array([1.5, 0.5])
     signal = np.zeros(2)
     forces(x, v, m, rho, h, c, P, F, offsets, count, idx, 3, support_scale, alphas, betas,
-           a, dedt, signal, pair_scratch(offsets))
+           a, dedt, signal)
     acc, heat, pi = _pair_acceleration(x, v, m, rho, h, c, S, B, F[0], support_scale,
                                        alpha, beta)
     assert (pi != 0.0) == approach
@@ -517,7 +516,7 @@ def test_pair_stress_and_viscosity_match_their_formulas(alpha, beta, approach):
         # the viscous part alone, separately: with zero stress the
         # acceleration is -m_j Pi_ij g_ij exactly
         forces(x, v, m, rho, h, c, np.zeros_like(P), F, offsets, count, idx, 3,
-               support_scale, alphas, betas, a, dedt, signal, pair_scratch(offsets))
+               support_scale, alphas, betas, a, dedt, signal)
         expect = -m[1] * pi * F[0] * (x[0] - x[1])
         assert np.allclose(a[0], expect, rtol=1e-12, atol=0.0)
         assert heat > 0.0  # viscosity only heats
@@ -574,7 +573,7 @@ def test_buffered_gradient_rows_give_the_pair_by_pair_bits(correct):
     lengths = np.diff(nl.offsets)
     results = []
     for width in (None, 0, int(np.median(lengths))):
-        scratch = pair_scratch(nl.offsets) if width is None else np.zeros((64, 27, width))
+        scratch = gradient_scratch(nl.offsets) if width is None else np.zeros((64, 13, width))
         idx = nl.idx.copy()
         F = np.zeros(idx.size, np.float32)
         L = np.zeros((n, 3, 3))
@@ -588,44 +587,3 @@ def test_buffered_gradient_rows_give_the_pair_by_pair_bits(correct):
     for other in results[1:]:
         for a, b in zip(results[0], other):
             assert np.array_equal(a, b)
-
-
-@pytest.mark.parametrize("per_particle", [False, True])
-def test_buffered_force_rows_give_the_pair_by_pair_bits(per_particle):
-    # The 3D form of forces works rows through a row buffer (viscosity for
-    # every pair, kept by selection); a row longer than the buffer takes the
-    # pair-by-pair row (_force_row), so a zero-width buffer is the reference.
-    # Bit for bit: acceleration, heating and signal speed, on a jittered
-    # cloud with random velocities (about half the pairs approach), random
-    # stresses, zero-mass neighbours, a pair factor a coupling zeroed, and
-    # one or per-particle viscosity coefficients; also a buffer that takes
-    # only some rows.
-    c = _cloud(3, n_side=9, jitter=0.3, hfac=1.3, seed=6)
-    n = c["x"].shape[0]
-    rng = np.random.default_rng(9)
-    x, h = c["x"], c["h"] * rng.uniform(0.9, 1.1, n)
-    m = c["m"].copy()
-    m[rng.choice(n, 20, replace=False)] = 0.0
-    v = rng.normal(size=(n, 3))
-    nl = build_neighbours(x, h, kernels.support(0), 0.2, 3)
-    F = np.zeros(nl.idx.size, np.float32)
-    count = np.zeros(n, np.int32)
-    velocity_gradient(x, v, h, m, c["rho"], nl.offsets, nl.idx, 0, c["sigma"], 3, 1.0, False,
-                      F, np.zeros((n, 3, 3)), np.zeros((n, 3, 3)), count,
-                      pair_scratch(nl.offsets))
-    F[nl.offsets[5]] = 0.0  # as a coupling's pair filter does
-    P = rng.normal(scale=1e-3, size=(n, 3, 3))
-    cs = rng.uniform(2000.0, 4000.0, n)
-    alpha = rng.uniform(0.5, 1.5, n) if per_particle else np.ones(1)
-    beta = rng.uniform(1.0, 3.0, n) if per_particle else np.full(1, 2.0)
-    out = []
-    for width in (None, 0, int(np.median(count))):
-        scratch = pair_scratch(nl.offsets) if width is None else np.zeros((64, 27, width))
-        a, heat, signal = np.zeros((n, 3)), np.zeros(n), np.zeros(n)
-        forces(x, v, m, c["rho"], h, cs, P, F, nl.offsets, count, nl.idx, 3, 1.0, alpha, beta,
-               a, heat, signal, scratch)
-        out.append((a, heat, signal))
-    assert (out[0][1] > 0).mean() > 0.9 and (out[0][2] > 0).mean() > 0.9
-    for other in out[1:]:
-        for p, q in zip(out[0], other):
-            assert np.array_equal(p, q)

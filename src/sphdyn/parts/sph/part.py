@@ -40,7 +40,7 @@ from ...neighbours import build_neighbours, mean_neighbours, update_neighbours
 from ...state import BC_FIXED, Particles
 from ..base import register_part
 from .artificial_stress import artificial_stress_forces, artificial_stress_tensor
-from .passes import (forces, pair_scratch, stress_terms, update_density_and_h,
+from .passes import (forces, gradient_scratch, stress_terms, update_density_and_h,
                      velocity_gradient, xsph_velocity)
 from .swegle import FLAG_FRACTION, REL_STRESS_TOL, count_unstable, stress_scale, swegle_indicator
 from .tl_scheme import TotalLagrangian
@@ -134,7 +134,7 @@ class SPHPart:
         self.density_limits = np.array(settings.density_limits, float).reshape(-1, 2)
         # pair gradient factors of the current list (float32, see velocity_gradient)
         self.F = self._F_buf = np.zeros(0, dtype=np.float32)
-        # row buffers of the pair passes, sized for the list they were made for
+        # row buffers of velocity_gradient, sized for the list they were made for
         self._scratch = None
         self._scratch_list = None
         #: callables run after every pass of :meth:`_gradients` (before the
@@ -391,9 +391,12 @@ class SPHPart:
                 self._F_buf = np.empty(int(need * 1.1), dtype=np.float32)
             self.F = self._F_buf[:need]
         if self.has_ul:
+            if self._scratch_list != (id(nl), nl.n_builds):  # after a rebuild
+                self._scratch = gradient_scratch(nl.offsets, self._scratch)
+                self._scratch_list = (id(nl), nl.n_builds)
             velocity_gradient(p.x, p.v, p.h, p.m, p.rho, nl.offsets, nl.idx, k.kid, k.sigma,
                               self.dim, k.support_scale, self.s.correction, self.F, p.L,
-                              p.B, p.n_support, self._pair_scratch())
+                              p.B, p.n_support, self._scratch)
         if self.tl is not None:
             self.tl.velocity_gradient(p)
         for f in self.pair_filters:
@@ -410,8 +413,7 @@ class SPHPart:
             stress_terms(p.sig, p.rho, p.B, p.S)
             alpha, beta, signal = self._viscosity_arrays()
             forces(p.x, p.v, p.m, p.rho, p.h, p.c, p.S, self.F, nl.offsets, p.n_support,
-                   nl.idx, self.dim, k.support_scale, alpha, beta, p.a, p.dedt_av, signal,
-                   self._pair_scratch())
+                   nl.idx, self.dim, k.support_scale, alpha, beta, p.a, p.dedt_av, signal)
         if self.as_on:
             artificial_stress_tensor(p.sig, p.rho, p.as_eps, p.R, p.Q)
             artificial_stress_forces(p.x, p.m, p.h, p.R, self.F, nl.offsets, nl.idx,
@@ -419,15 +421,6 @@ class SPHPart:
                                      s.stress_exponent, p.a, p.v, p.dedt_av)
         if self.tl is not None:
             self.tl.accelerations(p, p.dedt_av)
-
-    def _pair_scratch(self):
-        """The row buffers of the pair passes (:func:`.passes.pair_scratch`),
-        widened after a neighbour rebuild that made a row longer."""
-        nl = self.nl
-        if self._scratch_list != (id(nl), nl.n_builds):
-            self._scratch = pair_scratch(nl.offsets, self._scratch)
-            self._scratch_list = (id(nl), nl.n_builds)
-        return self._scratch
 
     def _viscosity_arrays(self):
         """``(alpha, beta, signal)`` for :func:`.passes.forces`: the particles'

@@ -199,25 +199,20 @@ def _finish_row(i, dim, correct, l00, l01, l02, l10, l11, l12, l20, l21, l22,
 #: row within the support in column ``t``): x_i - x_j, r^2, h_j, v_j - v_i,
 #: m_j / rho_i, then the pair's m_j F_ij / rho_i and its gradient g
 _D0, _D1, _D2, _R2, _HJ, _U0, _U1, _U2, _WM, _FW, _G0, _G1, _G2 = range(13)
-#: rows in :func:`_buffered_force_row`: the neighbour's x, v, P (9), F, m,
-#: h, c, rho, alpha, beta; then the pair's m_j a_ij (3), heat and signal
-(_XJ, _VJ, _PJ, _FK, _MJ, _HF, _CJ, _RJ, _AJ, _BJ, _AC, _DH, _SG) = (
-    0, 3, 6, 15, 16, 17, 18, 19, 20, 21, 22, 25, 26)
-_ROWS = 27
-#: contiguous particle chunks of the buffered passes (each a row buffer)
-PAIR_CHUNKS = 64
+_ROWS = 13
+#: contiguous particle chunks of the buffered pass (each a row buffer)
+GRADIENT_CHUNKS = 64
 
 
-def pair_scratch(offsets, scratch=None):
-    """Row buffers (PAIR_CHUNKS, 27, width) of the buffered forms of
-    :func:`velocity_gradient` and :func:`forces`, ``width`` the longest row
-    of the CSR list ``offsets`` ((N + 1,)): ``scratch`` itself when it is
-    wide enough (called after each neighbour rebuild; a row longer than the
-    buffer is worked pair by pair)."""
+def gradient_scratch(offsets, scratch=None):
+    """Row buffers (GRADIENT_CHUNKS, 13, width) of :func:`velocity_gradient`'s
+    buffered forms, ``width`` the longest row of the CSR list ``offsets``
+    ((N + 1,)): ``scratch`` itself when it is wide enough (called after each
+    neighbour rebuild; a longer row than the buffer is worked without it)."""
     width = int(np.max(np.diff(offsets))) if offsets.shape[0] > 1 else 0
     if scratch is not None and scratch.shape[2] >= width:
         return scratch
-    return np.zeros((PAIR_CHUNKS, _ROWS, int(width * 1.2) + 8))
+    return np.zeros((GRADIENT_CHUNKS, _ROWS, int(width * 1.2) + 8))
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -225,7 +220,7 @@ def _buffered_row(i, x, v, h, m, rho, offsets, idx, sigma, support_scale, correc
                   count, W):
     """Row ``i`` of :func:`velocity_gradient` for the 3D cubic spline, the same
     operations in the same order as :func:`_gradient_row` (the same bits),
-    in three loops over the row buffer ``W`` (27, width; 13 rows used): (1) gather and
+    in three loops over the row buffer ``W`` (13, width): (1) gather and
     partition, (2) the kernel factors and the pair gradients, pair by pair
     independent, which the compiler turns into SIMD instructions, (3) the
     row's sums, in the row's order."""
@@ -317,11 +312,11 @@ def _buffered_row(i, x, v, h, m, rho, offsets, idx, sigma, support_scale, correc
 @njit(cache=True, error_model="numpy", inline="always")
 def _buffered_chunk(t, x, v, h, m, rho, offsets, idx, sigma, support_scale, correct, F, L, B,
                     count, work):
-    """Chunk ``t`` of :data:`PAIR_CHUNKS` (contiguous particles) of the
+    """Chunk ``t`` of :data:`GRADIENT_CHUNKS` (contiguous particles) of the
     buffered pass; a row longer than the buffer takes :func:`_gradient_row`."""
     n = x.shape[0]
     W = work[t]
-    for i in range(t * n // PAIR_CHUNKS, (t + 1) * n // PAIR_CHUNKS):
+    for i in range(t * n // GRADIENT_CHUNKS, (t + 1) * n // GRADIENT_CHUNKS):
         if offsets[i + 1] - offsets[i] <= W.shape[1]:
             _buffered_row(i, x, v, h, m, rho, offsets, idx, sigma, support_scale, correct,
                           F, L, B, count, W)
@@ -404,19 +399,19 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
     B : (N, 3, 3) out, correction matrix applied to kernel gradients
         (identity when ``correct`` is False).
     count : (N,) int32 out, pairs within the support at the head of row i.
-    work : (PAIR_CHUNKS, 27, width) scratch of the buffered forms
-        (:func:`pair_scratch`).
+    work : (GRADIENT_CHUNKS, 13, width) scratch of the buffered forms
+        (:func:`gradient_scratch`).
     """
     n = x.shape[0]
     # constants in the common forms (the cubic spline is kernel 0); the
     # same row in each
     if dim == 3 and kid == 0:
         if correct:
-            for t in prange(PAIR_CHUNKS):
+            for t in prange(GRADIENT_CHUNKS):
                 _buffered_chunk(t, x, v, h, m, rho, offsets, idx, sigma, support_scale, True,
                                 F, L, B, count, work)
         else:
-            for t in prange(PAIR_CHUNKS):
+            for t in prange(GRADIENT_CHUNKS):
                 _buffered_chunk(t, x, v, h, m, rho, offsets, idx, sigma, support_scale, False,
                                 F, L, B, count, work)
     elif correct:
@@ -430,7 +425,7 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
 
 @njit(cache=True, error_model="numpy", parallel=True)
 def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, dim, support_scale, alpha, beta,
-           a, dedt_av, signal, work):
+           a, dedt_av, signal):
     r"""Acceleration from the stress divergence and Monaghan artificial viscosity.
 
     Symmetric (momentum-conserving) form of Gray, Monaghan & Swift (2001),
@@ -480,226 +475,90 @@ def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, dim, support_scale, al
     dedt_av : (N,) out, viscous heating rate [W/kg].
     signal : (N,) out, viscous signal speed [m/s], or (0,): not wanted (no
         fluid particles; the pass then skips it).
-    work : (PAIR_CHUNKS, 27, width) scratch (:func:`pair_scratch`) of the 3D
-        form, which works each row through a row buffer
-        (:func:`_buffered_force_row`: the pair terms, viscosity included, in
-        SIMD instructions without a branch; the sums in the row's order, so
-        the same bits as pair by pair).
     """
     n = x.shape[0]
+    three = dim == 3
     per_particle = alpha.shape[0] > 1
     want_signal = signal.shape[0] > 0
-    if dim == 3:
-        for t in prange(PAIR_CHUNKS):
-            W = work[t]
-            for i in range(t * n // PAIR_CHUNKS, (t + 1) * n // PAIR_CHUNKS):
-                if count[i] <= W.shape[1]:
-                    _buffered_force_row(i, x, v, m, rho, h, c, P, F, offsets, count, idx,
-                                        support_scale, alpha, beta, per_particle, want_signal,
-                                        a, dedt_av, signal, W)
-                else:
-                    _force_row(i, x, v, m, rho, h, c, P, F, offsets, count, idx, True,
-                               support_scale, alpha, beta, per_particle, want_signal, a,
-                               dedt_av, signal)
-    else:
-        for i in prange(n):
-            _force_row(i, x, v, m, rho, h, c, P, F, offsets, count, idx, False, support_scale,
-                       alpha, beta, per_particle, want_signal, a, dedt_av, signal)
-
-
-@njit(cache=True, error_model="numpy", inline="always")
-def _force_row(i, x, v, m, rho, h, c, P, F, offsets, count, idx, three, support_scale, alpha,
-               beta, per_particle, want_signal, a, dedt_av, signal):
-    """Row ``i`` of :func:`forces`, pair by pair."""
-    p00 = P[i, 0, 0]
-    p01 = P[i, 0, 1]
-    p02 = P[i, 0, 2]
-    p10 = P[i, 1, 0]
-    p11 = P[i, 1, 1]
-    p12 = P[i, 1, 2]
-    p20 = P[i, 2, 0]
-    p21 = P[i, 2, 1]
-    p22 = P[i, 2, 2]
-    xi0 = x[i, 0]
-    xi1 = x[i, 1]
-    xi2 = x[i, 2]
-    vi0 = v[i, 0]
-    vi1 = v[i, 1]
-    vi2 = v[i, 2]
-    hi = h[i]
-    ci = c[i]
-    rhoi = rho[i]
-    alphai = alpha[i] if per_particle else alpha[0]
-    betai = beta[i] if per_particle else beta[0]
-    a0 = a1 = a2 = 0.0
-    heat = 0.0
-    sig_max = 0.0
-    for k in range(offsets[i], offsets[i] + count[i]):
-        j = idx[k]
-        f = F[k]
-        mj = m[j]
-        if f == 0.0 or mj == 0.0:  # a pair a coupling took out; a zero-mass j
-            continue
-        d0 = xi0 - x[j, 0]
-        d1 = xi1 - x[j, 1]
-        w0 = vi0 - v[j, 0]
-        w1 = vi1 - v[j, 1]
-        if three:
-            d2 = xi2 - x[j, 2]
-            w2 = vi2 - v[j, 2]
-        else:
-            d2 = 0.0
-            w2 = 0.0
-        g0 = f * d0
-        g1 = f * d1
-        g2 = f * d2
-        f0 = (p00 + P[j, 0, 0]) * g0 + (p01 + P[j, 0, 1]) * g1 + (p02 + P[j, 0, 2]) * g2
-        f1 = (p10 + P[j, 1, 0]) * g0 + (p11 + P[j, 1, 1]) * g1 + (p12 + P[j, 1, 2]) * g2
-        f2 = 0.0
-        if three:
-            f2 = ((p20 + P[j, 2, 0]) * g0 + (p21 + P[j, 2, 1]) * g1
-                  + (p22 + P[j, 2, 2]) * g2)
-        # artificial viscosity, approaching pairs only
-        vx = w0 * d0 + w1 * d1 + w2 * d2
-        if vx < 0.0:
-            hij = support_scale * 0.5 * (hi + h[j])
-            r2 = d0 * d0 + d1 * d1 + d2 * d2
-            mu = hij * vx / (r2 + 0.01 * hij * hij)
-            if per_particle:
-                aij = 0.5 * (alphai + alpha[j]) * 0.5 * (ci + c[j])
-                bij = 0.5 * (betai + beta[j])
+    for i in prange(n):
+        p00 = P[i, 0, 0]
+        p01 = P[i, 0, 1]
+        p02 = P[i, 0, 2]
+        p10 = P[i, 1, 0]
+        p11 = P[i, 1, 1]
+        p12 = P[i, 1, 2]
+        p20 = P[i, 2, 0]
+        p21 = P[i, 2, 1]
+        p22 = P[i, 2, 2]
+        xi0 = x[i, 0]
+        xi1 = x[i, 1]
+        xi2 = x[i, 2]
+        vi0 = v[i, 0]
+        vi1 = v[i, 1]
+        vi2 = v[i, 2]
+        hi = h[i]
+        ci = c[i]
+        rhoi = rho[i]
+        alphai = alpha[i] if per_particle else alpha[0]
+        betai = beta[i] if per_particle else beta[0]
+        a0 = a1 = a2 = 0.0
+        heat = 0.0
+        sig_max = 0.0
+        for k in range(offsets[i], offsets[i] + count[i]):
+            j = idx[k]
+            f = F[k]
+            mj = m[j]
+            if f == 0.0 or mj == 0.0:  # a pair a coupling took out; a zero-mass j
+                continue
+            d0 = xi0 - x[j, 0]
+            d1 = xi1 - x[j, 1]
+            w0 = vi0 - v[j, 0]
+            w1 = vi1 - v[j, 1]
+            if three:
+                d2 = xi2 - x[j, 2]
+                w2 = vi2 - v[j, 2]
             else:
-                aij = alphai * 0.5 * (ci + c[j])
-                bij = betai
-            pi_ij = (-aij * mu + bij * mu * mu) / (0.5 * (rhoi + rho[j]))
-            if want_signal:
-                s_ij = aij - bij * mu  # mu < 0
-                if s_ij > sig_max:
-                    sig_max = s_ij
-            f0 -= pi_ij * g0
-            f1 -= pi_ij * g1
-            f2 -= pi_ij * g2
-            heat += 0.5 * mj * pi_ij * (w0 * g0 + w1 * g1 + w2 * g2)
-        a0 += mj * f0
-        a1 += mj * f1
-        a2 += mj * f2
-    a[i, 0] = a0
-    a[i, 1] = a1
-    a[i, 2] = a2
-    dedt_av[i] = heat
-    if want_signal:
-        signal[i] = sig_max
-
-
-
-@njit(cache=True, error_model="numpy", inline="always")
-def _buffered_force_row(i, x, v, m, rho, h, c, P, F, offsets, count, idx, support_scale, alpha,
-                        beta, per_particle, want_signal, a, dedt_av, signal, W):
-    """Row ``i`` of :func:`forces` in 3D through the row buffer ``W`` (27,
-    width): (1) gather the neighbours' fields, (2) every pair's terms, the
-    viscosity formed for all and kept by selection where the pair
-    approaches (SIMD, no branch), (3) the row's sums in its order. A pair
-    :func:`_force_row` skips (``F = 0`` or a zero-mass neighbour) or one
-    without viscosity adds an exact zero there, which leaves the sums'
-    bits as they are (a sum of round-to-nearest additions starting at +0
-    is never -0), so the bits are :func:`_force_row`'s."""
-    p00 = P[i, 0, 0]
-    p01 = P[i, 0, 1]
-    p02 = P[i, 0, 2]
-    p10 = P[i, 1, 0]
-    p11 = P[i, 1, 1]
-    p12 = P[i, 1, 2]
-    p20 = P[i, 2, 0]
-    p21 = P[i, 2, 1]
-    p22 = P[i, 2, 2]
-    xi0 = x[i, 0]
-    xi1 = x[i, 1]
-    xi2 = x[i, 2]
-    vi0 = v[i, 0]
-    vi1 = v[i, 1]
-    vi2 = v[i, 2]
-    hi = h[i]
-    ci = c[i]
-    rhoi = rho[i]
-    alphai = alpha[i] if per_particle else alpha[0]
-    betai = beta[i] if per_particle else beta[0]
-    o = offsets[i]
-    cnt = count[i]
-    for t in range(cnt):
-        j = idx[o + t]
-        W[_XJ, t] = x[j, 0]
-        W[_XJ + 1, t] = x[j, 1]
-        W[_XJ + 2, t] = x[j, 2]
-        W[_VJ, t] = v[j, 0]
-        W[_VJ + 1, t] = v[j, 1]
-        W[_VJ + 2, t] = v[j, 2]
-        for r in range(3):
-            W[_PJ + 3 * r, t] = P[j, r, 0]
-            W[_PJ + 3 * r + 1, t] = P[j, r, 1]
-            W[_PJ + 3 * r + 2, t] = P[j, r, 2]
-        W[_FK, t] = F[o + t]
-        W[_MJ, t] = m[j]
-        W[_HF, t] = h[j]
-        W[_CJ, t] = c[j]
-        W[_RJ, t] = rho[j]
-        if per_particle:
-            W[_AJ, t] = alpha[j]
-            W[_BJ, t] = beta[j]
-    for t in range(cnt):
-        f = W[_FK, t]
-        mj = W[_MJ, t]
-        d0 = xi0 - W[_XJ, t]
-        d1 = xi1 - W[_XJ + 1, t]
-        d2 = xi2 - W[_XJ + 2, t]
-        w0 = vi0 - W[_VJ, t]
-        w1 = vi1 - W[_VJ + 1, t]
-        w2 = vi2 - W[_VJ + 2, t]
-        g0 = f * d0
-        g1 = f * d1
-        g2 = f * d2
-        f0 = ((p00 + W[_PJ, t]) * g0 + (p01 + W[_PJ + 1, t]) * g1
-              + (p02 + W[_PJ + 2, t]) * g2)
-        f1 = ((p10 + W[_PJ + 3, t]) * g0 + (p11 + W[_PJ + 4, t]) * g1
-              + (p12 + W[_PJ + 5, t]) * g2)
-        f2 = ((p20 + W[_PJ + 6, t]) * g0 + (p21 + W[_PJ + 7, t]) * g1
-              + (p22 + W[_PJ + 8, t]) * g2)
-        vx = w0 * d0 + w1 * d1 + w2 * d2
-        hij = support_scale * 0.5 * (hi + W[_HF, t])
-        r2 = d0 * d0 + d1 * d1 + d2 * d2
-        mu = hij * vx / (r2 + 0.01 * hij * hij)
-        if per_particle:
-            aij = 0.5 * (alphai + W[_AJ, t]) * 0.5 * (ci + W[_CJ, t])
-            bij = 0.5 * (betai + W[_BJ, t])
-        else:
-            aij = alphai * 0.5 * (ci + W[_CJ, t])
-            bij = betai
-        pi_ij = (-aij * mu + bij * mu * mu) / (0.5 * (rhoi + W[_RJ, t]))
-        live = f != 0.0 and mj != 0.0
-        on = vx < 0.0 and live
-        f0 = f0 - pi_ij * g0 if on else f0
-        f1 = f1 - pi_ij * g1 if on else f1
-        f2 = f2 - pi_ij * g2 if on else f2
-        W[_AC, t] = mj * f0 if live else 0.0
-        W[_AC + 1, t] = mj * f1 if live else 0.0
-        W[_AC + 2, t] = mj * f2 if live else 0.0
-        W[_DH, t] = 0.5 * mj * pi_ij * (w0 * g0 + w1 * g1 + w2 * g2) if on else 0.0
-        W[_SG, t] = aij - bij * mu if on else 0.0  # mu < 0
-    a0 = a1 = a2 = 0.0
-    heat = 0.0
-    sig_max = 0.0
-    for t in range(cnt):
-        a0 += W[_AC, t]
-        a1 += W[_AC + 1, t]
-        a2 += W[_AC + 2, t]
-        heat += W[_DH, t]
-        s_ij = W[_SG, t]
-        sig_max = s_ij if s_ij > sig_max else sig_max
-    a[i, 0] = a0
-    a[i, 1] = a1
-    a[i, 2] = a2
-    dedt_av[i] = heat
-    if want_signal:
-        signal[i] = sig_max
+                d2 = 0.0
+                w2 = 0.0
+            g0 = f * d0
+            g1 = f * d1
+            g2 = f * d2
+            f0 = (p00 + P[j, 0, 0]) * g0 + (p01 + P[j, 0, 1]) * g1 + (p02 + P[j, 0, 2]) * g2
+            f1 = (p10 + P[j, 1, 0]) * g0 + (p11 + P[j, 1, 1]) * g1 + (p12 + P[j, 1, 2]) * g2
+            f2 = 0.0
+            if three:
+                f2 = ((p20 + P[j, 2, 0]) * g0 + (p21 + P[j, 2, 1]) * g1
+                      + (p22 + P[j, 2, 2]) * g2)
+            # artificial viscosity, approaching pairs only
+            vx = w0 * d0 + w1 * d1 + w2 * d2
+            if vx < 0.0:
+                hij = support_scale * 0.5 * (hi + h[j])
+                r2 = d0 * d0 + d1 * d1 + d2 * d2
+                mu = hij * vx / (r2 + 0.01 * hij * hij)
+                if per_particle:
+                    aij = 0.5 * (alphai + alpha[j]) * 0.5 * (ci + c[j])
+                    bij = 0.5 * (betai + beta[j])
+                else:
+                    aij = alphai * 0.5 * (ci + c[j])
+                    bij = betai
+                pi_ij = (-aij * mu + bij * mu * mu) / (0.5 * (rhoi + rho[j]))
+                if want_signal:
+                    s_ij = aij - bij * mu  # mu < 0
+                    if s_ij > sig_max:
+                        sig_max = s_ij
+                f0 -= pi_ij * g0
+                f1 -= pi_ij * g1
+                f2 -= pi_ij * g2
+                heat += 0.5 * mj * pi_ij * (w0 * g0 + w1 * g1 + w2 * g2)
+            a0 += mj * f0
+            a1 += mj * f1
+            a2 += mj * f2
+        a[i, 0] = a0
+        a[i, 1] = a1
+        a[i, 2] = a2
+        dedt_av[i] = heat
+        if want_signal:
+            signal[i] = sig_max
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
