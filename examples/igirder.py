@@ -64,6 +64,10 @@ FEM_VARIANTS = {
     "fem_5mm": ("pure FEM, one-point hexes of 5 mm",
                 ['mesh.0.prism.element_size="5 mm"'] +
                 [f'mesh.{k}.line.element_length="5 mm"' for k in range(1, 5)]),
+    # half the loading rate: how much of the dip after the first crack is
+    # the girder ringing (inertia) rather than its static response
+    "fem_slow": ("pure FEM, the load ramped over 64 ms (half the rate)",
+                 ['run.t_end="64 ms"', 'boundary.2.ramp_time="64 ms"']),
 }
 
 

@@ -391,12 +391,9 @@ class SPHPart:
                 self._F_buf = np.empty(int(need * 1.1), dtype=np.float32)
             self.F = self._F_buf[:need]
         if self.has_ul:
-            if self._scratch_list != (id(nl), nl.n_builds):  # after a rebuild
-                self._scratch = gradient_scratch(nl.offsets, self._scratch)
-                self._scratch_list = (id(nl), nl.n_builds)
             velocity_gradient(p.x, p.v, p.h, p.m, p.rho, nl.offsets, nl.idx, k.kid, k.sigma,
                               self.dim, k.support_scale, self.s.correction, self.F, p.L,
-                              p.B, p.n_support, self._scratch)
+                              p.B, p.n_support, self._gradient_scratch())
         if self.tl is not None:
             self.tl.velocity_gradient(p)
         for f in self.pair_filters:
@@ -421,6 +418,16 @@ class SPHPart:
                                      s.stress_exponent, p.a, p.v, p.dedt_av)
         if self.tl is not None:
             self.tl.accelerations(p, p.dedt_av)
+
+    def _gradient_scratch(self):
+        """The row buffers of :func:`.passes.velocity_gradient`
+        (:func:`.passes.gradient_scratch`), widened after a neighbour rebuild
+        that made a row longer."""
+        nl = self.nl
+        if self._scratch_list != (id(nl), nl.n_builds):
+            self._scratch = gradient_scratch(nl.offsets, self._scratch)
+            self._scratch_list = (id(nl), nl.n_builds)
+        return self._scratch
 
     def _viscosity_arrays(self):
         """``(alpha, beta, signal)`` for :func:`.passes.forces`: the particles'
