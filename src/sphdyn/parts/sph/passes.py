@@ -298,13 +298,11 @@ def _buffered_row(i, x, v, h, m, rho, offsets, idx, sigma, support_scale, correc
         l21 += u2 * g1
         l22 += u2 * g2
         if correct:  # (x_j - x_i) = -d
-            d0 = W[_D0, t]
-            d1 = W[_D1, t]
-            m00 -= d0 * g0
-            m01 -= d0 * g1
-            m02 -= d0 * g2
-            m11 -= d1 * g1
-            m12 -= d1 * g2
+            m00 -= W[_D0, t] * g0
+            m01 -= W[_D0, t] * g1
+            m02 -= W[_D0, t] * g2
+            m11 -= W[_D1, t] * g1
+            m12 -= W[_D1, t] * g2
             m22 -= W[_D2, t] * g2
     _finish_row(i, 3, correct, l00, l01, l02, l10, l11, l12, l20, l21, l22,
                 m00, m01, m02, m11, m12, m22, L, B)
