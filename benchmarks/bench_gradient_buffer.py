@@ -26,7 +26,7 @@ import numpy as np
 from sphdyn.assembly import build_stepper
 from sphdyn.bench import case_deck
 from sphdyn.deck import load_deck
-from sphdyn.parts.sph.passes import GRADIENT_CHUNKS, velocity_gradient
+from sphdyn.parts.sph.passes import GRADIENT_CHUNKS, GRADIENT_ROWS, velocity_gradient
 
 
 def main() -> None:
@@ -57,7 +57,7 @@ def main() -> None:
         return time.perf_counter() - t0
 
     forms = {"buffered": part._gradient_scratch(),
-             "pair by pair": np.zeros((GRADIENT_CHUNKS, 13, 0))}
+             "pair by pair": np.zeros((GRADIENT_CHUNKS, GRADIENT_ROWS, 0))}
     times: dict = {name: [] for name in forms}
     for scratch in forms.values():
         call(scratch)  # compilation or cache load

@@ -6,7 +6,8 @@ import pytest
 from sphdyn import kernels
 from sphdyn.geometry import box_lattice
 from sphdyn.neighbours import build_neighbours
-from sphdyn.parts.sph.passes import (forces, gradient_scratch, stress_terms,
+from sphdyn.parts.sph.passes import (GRADIENT_CHUNKS, GRADIENT_ROWS, forces, gradient_scratch,
+                                     stress_terms,
                                      update_density_and_h, velocity_gradient, xsph_velocity)
 
 
@@ -573,7 +574,7 @@ def test_buffered_gradient_rows_give_the_pair_by_pair_bits(correct):
     lengths = np.diff(nl.offsets)
     results = []
     for width in (None, 0, int(np.median(lengths))):
-        scratch = gradient_scratch(nl.offsets) if width is None else np.zeros((64, 13, width))
+        scratch = gradient_scratch(nl.offsets) if width is None else np.zeros((GRADIENT_CHUNKS, GRADIENT_ROWS, width))
         idx = nl.idx.copy()
         F = np.zeros(idx.size, np.float32)
         L = np.zeros((n, 3, 3))

@@ -413,7 +413,8 @@ def elastic_radius_bound(p):
     (packed as ``P_R0_ELASTIC``; called once per material, in Python).
 
     Where ``Ff``, ``Q1`` and ``Q2`` do not decrease with ``J1`` (``lamda beta
-    >= 0`` and ``theta >= 0`` for each, as in every fit of notes sec. 1.5-1.6),
+    >= 0`` and ``theta >= 0`` for each: the default fits of notes sec. 2.2 up
+    to about fc = 60 MPa; above, their ``Q1``, ``Q2`` decrease),
     :func:`surely_elastic`'s bound ``min(Q1, Q2, 1) Ff (1 - 1e-9)`` is smallest
     at ``J1 = 0``:
 
@@ -425,8 +426,7 @@ def elastic_radius_bound(p):
     decrease, or an ``r0`` below ``1e-6 alpha`` (a bound lost in round-off).
     """
     rising = True
-    for a, t, lam, b in ((P_ALPHA, P_THETA, P_LAMDA, P_BETA), (P_A1, P_T1, P_L1, P_B1),
-                         (P_A2, P_T2, P_L2, P_B2)):
+    for t, lam, b in ((P_THETA, P_LAMDA, P_BETA), (P_T1, P_L1, P_B1), (P_T2, P_L2, P_B2)):
         rising = rising and p[lam] * p[b] >= 0.0 and p[t] >= 0.0
     q1, q2 = rubin_q(0.0, p)
     r0 = 0.999 * min(q1, q2, 1.0) * shear_surface(0.0, p)

@@ -199,20 +199,20 @@ def _finish_row(i, dim, correct, l00, l01, l02, l10, l11, l12, l20, l21, l22,
 #: row within the support in column ``t``): x_i - x_j, r^2, h_j, v_j - v_i,
 #: m_j / rho_i, then the pair's m_j F_ij / rho_i and its gradient g
 _D0, _D1, _D2, _R2, _HJ, _U0, _U1, _U2, _WM, _FW, _G0, _G1, _G2 = range(13)
-_ROWS = 13
+GRADIENT_ROWS = 13
 #: contiguous particle chunks of the buffered pass (each a row buffer)
 GRADIENT_CHUNKS = 64
 
 
 def gradient_scratch(offsets, scratch=None):
-    """Row buffers (GRADIENT_CHUNKS, 13, width) of :func:`velocity_gradient`'s
+    """Row buffers (GRADIENT_CHUNKS, GRADIENT_ROWS, width) of :func:`velocity_gradient`'s
     buffered forms, ``width`` the longest row of the CSR list ``offsets``
     ((N + 1,)): ``scratch`` itself when it is wide enough (called after each
     neighbour rebuild; a longer row than the buffer is worked without it)."""
     width = int(np.max(np.diff(offsets))) if offsets.shape[0] > 1 else 0
     if scratch is not None and scratch.shape[2] >= width:
         return scratch
-    return np.zeros((GRADIENT_CHUNKS, _ROWS, int(width * 1.2) + 8))
+    return np.zeros((GRADIENT_CHUNKS, GRADIENT_ROWS, int(width * 1.2) + 8))
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -220,7 +220,7 @@ def _buffered_row(i, x, v, h, m, rho, offsets, idx, sigma, support_scale, correc
                   count, W):
     """Row ``i`` of :func:`velocity_gradient` for the 3D cubic spline, the same
     operations in the same order as :func:`_gradient_row` (the same bits),
-    in three loops over the row buffer ``W`` (13, width): (1) gather and
+    in three loops over the row buffer ``W`` (GRADIENT_ROWS, width): (1) gather and
     partition, (2) the kernel factors and the pair gradients, pair by pair
     independent, which the compiler turns into SIMD instructions, (3) the
     row's sums, in the row's order."""
@@ -241,7 +241,7 @@ def _buffered_row(i, x, v, h, m, rho, offsets, idx, sigma, support_scale, correc
         d2 = xi2 - x[j, 2]
         r2 = d0 * d0 + d1 * d1 + d2 * d2
         hj = h[j]
-        if r2 >= (2.0 * (support_scale * 0.5 * (hi + hj))) ** 2:
+        if r2 >= (support_nb(0) * (support_scale * 0.5 * (hi + hj))) ** 2:
             F[k] = 0.0
             continue
         if k != head:  # swap with the first skin pair of the row
@@ -266,11 +266,8 @@ def _buffered_row(i, x, v, h, m, rho, offsets, idx, sigma, support_scale, correc
         ih2 = ih * ih
         scale = sigma * ih2 * ih2
         scale *= ih
-        q = simd_sqrt(W[_R2, t]) * ih
-        a = 2.0 - q
-        # dwdq_over_q of the cubic spline (kernel 0), both pieces formed
-        w = 9.0 * q - 12.0 if q < 1.0 else (-3.0 * a * a / q if q < 2.0 else 0.0)
-        fk = np.float64(np.float32(scale * w))
+        # the kernel's own w'(q)/q, inlined: both pieces formed, one selected
+        fk = np.float64(np.float32(scale * dwdq_over_q(0, simd_sqrt(W[_R2, t]) * ih)))
         F[o + t] = fk
         f = fk * W[_WM, t]
         W[_FW, t] = f
@@ -398,7 +395,7 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
     B : (N, 3, 3) out, correction matrix applied to kernel gradients
         (identity when ``correct`` is False).
     count : (N,) int32 out, pairs within the support at the head of row i.
-    work : (GRADIENT_CHUNKS, 13, width) scratch of the buffered forms
+    work : (GRADIENT_CHUNKS, GRADIENT_ROWS, width) scratch of the buffered forms
         (:func:`gradient_scratch`).
     """
     n = x.shape[0]
