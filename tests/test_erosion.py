@@ -449,6 +449,62 @@ def test_a_particle_born_inside_the_contact_thickness_keeps_that_penetration_fre
     assert cp.pen0[0] == pytest.approx(0.002, rel=1e-12)
 
 
+def test_a_spring_keeps_its_extension_when_its_face_erodes():
+    """A crushed, warped element lies on a 10 mm cube: its top face falls from
+    10.5 mm (x = 0) to 9.8 mm (x = 10 mm), below the cube's top at its right
+    end (the 1000 m/s penetration run's crushed elements were warped so). A
+    particle presses e = 0.01 mm into that face near x = 9 mm. The element
+    erodes and the particle faces the cube's top, now nearer: 0.145 mm deep.
+    Its spring keeps its extension: the allowance becomes that depth less e
+    and the force stays a = alpha e / dt^2 (paper eq. 8; the particle, 2 mg,
+    lighter than the face points), along the new face's normal. With the old
+    allowance (0) it met the new face at 0.145 mm: 14.5 times the force (the
+    jumps that put 2 kJ into that run). A particle pressing on a face that
+    stays (the cube's bottom, 0.3 mm) keeps its allowance 0 and its force.
+    1e-9: the penetrations' round-off (~1e-18 m) against e."""
+    x, cells = block([0, 0, 0], [0.01, 0.01, 0.02], (1, 1, 2), 3)
+    top_nodes = np.isclose(x[:, 2], 0.02)
+    x[top_nodes, 2] = 0.0105 - 0.07 * x[top_nodes, 0]
+    mat = material(**CONCRETE)
+    solid = part(x, cells, 3, mat=mat)
+    top = int(np.argmax(x[cells][:, :, 2].mean(axis=1)))
+    sph = empty_sph(3, mat)
+    cp = PenaltyCoupling("c", sph, solid, alpha=0.1)
+    p = sph.p
+    rows = p.grow(2, notify=False)
+    t = 0.5 * 0.004  # contact thickness f_t V^(1/3)
+    e = 1e-5
+    n = np.array([0.07, 0.0, 1.0]) / np.hypot(0.07, 1.0)  # the warped face's normal
+    foot = np.array([0.009, 0.005, 0.0105 - 0.07 * 0.009])
+    p.x[rows] = [foot + (t - e) * n, [0.005, 0.005, -t + 3e-4]]
+    p.m[rows], p.vol0[rows], p.rho0[rows], p.rho[rows] = 2e-6, 0.004 ** 3, RHO, RHO
+    p.h[rows] = p.h0[rows] = 0.006
+    p.notify_grown(rows.start, rows.stop)
+    cp.fresh[:] = False  # as if present from the start: no allowance
+    dt = 1e-6
+
+    def accel():
+        cp.update_geometry(0.0)
+        a = np.zeros((2, 3))
+        cp.forces(0.0, dt, a)
+        return a
+
+    before = accel()
+    a_e = 0.1 * e / dt ** 2
+    assert before[0] == pytest.approx(a_e * n, rel=1e-9, abs=1e-9 * a_e)
+    assert before[1] == pytest.approx([0, 0, -0.1 * 3e-4 / dt ** 2], rel=1e-9,
+                                      abs=1e-9 * a_e)
+    solid.erode(np.array([top]))
+    cp.mesh_changed()
+    depth = t - (p.x[0, 2] - 0.01)  # under the cube's top face
+    assert depth == pytest.approx(14.5 * e, rel=0.01)
+    assert cp.pen0[0] == pytest.approx(depth - e, rel=1e-9)
+    assert cp.pen0[1] == pytest.approx(0.0, abs=1e-15)
+    after = accel()
+    assert after[0] == pytest.approx([0, 0, a_e], rel=1e-9, abs=1e-9 * a_e)
+    assert after[1] == pytest.approx(before[1], rel=1e-9, abs=1e-9 * a_e)
+
+
 def test_penalty_ties_follow_their_faces_through_erosion():
     """Penalty ties (tie_factor > 0) keep their face when other elements erode
     (same face nodes after the faces are renumbered) and end when their own
