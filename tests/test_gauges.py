@@ -122,6 +122,25 @@ def test_a_gauge_point_outside_the_model_is_refused_before_the_run(tmp_path):
         Simulation.from_deck(deck, tmp_path / "run")
 
 
+def test_sphdyn_check_places_the_gauges(tmp_path, capsys):
+    """``sphdyn check`` refuses a gauge point outside the model (exit 2, the
+    field named) as a run would, and passes one inside."""
+    from sphdyn.cli import main
+
+    for z, ok in (("150 mm", False), ("50 mm", True)):
+        path = tmp_path / "deck.toml"
+        path.write_text(COLUMN + f'[[gauge]]\nname = "g"\ntype = "point"\npoint = [0, 0, "{z}"]\n')
+        try:
+            rc = main(["check", str(path)])
+        except SystemExit as exc:
+            rc = exc.code
+        out = capsys.readouterr()
+        if ok:
+            assert rc == 0 and "1 gauges" in out.out
+        else:
+            assert rc == 2 and "gauge[0] 'g'.point" in out.err + out.out
+
+
 def test_a_restarted_run_continues_the_gauges_and_gravity_bitwise(tmp_path):
     # Run through, and stopped after 150 steps (exit checkpoint) then
     # restarted: every gauge file and the history (with W_gravity) bitwise

@@ -184,11 +184,17 @@ def cmd_check(args) -> int:
     estimate = estimate_size(deck)
     p = model.particles
     limit, source = memory_limit(deck)
+    if deck.gauge:  # placed on the stepper's parts, as a run places them
+        from .assembly import build_stepper
+        from .gauges import build_gauges
+
+        build_gauges(deck, build_stepper(deck, model).parts)
     print(f"{args.deck}: OK")
     print(f"  {deck.run.dimension}D, t_end = {deck.run.t_end:g} s, {p.n} particles in "
           f"{len(model.body_names)} bodies{_mesh_counts(model)}, "
           f"{len(deck.material)} materials, "
-          f"{len(model.walls)} walls, sets {sorted(model.sets) + sorted(model.mesh_sets) or '-'}")
+          f"{len(model.walls)} walls, sets {sorted(model.sets) + sorted(model.mesh_sets) or '-'}"
+          f"{f', {len(deck.gauge)} gauges' if deck.gauge else ''}")
     print(f"  estimate: {estimate.summary()}; memory limit {show_bytes(limit)} "
           f"({source})")
     if args.resolved:
