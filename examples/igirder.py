@@ -56,6 +56,9 @@ VARIANTS = {
     # kernel gradients corrected: the flanges' free faces carry their share of
     # the bending (78 % of the FEM girders' elastic force without, 93 % with)
     "sph_corr": ("SPH, axial, corrected kernel gradients", ["sph.correction=true"]),
+    # half the loading rate, as fem_slow: the fair comparison with that reference
+    "sph_slow": ("SPH, axial, the load ramped over 64 ms (half the rate)",
+                 ['run.t_end="64 ms"', 'boundary.2.ramp_time="64 ms"']),
 }
 #: variants of igirder_fem.toml: label and overrides (the reference's own spread)
 FEM_VARIANTS = {
