@@ -412,6 +412,24 @@ def test_restart_across_a_conversion_is_bitwise():
     assert st3.interactions[2].faces.shape == st.interactions[2].faces.shape
 
 
+def _cube_and_particle(x, m, vol0, h):
+    """A 10 mm cube of one element, a penalty coupling and one particle born
+    at ``x`` [m] (mass ``m`` [kg], volume ``vol0`` [m^3], ``h`` [m]): the
+    solid, the SPH part and the coupling."""
+    xn, cells = block([0, 0, 0], [0.01, 0.01, 0.01], (1, 1, 1), 3)
+    mat = material(**CONCRETE)
+    solid = part(xn, cells, 3, mat=mat)
+    sph = empty_sph(3, mat)
+    cp = PenaltyCoupling("c", sph, solid, alpha=0.1)
+    p = sph.p
+    rows = p.grow(1, notify=False)
+    p.x[rows] = x
+    p.m[rows], p.vol0[rows], p.rho0[rows], p.rho[rows] = m, vol0, RHO, RHO
+    p.h[rows] = p.h0[rows] = h
+    p.notify_grown(rows.start, rows.stop)
+    return solid, sph, cp
+
+
 def test_a_particle_born_inside_the_contact_thickness_keeps_that_penetration_free():
     """LS-DYNA's IGNORE = 2 for born particles: a particle appearing 3 mm deep
     in a face's 5 mm contact thickness feels nothing there; pushed 1 mm deeper
@@ -420,17 +438,9 @@ def test_a_particle_born_inside_the_contact_thickness_keeps_that_penetration_fre
     face's centre) = 1.2 g, half the particle's 2.4 g; 1e-12);
     moving out shrinks the allowance to the smallest penetration seen.
     Particles present from the start have no allowance."""
-    x, cells = block([0, 0, 0], [0.01, 0.01, 0.01], (1, 1, 1), 3)
-    mat = material(**CONCRETE)
-    solid = part(x, cells, 3, mat=mat)
-    sph = empty_sph(3, mat)
-    cp = PenaltyCoupling("c", sph, solid, alpha=0.1)
+    # 2 mm above the top face: 3 mm deep
+    solid, sph, cp = _cube_and_particle([0.005, 0.005, 0.012], 2.4e-3, 1e-6, 0.012)
     p = sph.p
-    rows = p.grow(1, notify=False)
-    p.x[rows] = [0.005, 0.005, 0.012]  # 2 mm above the top face: 3 mm deep
-    p.m[rows], p.vol0[rows], p.rho0[rows], p.rho[rows] = 2.4e-3, 1e-6, RHO, RHO
-    p.h[rows] = p.h0[rows] = 0.012
-    p.notify_grown(rows.start, rows.stop)
     dt = 1e-6
 
     def accel(z):
@@ -449,6 +459,37 @@ def test_a_particle_born_inside_the_contact_thickness_keeps_that_penetration_fre
     assert cp.pen0[0] == pytest.approx(0.002, rel=1e-12)
 
 
+#: the warped face's normal, a particle's contact thickness f_t V^(1/3) and
+#: the extension e of the spring pressing on it [m] (_warped_column)
+WARP_N = np.array([0.07, 0.0, 1.0]) / np.hypot(0.07, 1.0)
+WARP_T, WARP_E = 0.5 * 0.004, 1e-5
+
+
+def _warped_column(others=()):
+    """A crushed, warped element on a 10 mm cube (its top face from 10.5 mm
+    at x = 0 down to 9.8 mm at x = 10 mm), a penalty coupling, and a 2 mg
+    particle pressing WARP_E into that face near x = 9 mm, then the particles
+    at ``others`` [m]; all as if present from the start (no allowance).
+    Returns the solid, the SPH part, the coupling and the top element."""
+    x, cells = block([0, 0, 0], [0.01, 0.01, 0.02], (1, 1, 2), 3)
+    top_nodes = np.isclose(x[:, 2], 0.02)
+    x[top_nodes, 2] = 0.0105 - 0.07 * x[top_nodes, 0]
+    mat = material(**CONCRETE)
+    solid = part(x, cells, 3, mat=mat)
+    top = int(np.argmax(x[cells][:, :, 2].mean(axis=1)))
+    sph = empty_sph(3, mat)
+    cp = PenaltyCoupling("c", sph, solid, alpha=0.1)
+    p = sph.p
+    rows = p.grow(1 + len(others), notify=False)
+    foot = np.array([0.009, 0.005, 0.0105 - 0.07 * 0.009])
+    p.x[rows] = [foot + (WARP_T - WARP_E) * WARP_N, *others]
+    p.m[rows], p.vol0[rows], p.rho0[rows], p.rho[rows] = 2e-6, 0.004 ** 3, RHO, RHO
+    p.h[rows] = p.h0[rows] = 0.006
+    p.notify_grown(rows.start, rows.stop)
+    cp.fresh[:] = False
+    return solid, sph, cp, top
+
+
 def test_a_spring_keeps_its_extension_when_its_face_erodes():
     """A crushed, warped element lies on a 10 mm cube: its top face falls from
     10.5 mm (x = 0) to 9.8 mm (x = 10 mm), below the cube's top at its right
@@ -462,25 +503,9 @@ def test_a_spring_keeps_its_extension_when_its_face_erodes():
     jumps that put 2 kJ into that run). A particle pressing on a face that
     stays (the cube's bottom, 0.3 mm) keeps its allowance 0 and its force.
     1e-9: the penetrations' round-off (~1e-18 m) against e."""
-    x, cells = block([0, 0, 0], [0.01, 0.01, 0.02], (1, 1, 2), 3)
-    top_nodes = np.isclose(x[:, 2], 0.02)
-    x[top_nodes, 2] = 0.0105 - 0.07 * x[top_nodes, 0]
-    mat = material(**CONCRETE)
-    solid = part(x, cells, 3, mat=mat)
-    top = int(np.argmax(x[cells][:, :, 2].mean(axis=1)))
-    sph = empty_sph(3, mat)
-    cp = PenaltyCoupling("c", sph, solid, alpha=0.1)
+    t, e, n = WARP_T, WARP_E, WARP_N
+    solid, sph, cp, top = _warped_column(others=[[0.005, 0.005, -WARP_T + 3e-4]])
     p = sph.p
-    rows = p.grow(2, notify=False)
-    t = 0.5 * 0.004  # contact thickness f_t V^(1/3)
-    e = 1e-5
-    n = np.array([0.07, 0.0, 1.0]) / np.hypot(0.07, 1.0)  # the warped face's normal
-    foot = np.array([0.009, 0.005, 0.0105 - 0.07 * 0.009])
-    p.x[rows] = [foot + (t - e) * n, [0.005, 0.005, -t + 3e-4]]
-    p.m[rows], p.vol0[rows], p.rho0[rows], p.rho[rows] = 2e-6, 0.004 ** 3, RHO, RHO
-    p.h[rows] = p.h0[rows] = 0.006
-    p.notify_grown(rows.start, rows.stop)
-    cp.fresh[:] = False  # as if present from the start: no allowance
     dt = 1e-6
 
     def accel():
@@ -503,6 +528,74 @@ def test_a_spring_keeps_its_extension_when_its_face_erodes():
     after = accel()
     assert after[0] == pytest.approx([0, 0, a_e], rel=1e-9, abs=1e-9 * a_e)
     assert after[1] == pytest.approx(before[1], rel=1e-9, abs=1e-9 * a_e)
+
+
+def test_debris_inherits_no_contact_force_and_the_contact_moves_to_the_new_surface():
+    """The crushed, warped element of the test above erodes into a particle
+    while a particle presses on it (the contact its only load). Its contact
+    forces leave the accelerations before the debris takes its nodes'
+    (PenaltyCoupling.withdraw_forces): the debris gets none (with them a
+    spring on a crushed element's face launched debris at 5 km/s in the
+    1000 m/s penetration run); the pressing particle's spring then acts on
+    the face behind with the force it had (alpha e / dt^2 upwards); and the
+    contact's momentum rate, sum of m a_ext over particles and nodes, is zero
+    (1e-12 of m_p alpha e / dt^2: round-off)."""
+    e = WARP_E
+    solid, sph, cp, top = _warped_column()
+    p, q = sph.p, solid.nodes
+    st = Stepper([solid, sph], [cp])
+    dt = 1e-6
+    st.dt_prev = dt
+    for a in (p.a, q.a):
+        a[:] = 0.0
+    cp.update_geometry(0.0)
+    st._interaction_forces(dt)  # the contact alone: a = a_ext
+    assert np.abs(q.a_ext).max() > 0.0  # the crushed element's nodes are pushed
+    ev = ElementErosion("e", solid, {0: ErosionRules(min_time_step=1.0)}, to="particles",
+                        sph=sph)
+    ev.rules[:, 3] = 0.0
+    ev.rules[top, 3] = np.inf
+    ev.apply(st)
+    assert solid.el.active[top] == 0 and p.n == 2
+    a_e = 0.1 * e / dt ** 2
+    assert np.abs(p.a_ext[1]).max() == 0.0 and np.abs(p.a[1]).max() == 0.0
+    assert p.a_ext[0] == pytest.approx([0, 0, a_e], rel=1e-9, abs=1e-9 * a_e)
+    assert p.a[0] == pytest.approx(p.a_ext[0], rel=1e-12)
+    rate = (p.m[:, None] * p.a_ext).sum(axis=0) + (q.m[:, None] * q.a_ext).sum(axis=0)
+    assert np.abs(rate).max() < 1e-12 * p.m[0] * a_e
+
+
+@pytest.mark.parametrize("last, d_last, speed, allowed", [
+    ("top", 2e-4, 300.0, 0.0),       # the same face: no switch, no allowance
+    ("side", 2e-4, 300.0, 5e-4),     # a switch: 1 mm deep, 0.2 + 0.3 by motion: 0.5 allowed
+    ("side", 2e-4, 900.0, 0.0),      # the motion (0.9 mm) can take it there: none
+    ("none", 2e-4, 0.0, 0.0),        # faced nothing before (far): no check
+    ("renumbered", -np.inf, 0.0, 1e-3),  # faces renumbered, faced none: all allowed
+])
+def test_a_switch_of_face_allows_what_the_motion_cannot_explain(last, d_last, speed, allowed):
+    """A particle 1 mm deep in a cube's top face (contact thickness 2 mm),
+    moving down at ``speed``, evaluated with dt = 1 us after facing ``last``
+    at signed depth ``d_last`` (0.2 mm). At a switch of face the spring's
+    extension grows by at most the approach the motion allows, |v_r| dt: the
+    allowance takes the excess, 1 - 0.2 - 0.3 = 0.5 mm at 300 m/s, none at
+    900 m/s; the acceleration is then alpha (1 mm - allowance) / dt^2 (paper
+    eq. 8, the particle lighter than the face). 1e-9: round-off."""
+    solid, sph, cp = _cube_and_particle([0.005, 0.005, 0.01 + 0.002 - 0.001], 1e-5,
+                                        0.004 ** 3, 0.006)
+    p = sph.p
+    p.v[0] = [0.0, 0.0, -speed]
+    cp.fresh[:] = False
+    on_top = np.all(np.isclose(solid.nodes.x[cp.faces][:, :, 2], 0.01), axis=1)
+    top, side = int(np.flatnonzero(on_top)[0]), int(np.flatnonzero(~on_top)[0])
+    cp.last_face[0] = {"top": top, "side": side, "none": -1, "renumbered": -2}[last]
+    cp.d_last[0] = d_last
+    dt = 1e-6
+    a = np.zeros((1, 3))
+    cp.update_geometry(0.0)
+    cp.forces(0.0, dt, a)
+    assert cp.pen0[0] == pytest.approx(allowed, rel=1e-9, abs=1e-15)
+    assert a[0, 2] == pytest.approx(0.1 * (1e-3 - allowed) / dt ** 2, rel=1e-9, abs=1e-3)
+    assert cp.last_face[0] == top and cp.d_last[0] == pytest.approx(1e-3, rel=1e-12)
 
 
 def test_penalty_ties_follow_their_faces_through_erosion():

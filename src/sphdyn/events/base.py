@@ -11,7 +11,8 @@ an event must remember across a restart (whether it fired).
 Optional: ``columns(t)``, the event's history columns, and
 ``energy_removed`` [J], energy the event took out of the model, which the
 stepper's ``E_total`` counts (:mod:`.erosion`). An event that changes a mesh
-calls ``mesh_changed()`` on the interactions whose ``solid`` is that part.
+calls ``withdraw_forces()`` (if they have it) before the change and
+``mesh_changed()`` after it on the interactions whose ``solid`` is that part.
 """
 
 from __future__ import annotations

@@ -31,7 +31,11 @@ the parent points :math:`\xi_o = \pm\tfrac12`, each with
 The new particles join their material's group of the SPH part, in the body
 ``body`` (an updated-Lagrangian body), and meet the remaining elements
 through any penalty coupling of the two parts, whose master faces follow
-the erosion (:meth:`~sphdyn.interactions.PenaltyCoupling.mesh_changed`).
+the erosion (:meth:`~sphdyn.interactions.PenaltyCoupling.mesh_changed`);
+that coupling's forces of the step are taken out of the accelerations
+before anything below reads them and those of the new surface put back
+after (:meth:`~sphdyn.interactions.PenaltyCoupling.withdraw_forces`), so the
+particles inherit no contact force from their element's nodes.
 A degenerate element (eroded by the time-step rule, crushed below
 :data:`MIN_VOLUME_RATIO` of its volume, or inverted) gives no force in the
 step it fails in (LS-DYNA's practice; its last force is the artefact it
@@ -181,6 +185,11 @@ class ElementErosion:
         for code in np.unique(self.flags[new]):
             self.count[REASONS[int(code)]] += int(np.sum(self.flags[new] == code))
         dt_half = 0.5 * stepper.dt_prev  # the coming half kick
+        couplings = [inter for inter in stepper.interactions
+                     if getattr(inter, "solid", None) is s and hasattr(inter, "mesh_changed")]
+        for inter in couplings:  # the contact forces of the old surface out (of the books too)
+            if hasattr(inter, "withdraw_forces"):
+                inter.withdraw_forces()
         # a degenerate element (its step collapsed, crushed below
         # MIN_VOLUME_RATIO or inverted) gives no force in its last step: that
         # force is the artefact it fails for; what its loads held at the half
@@ -197,9 +206,8 @@ class ElementErosion:
         if born is None:
             self.mass_removed += float(m.sum())
             self.energy_removed += float(kinetic.sum() + internal.sum())
-        for inter in stepper.interactions:
-            if getattr(inter, "solid", None) is s and hasattr(inter, "mesh_changed"):
-                inter.mesh_changed()
+        for inter in couplings:  # the new surface and its forces
+            inter.mesh_changed()
         if born is not None:
             self._add(born)
 

@@ -71,14 +71,27 @@ thickness. The spring then acts on the penetration beyond the one they had
 at that moment, :math:`\delta - \delta_0`, with :math:`\delta_0` only
 shrinking as they move out (LS-DYNA's IGNORE = 2): a spring that was never
 loaded releases no energy. Particles present at the start have
-:math:`\delta_0 = 0`. When erosion changes the master surface, every
-particle takes its allowance on the new surface at once, at the positions of
-the last evaluation, keeping its spring's extension :math:`e = \delta -
-\delta_0`: :math:`\delta_0' = \max(\delta' - e, 0)`. A particle on a face
-that stays keeps its :math:`\delta_0`; one whose face eroded meets the face
-behind it with the force it had (with its old :math:`\delta_0` it would meet
-it at the depth of the whole eroded layer: a force jump of a thousand times,
-kilojoules of spurious work in the 1000 m/s penetration run).
+:math:`\delta_0 = 0`.
+
+A particle that switches from one face to another may find itself deeper
+than its motion can have taken it: behind a warped or crushed face, or
+facing a face that erosion has just exposed. Between two evaluations its
+signed penetration :math:`d = -g` can grow by at most the approach of the
+motion, :math:`|\mathbf v_r|\,\Delta t` (the particle's and the face
+point's relative velocity over the step); at a switch of face the excess
+
+.. math:: \Delta\delta_0 = \max(d' - d - |\mathbf v_r|\,\Delta t,\ 0)
+
+is added to the allowance (at most up to :math:`\delta'`), so the spring's
+extension, and its force, grow only by what the motion explains. When
+erosion changes the master surface every particle meets its face again at
+once, at the positions of the last evaluation (:math:`\Delta t = 0`): a
+particle whose face eroded meets the face behind it with the force it had; a
+particle that faced none may face a newly exposed face inside its thickness,
+and is allowed that penetration. Without this, a projectile particle that had
+touched a crushed, warped element lightly met the face behind it 2 mm deep
+(a thousand times the force) and the 1000 m/s penetration run took kilojoules
+of spurious work from such jumps.
 
 Limitations: one face per particle (at a concave corner of the master
 surface a particle is held out of the nearer face only). With the default
@@ -118,6 +131,21 @@ def face_inverse_mass(mn, face, N):
 
 
 @njit(cache=True, error_model="numpy")
+def _relative_velocity(vp, vn, i, face, N):
+    r""":math:`\mathbf v_p - \sum_a N_a \mathbf v_a` [m/s] (3 floats) of particle
+    ``i`` (``vp`` (N, 3)) against the point of ``face`` (nf,) with shape values
+    ``N`` (``vn`` (M, 3) node velocities)."""
+    w0 = vp[i, 0]
+    w1 = vp[i, 1]
+    w2 = vp[i, 2]
+    for a in range(face.shape[0]):
+        w0 -= N[a] * vn[face[a], 0]
+        w1 -= N[a] * vn[face[a], 1]
+        w2 -= N[a] * vn[face[a], 2]
+    return w0, w1, w2
+
+
+@njit(cache=True, error_model="numpy")
 def spring_mass(m_p, inv_f):
     r"""The mass of eq. 8's spring, :math:`\min(m_p, m_f)` [kg], of a particle of
     mass ``m_p`` [kg] on a face point of inverse mass ``inv_f``
@@ -128,8 +156,8 @@ def spring_mass(m_p, inv_f):
 @njit(cache=True, error_model="numpy", parallel=True)
 def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, faces,
                             offsets, cand, thickness_factor, method, alpha, friction, dt,
-                            a_p, a_n, face_of, shares, force, normal_force, skip, pen0,
-                            fresh, carry, stretch):
+                            a_p, a_n, face_of, shares, force, normal_force, accel, skip,
+                            pen0, fresh, last_face, d_last, motion_dt):
     r"""Particle-face penalty forces (module docstring) into the particles' and nodes' ``a``.
 
     Parameters
@@ -152,17 +180,23 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
         (:math:`-N_a \mathbf F_p`; rows past nf unused).
     force : (N, 3) out, the force on each particle [N] (N/m in 2D).
     normal_force : (N,) out, its component along the contact direction [N].
+    accel : (N, 3) out, the acceleration added to each particle [m/s^2]
+        (:func:`withdraw_contact` takes it back).
     skip : (N,) bool, particles left out (those tied by :func:`tie_forces`).
     pen0 : (N,) in/out, penetration each particle is allowed without force
         [m] (a particle born or exposed inside the contact thickness): the
         spring acts on :math:`\delta - \delta_0`, and :math:`\delta_0` only
         shrinks, to the smallest penetration seen (LS-DYNA's IGNORE = 2).
-    fresh : (N,) bool in/out, particles whose allowance is taken now, then
-        cleared: :math:`\delta_0 = \max(\delta - c, 0)` with ``carry`` :math:`c`.
-    carry : (N,) spring extension [m] a fresh particle keeps (0: its whole
-        current penetration is allowed; :meth:`PenaltyCoupling.mesh_changed`).
-    stretch : (N,) out, each particle's spring extension
-        :math:`\delta - \delta_0` [m] (0 out of contact).
+    fresh : (N,) bool in/out, particles whose allowance is taken now (their
+        current penetration), then cleared.
+    last_face, d_last : (N,) in/out, the face each particle faced at the last
+        evaluation (-1: none, so no switch is checked; -2: the faces were
+        renumbered, any face is a switch) and its signed penetration there
+        :math:`d = -g` [m]. At a switch of face the spring's extension grows
+        by at most the approach the motion allows, :math:`|\mathbf v_r|`
+        ``motion_dt``; the allowance takes the excess (module docstring).
+    motion_dt : time [s] the particles moved since the last evaluation (the
+        step; 0 when the faces changed under unmoved particles).
 
     Returns
     -------
@@ -177,11 +211,13 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
     count = 0
     for i in prange(n):
         face_of[i] = -1
-        stretch[i] = 0.0
         force[i, 0] = 0.0
         force[i, 1] = 0.0
         force[i, 2] = 0.0
         normal_force[i] = 0.0
+        accel[i, 0] = 0.0
+        accel[i, 1] = 0.0
+        accel[i, 2] = 0.0
         if skip[i]:
             continue
         best = np.inf
@@ -201,6 +237,7 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
         if bf < 0:
             pen0[i] = 0.0
             fresh[i] = False
+            last_face[i] = -1
             continue
         r0 = xp[i, 0] - cx
         r1 = xp[i, 1] - cy
@@ -221,38 +258,40 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
         else:
             gap = 0.0  # behind the plane of a face's boundary: no contact
         pen = max(-gap, 0.0)
+        N = face_shapes(xi, eta, nf)
         if fresh[i]:
-            pen0[i] = max(pen - carry[i], 0.0)
-            fresh[i] = False
-        elif pen < pen0[i]:
             pen0[i] = pen
+            fresh[i] = False
+        elif last_face[i] != -1 and bf != last_face[i]:  # a switch of face
+            w0, w1, w2 = _relative_velocity(vp, vn, i, faces[bf], N)
+            excess = -gap - d_last[i] - motion_dt * np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+            if excess > 0.0:  # deeper than the motion can take it: geometry
+                pen0[i] = min(pen0[i] + excess, pen)
+        if pen < pen0[i]:
+            pen0[i] = pen
+        last_face[i] = bf
+        d_last[i] = -gap
         if pen - pen0[i] <= 0.0:
             continue
-        stretch[i] = pen - pen0[i]
         count += 1
         an = spring_acceleration(pen - pen0[i], method, alpha, dt, kbulk[i], vol0[i],
                                  rho0[i], dim)
         if mp[i] <= 0.0:  # pushed out, no force of its own
-            a_p[i, 0] += an * e0
-            a_p[i, 1] += an * e1
-            a_p[i, 2] += an * e2
+            accel[i, 0] = an * e0
+            accel[i, 1] = an * e1
+            accel[i, 2] = an * e2
+            a_p[i, 0] += accel[i, 0]
+            a_p[i, 1] += accel[i, 1]
+            a_p[i, 2] += accel[i, 2]
             continue
-        N = face_shapes(xi, eta, nf)
         inv_f = face_inverse_mass(mn, faces[bf], N)
         fn = an * (spring_mass(mp[i], inv_f) if method == STIFFNESS_MASS else mp[i])
         f0 = fn * e0
         f1 = fn * e1
         f2 = fn * e2
         if friction > 0.0:
-            w0 = vp[i, 0]
-            w1 = vp[i, 1]
-            w2 = vp[i, 2]
+            w0, w1, w2 = _relative_velocity(vp, vn, i, faces[bf], N)
             inv_meff = 1.0 / mp[i] + inv_f
-            for a in range(nf):
-                node = faces[bf, a]
-                w0 -= N[a] * vn[node, 0]
-                w1 -= N[a] * vn[node, 1]
-                w2 -= N[a] * vn[node, 2]
             wn = w0 * e0 + w1 * e1 + w2 * e2
             t0 = w0 - wn * e0
             t1 = w1 - wn * e1
@@ -263,9 +302,12 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
                 f0 -= ft * t0 / vt
                 f1 -= ft * t1 / vt
                 f2 -= ft * t2 / vt
-        a_p[i, 0] += f0 / mp[i]
-        a_p[i, 1] += f1 / mp[i]
-        a_p[i, 2] += f2 / mp[i]
+        accel[i, 0] = f0 / mp[i]
+        accel[i, 1] = f1 / mp[i]
+        accel[i, 2] = f2 / mp[i]
+        a_p[i, 0] += accel[i, 0]
+        a_p[i, 1] += accel[i, 1]
+        a_p[i, 2] += accel[i, 2]
         force[i, 0] = f0
         force[i, 1] = f1
         force[i, 2] = f2
@@ -287,6 +329,25 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
                 a_n[node, 1] += shares[i, a, 1] / mn[node]
                 a_n[node, 2] += shares[i, a, 2] / mn[node]
     return count
+
+
+@njit(cache=True, error_model="numpy")
+def withdraw_contact(face_of, faces, shares, accel, mn, a_p, a_n):
+    """Take the contact accelerations of the last :func:`penalty_coupling_forces`
+    out of ``a_p`` (N, 3) and ``a_n`` (M, 3) (its ``face_of``, ``faces``,
+    ``shares``, ``accel``; node masses ``mn`` (M,) as then) [m/s^2]; serial,
+    in the order they were added."""
+    for i in range(face_of.shape[0]):
+        for c in range(3):
+            a_p[i, c] -= accel[i, c]
+        f = face_of[i]
+        if f < 0:
+            continue
+        for a in range(faces.shape[1]):
+            node = faces[f, a]
+            if mn[node] > 0.0:
+                for c in range(3):
+                    a_n[node, c] -= shares[i, a, c] / mn[node]
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
@@ -448,11 +509,15 @@ class PenaltyCoupling(InteractionBase):
         # faces) inside the contact thickness (the kernel's pen0 / fresh)
         self.pen0 = np.zeros(sph_part.p.n)
         self.fresh = np.zeros(sph_part.p.n, dtype=np.bool_)
-        self.stretch = np.zeros(sph_part.p.n)  # each spring's extension, last evaluation
+        # the face each particle faced at the last evaluation and its signed
+        # penetration there (face switches: the kernel's last_face / d_last)
+        self.last_face = np.full(sph_part.p.n, -1, dtype=np.int64)
+        self.d_last = np.zeros(sph_part.p.n)
         self.count = 0
         self.n_builds = 0
         self.total_normal = 0.0
         self.total_tie = 0.0
+        self._dt_step = 0.0  # the step of the last force evaluation [s]
         self._allocate()
         self._tie(float(tie_factor))
         sph_part.p.on_grow(lambda n_old, n_new: self._allocate())
@@ -468,12 +533,13 @@ class PenaltyCoupling(InteractionBase):
         if n > old:
             self.pen0 = np.concatenate([self.pen0, np.zeros(n - old)])
             self.fresh = np.concatenate([self.fresh, np.ones(n - old, dtype=np.bool_)])
-            self.stretch = np.concatenate([self.stretch, np.zeros(n - old)])
-        self.no_carry = np.zeros(n)
+            self.last_face = np.concatenate([self.last_face, np.full(n - old, -1, np.int64)])
+            self.d_last = np.concatenate([self.d_last, np.zeros(n - old)])
         self.face_of = np.full(n, -1, dtype=np.int64)
         self.shares = np.zeros((n, 4, 3))
         self.force = np.zeros((n, 3))
         self.normal_force = np.zeros(n)
+        self.accel = np.zeros((n, 3))
         skip = np.zeros(n, dtype=np.bool_)
         if hasattr(self, "tied"):
             skip[self.tied] = True
@@ -519,7 +585,7 @@ class PenaltyCoupling(InteractionBase):
         self.xn_ref = q.x.copy()
         self.n_builds += 1
 
-    def mesh_changed(self) -> None:
+    def _surface_changed(self) -> None:
         """Elements of the solid part eroded: the master surface is that of the
         remaining elements (default surface), or the given faces that are
         still exterior faces of them; lists rebuilt."""
@@ -544,23 +610,52 @@ class PenaltyCoupling(InteractionBase):
         self.faces = faces
         self.master_nodes = np.unique(self.faces)
         self._allocate()
-        # every particle takes its allowance on the new surface now, at the
-        # positions of the last evaluation, keeping its spring's extension:
-        # delta_0 = max(delta - stretch, 0). A particle out of contact may face
-        # a newly exposed face inside its thickness (allowed, no force); one in
-        # contact on a face that stays keeps its delta_0; one whose face eroded
-        # meets the face behind it with the force it had, not with the
-        # penetration of the whole eroded layer (a jump that put kilojoules
-        # into the penetration runs)
+
+    def withdraw_forces(self) -> None:
+        """Before elements erode (:class:`~sphdyn.events.ElementErosion`): take
+        this step's contact forces out of the particles' and nodes'
+        accelerations (``a`` and ``a_ext``); :meth:`mesh_changed` puts those of
+        the new surface back. The particles of an eroded element then inherit
+        no contact force from its nodes (a spring pressing on a crushed
+        element's face, 1e11 m/s^2 on its nodes, launched its debris at
+        5 km/s), and the forces of the step are those of the surface the kick
+        acts on."""
         p, q = self.part.p, self.solid.nodes
-        n = p.n
-        self.fresh[:] = True
-        penalty_coupling_forces(
+        for a_p, a_n in ((p.a, q.a), (p.a_ext, q.a_ext)):
+            withdraw_contact(self.face_of, self.faces, self.shares, self.accel, q.m, a_p, a_n)
+
+    def mesh_changed(self) -> None:
+        """Elements eroded (after :meth:`withdraw_forces`): the new master
+        surface, and the contact forces on it at the positions of the last
+        evaluation, added to the particles' and nodes' ``a`` and ``a_ext``.
+
+        The faces were renumbered: every particle near them meets its face
+        anew, as at a switch of face with no motion (module docstring): a
+        spring keeps its extension (one whose face eroded meets the face
+        behind it with the force it had); a particle out of contact facing a
+        newly exposed face inside its thickness is allowed that penetration."""
+        self._surface_changed()
+        p, q = self.part.p, self.solid.nodes
+        self.d_last[self.last_face == -1] = -np.inf  # faced none: any depth is new
+        self.last_face[:] = -2
+        a_p, a_n = np.zeros_like(p.a), np.zeros_like(q.a)
+        self._contact(self._dt_step or self._dt, a_p, a_n, motion_dt=0.0)
+        p.a += a_p
+        p.a_ext += a_p
+        q.a += a_n
+        q.a_ext += a_n
+
+    def _contact(self, dt: float, a_p: np.ndarray, a_n: np.ndarray, motion_dt: float) -> None:
+        """The particle-face contact (:func:`penalty_coupling_forces`) added to
+        ``a_p`` and ``a_n``; its count and total normal force kept."""
+        p, q = self.part.p, self.solid.nodes
+        self.count = int(penalty_coupling_forces(
             p.x, p.v, p.m, p.vol0, p.rho0, p.bulk_modulus, p.dim, q.x, q.v, q.m, self.faces,
             self.offsets, self.cand, self.thickness_factor, self.method, self.alpha,
-            self.friction, self._dt, np.zeros((n, 3)), np.zeros_like(q.a_ext),
-            np.full(n, -1, dtype=np.int64), np.zeros((n, 4, 3)), np.zeros((n, 3)), np.zeros(n),
-            self.skip, self.pen0, self.fresh, self.stretch.copy(), self.stretch)
+            self.friction, dt, a_p, a_n, self.face_of, self.shares, self.force,
+            self.normal_force, self.accel, self.skip, self.pen0, self.fresh, self.last_face,
+            self.d_last, motion_dt))
+        self.total_normal = float(self.normal_force.sum())
 
     # ----------------------------------------------------------- protocol
     def stable_dt(self) -> float:
@@ -578,13 +673,8 @@ class PenaltyCoupling(InteractionBase):
         # the nodes' share goes to their a_ext, except when the caller asks
         # into a scratch array (the stepper's restore refreshes the columns)
         a_n = q.a_ext if a_out is p.a_ext else np.zeros_like(q.a_ext)
-        self.count = int(penalty_coupling_forces(
-            p.x, p.v, p.m, p.vol0, p.rho0, p.bulk_modulus, p.dim, q.x, q.v, q.m, self.faces,
-            self.offsets, self.cand, self.thickness_factor, self.method, self.alpha,
-            self.friction, dt, a_out, a_n, self.face_of, self.shares, self.force,
-            self.normal_force, self.skip, self.pen0, self.fresh, self.no_carry,
-            self.stretch))
-        self.total_normal = float(self.normal_force.sum())
+        self._dt_step = dt
+        self._contact(dt, a_out, a_n, motion_dt=dt)
         if self.tied.size:
             self.total_tie = float(tie_forces(
                 self.tied, self.tie_face, self.tie_xi, self.tie_eta, self.tie_offset, p.x,
@@ -601,13 +691,13 @@ class PenaltyCoupling(InteractionBase):
     def state(self) -> tuple[dict, dict[str, np.ndarray]]:
         return {}, {"offsets": self.offsets, "cand": self.cand, "xp_ref": self.xp_ref,
                     "xn_ref": self.xn_ref, "pen0": self.pen0, "fresh": self.fresh,
-                    "stretch": self.stretch,
+                    "last_face": self.last_face, "d_last": self.d_last,
                     "face_of": self.face_of}
 
     def restore(self, scalars: dict, arrays: dict) -> None:
         if np.any(self.solid.el.active == 0):  # eroded before the checkpoint
-            self.mesh_changed()
-        for name in ("pen0", "fresh", "face_of", "stretch"):
+            self._surface_changed()
+        for name in ("pen0", "fresh", "face_of", "last_face", "d_last"):
             if name in arrays:
                 setattr(self, name, arrays[name].copy())
         self.offsets = arrays["offsets"].copy()
