@@ -96,7 +96,9 @@ class _SetInteraction(InteractionBase):
     def __init__(self, name: str, part, idx: np.ndarray):
         idx = np.asarray(idx, dtype=np.int64)
         if idx.size == 0:
-            raise ValueError(f"{name}: the set is empty")
+            raise ValueError(f"{name}: the set is empty. Fix: make its [[set]] region "
+                             "(or its nodes) select at least one particle or node of "
+                             "the body or mesh it names")
         self.name = name
         self.part = part
         self.idx = idx
