@@ -486,7 +486,7 @@ def _warped_column(others=()):
     p.m[rows], p.vol0[rows], p.rho0[rows], p.rho[rows] = 2e-6, 0.004 ** 3, RHO, RHO
     p.h[rows] = p.h0[rows] = 0.006
     p.notify_grown(rows.start, rows.stop)
-    cp.fresh[:] = False
+    cp.last_face[:] = -1  # as if present from the start: no allowance
     return solid, sph, cp, top
 
 
@@ -584,7 +584,7 @@ def test_a_switch_of_face_allows_what_the_motion_cannot_explain(last, d_last, sp
                                         0.004 ** 3, 0.006)
     p = sph.p
     p.v[0] = [0.0, 0.0, -speed]
-    cp.fresh[:] = False
+    cp.last_face[:] = -1  # as if present from the start: no allowance
     on_top = np.all(np.isclose(solid.nodes.x[cp.faces][:, :, 2], 0.01), axis=1)
     top, side = int(np.flatnonzero(on_top)[0]), int(np.flatnonzero(~on_top)[0])
     cp.last_face[0] = {"top": top, "side": side, "none": -1, "renumbered": -2}[last]

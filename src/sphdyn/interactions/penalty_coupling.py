@@ -157,7 +157,7 @@ def spring_mass(m_p, inv_f):
 def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, faces,
                             offsets, cand, thickness_factor, method, alpha, friction, dt,
                             a_p, a_n, face_of, shares, force, normal_force, accel, skip,
-                            pen0, fresh, last_face, d_last, motion_dt):
+                            pen0, last_face, d_last, motion_dt):
     r"""Particle-face penalty forces (module docstring) into the particles' and nodes' ``a``.
 
     Parameters
@@ -187,12 +187,11 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
         [m] (a particle born or exposed inside the contact thickness): the
         spring acts on :math:`\delta - \delta_0`, and :math:`\delta_0` only
         shrinks, to the smallest penetration seen (LS-DYNA's IGNORE = 2).
-    fresh : (N,) bool in/out, particles whose allowance is taken now (their
-        current penetration), then cleared.
     last_face, d_last : (N,) in/out, the face each particle faced at the last
-        evaluation (-1: none, so no switch is checked; -2: the faces were
-        renumbered, any face is a switch) and its signed penetration there
-        :math:`d = -g` [m]. At a switch of face the spring's extension grows
+        evaluation (-1: none, so no switch is checked; -2: unknown, a particle
+        born since or faces renumbered, so any face is a switch) and its
+        signed penetration there :math:`d = -g` [m] (:math:`-\infty` with -2
+        for a particle that faced none: its whole penetration is allowed). At a switch of face the spring's extension grows
         by at most the approach the motion allows, :math:`|\mathbf v_r|`
         ``motion_dt``; the allowance takes the excess (module docstring).
     motion_dt : time [s] the particles moved since the last evaluation (the
@@ -236,7 +235,6 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
                 xi, eta, cx, cy, cz, nx, ny, nz, clamped = res
         if bf < 0:
             pen0[i] = 0.0
-            fresh[i] = False
             last_face[i] = -1
             continue
         r0 = xp[i, 0] - cx
@@ -259,10 +257,7 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
             gap = 0.0  # behind the plane of a face's boundary: no contact
         pen = max(-gap, 0.0)
         N = face_shapes(xi, eta, nf)
-        if fresh[i]:
-            pen0[i] = pen
-            fresh[i] = False
-        elif last_face[i] != -1 and bf != last_face[i]:  # a switch of face
+        if last_face[i] != -1 and bf != last_face[i]:  # a switch of face
             w0, w1, w2 = _relative_velocity(vp, vn, i, faces[bf], N)
             excess = -gap - d_last[i] - motion_dt * np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
             if excess > 0.0:  # deeper than the motion can take it: geometry
@@ -506,11 +501,10 @@ class PenaltyCoupling(InteractionBase):
                              f"in {dim}D, got {self.faces.shape}")
         self.master_nodes = np.unique(self.faces)
         # penetration allowed without force: particles born (or exposed to new
-        # faces) inside the contact thickness (the kernel's pen0 / fresh)
+        # faces) inside the contact thickness (the kernel's pen0); the face each
+        # particle faced at the last evaluation and its signed penetration there
+        # (switches of face: the kernel's last_face / d_last)
         self.pen0 = np.zeros(sph_part.p.n)
-        self.fresh = np.zeros(sph_part.p.n, dtype=np.bool_)
-        # the face each particle faced at the last evaluation and its signed
-        # penetration there (face switches: the kernel's last_face / d_last)
         self.last_face = np.full(sph_part.p.n, -1, dtype=np.int64)
         self.d_last = np.zeros(sph_part.p.n)
         self.count = 0
@@ -532,9 +526,9 @@ class PenaltyCoupling(InteractionBase):
         old = self.pen0.size
         if n > old:
             self.pen0 = np.concatenate([self.pen0, np.zeros(n - old)])
-            self.fresh = np.concatenate([self.fresh, np.ones(n - old, dtype=np.bool_)])
-            self.last_face = np.concatenate([self.last_face, np.full(n - old, -1, np.int64)])
-            self.d_last = np.concatenate([self.d_last, np.zeros(n - old)])
+            # born: faced nothing known, so their whole penetration is allowed
+            self.last_face = np.concatenate([self.last_face, np.full(n - old, -2, np.int64)])
+            self.d_last = np.concatenate([self.d_last, np.full(n - old, -np.inf)])
         self.face_of = np.full(n, -1, dtype=np.int64)
         self.shares = np.zeros((n, 4, 3))
         self.force = np.zeros((n, 3))
@@ -653,8 +647,8 @@ class PenaltyCoupling(InteractionBase):
             p.x, p.v, p.m, p.vol0, p.rho0, p.bulk_modulus, p.dim, q.x, q.v, q.m, self.faces,
             self.offsets, self.cand, self.thickness_factor, self.method, self.alpha,
             self.friction, dt, a_p, a_n, self.face_of, self.shares, self.force,
-            self.normal_force, self.accel, self.skip, self.pen0, self.fresh, self.last_face,
-            self.d_last, motion_dt))
+            self.normal_force, self.accel, self.skip, self.pen0, self.last_face, self.d_last,
+            motion_dt))
         self.total_normal = float(self.normal_force.sum())
 
     # ----------------------------------------------------------- protocol
@@ -690,16 +684,19 @@ class PenaltyCoupling(InteractionBase):
 
     def state(self) -> tuple[dict, dict[str, np.ndarray]]:
         return {}, {"offsets": self.offsets, "cand": self.cand, "xp_ref": self.xp_ref,
-                    "xn_ref": self.xn_ref, "pen0": self.pen0, "fresh": self.fresh,
+                    "xn_ref": self.xn_ref, "pen0": self.pen0,
                     "last_face": self.last_face, "d_last": self.d_last,
                     "face_of": self.face_of}
 
     def restore(self, scalars: dict, arrays: dict) -> None:
         if np.any(self.solid.el.active == 0):  # eroded before the checkpoint
             self._surface_changed()
-        for name in ("pen0", "fresh", "face_of", "last_face", "d_last"):
+        for name in ("pen0", "face_of", "last_face", "d_last"):
             if name in arrays:
                 setattr(self, name, arrays[name].copy())
+        if "fresh" in arrays and "last_face" not in arrays:  # a checkpoint before 2026-11-27
+            self.last_face[arrays["fresh"]] = -2
+            self.d_last[arrays["fresh"]] = -np.inf
         self.offsets = arrays["offsets"].copy()
         self.cand = arrays["cand"].copy()
         self.xp_ref = arrays["xp_ref"].copy()

@@ -57,8 +57,8 @@ from .projection import (NGOLDEN, NSCAN, project, project_from_trial, project_gl
 from .schema import CscmParams
 from .surface import (cap_from_compaction, cap_function, elastic_radius_bound, invariants,
                       j1_radius, kappa_from_cap, meridian, meridian_radius,
-                      meridian_radius_curvature, meridian_radius_slope, rubin_factor, rubin_q, shear_surface,
-                      surely_elastic, surface_radius, yield_function)
+                      meridian_radius_curvature, meridian_radius_slope, rubin_factor, rubin_q,
+                      shear_surface, surely_elastic, surface_radius, yield_function)
 
 CSCM = register(MaterialModel(
     name="cscm",
