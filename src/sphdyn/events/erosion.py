@@ -41,8 +41,9 @@ A degenerate element (eroded by the time-step rule, crushed below
 step it fails in (LS-DYNA's practice; its last force is the artefact it
 fails for): its nodal forces leave its nodes' accelerations first
 (:meth:`~sphdyn.parts.fem.SolidPart.withdraw_forces`; they sum to zero, so
-the momentum rate is unchanged), and the kinetic energy they held at the
-coming half kick's time level goes with its internal energy. An element
+the momentum rate is unchanged), and their work over the coming half kick,
+:math:`\tfrac{\Delta t}2\sum_I \mathbf f_{eI}\cdot\mathbf v_I`, goes with
+its internal energy (which holds that half step's work of its stress). An element
 eroded at a sane shape keeps its loads for the step. Until the next step
 computes their forces, the particles' acceleration is then the one their
 element's nodes have there, :math:`\sum_I N_I(\xi_o)\mathbf a_I`: the
@@ -192,8 +193,9 @@ class ElementErosion:
                 inter.withdraw_forces()
         # a degenerate element (its step collapsed, crushed below
         # MIN_VOLUME_RATIO or inverted) gives no force in its last step: that
-        # force is the artefact it fails for; what its loads held at the half
-        # kick's time level stays in its energy
+        # force is the artefact it fails for; the work its loads would have
+        # done over the coming half kick stays in its energy
+        # (SolidPart.withdraw_forces: first order, the books' own accuracy)
         degenerate = new[(self.flags[new] == BY_TIME_STEP)
                          | (el.vol[new] < MIN_VOLUME_RATIO * el.vol0[new])]
         held = s.withdraw_forces(degenerate, dt_half)
