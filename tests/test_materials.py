@@ -24,7 +24,7 @@ from sphdyn.materials import (
     register,
     von_mises,
 )
-from sphdyn.materials.base import to_sym6
+from sphdyn.materials.base import to_sym6, young_modulus
 
 RHO = 7800.0
 E, NU = 200e9, 0.3
@@ -38,6 +38,17 @@ MAT = dict(density=RHO, E=E, nu=NU, yield_stress=SY, hardening_modulus=H)
 
 def vm(s):
     return von_mises(to_sym6(np.asarray(s, dtype=np.float64)))
+
+
+def test_young_modulus_inverts_the_moduli_of_e_and_nu():
+    """E = 9KG/(3K + G) returns the E that gave K = E/(3(1 - 2nu)) and
+    G = E/(2(1 + nu)), for steel and for nearly incompressible and auxetic
+    values (round-off), scalars and arrays alike."""
+    for e, nu in [(E, NU), (30e9, 0.2), (1e6, 0.499), (1e9, -0.5)]:
+        k, g = e / (3 * (1 - 2 * nu)), e / (2 * (1 + nu))
+        assert young_modulus(k, g) == pytest.approx(e, rel=1e-13)
+    ks, gs = np.array([K, 2 * K]), np.array([G, 2 * G])
+    assert np.allclose(young_modulus(ks, gs), [E, 2 * E], rtol=1e-13)
 
 
 def elastic_step(sig, deps, ep):

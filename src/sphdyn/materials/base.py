@@ -314,3 +314,11 @@ def p_wave_speed(K, G, rho):
     if rho <= 0.0:
         return 0.0
     return math.sqrt((K + 4.0 * G / 3.0) / rho)
+
+
+@njit(cache=True, error_model="numpy")
+def young_modulus(K, G):
+    """Young's modulus of isotropic elasticity, :math:`E = 9KG/(3K + G)` [Pa],
+    from the bulk and shear moduli ``K``, ``G`` [Pa] (scalars or arrays of one
+    shape)."""
+    return 9.0 * K * G / (3.0 * K + G)

@@ -49,7 +49,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from .base import N_COMMON, P_G, P_K, MaterialModel
+from .base import N_COMMON, P_G, P_K, MaterialModel, young_modulus
 from .j2 import pack_j2
 
 P_YIELD = N_COMMON
@@ -62,8 +62,7 @@ H_PLASTIC, H_STRESS, H_DIRECTION = 0, 1, 2
 @njit(cache=True, error_model="numpy")
 def young(params):
     """Young's modulus :math:`E = 9KG/(3K + G)` [Pa] of a packed vector."""
-    K, G = params[P_K], params[P_G]
-    return 9.0 * K * G / (3.0 * K + G)
+    return young_modulus(params[P_K], params[P_G])
 
 
 def uniaxial_params(model: str, packed: np.ndarray) -> np.ndarray:

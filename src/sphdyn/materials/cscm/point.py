@@ -11,7 +11,7 @@ import math
 from numba import njit, prange
 
 from ..base import (P_G, P_K, ddot6, energy_increment, jaumann_rotate, load_sym6,
-                    p_wave_speed, rate_split, scale6, store_sym6)
+                    p_wave_speed, rate_split, scale6, store_sym6, young_modulus)
 from ..elastic import elastic_increment
 from .damage import (DMAX, brittle_softening_c, ductile_softening_a, logistic_damage,
                      max_principal, transition)
@@ -56,7 +56,7 @@ def cscm_point(h, deps, dt, p, size):
     """
     K = p[P_K]
     G = p[P_G]
-    E = 9.0 * K * G / (3.0 * K + G)
+    E = young_modulus(K, G)
     svp = (h[H_SVP], h[H_SVP + 1], h[H_SVP + 2], h[H_SVP + 3], h[H_SVP + 4], h[H_SVP + 5])
     eps = (h[H_EPS], h[H_EPS + 1], h[H_EPS + 2], h[H_EPS + 3], h[H_EPS + 4], h[H_EPS + 5])
     if h[H_ERODED] > 0.0:

@@ -68,6 +68,7 @@ import numpy as np
 
 from ...integrate import drift, ordered_sum
 from ...materials import get_model
+from ...materials.base import young_modulus
 from ...state import Elements, MaterialPoints, Nodes
 from ...state.store import STATE
 from ..base import register_part
@@ -199,7 +200,7 @@ class LinePart:
         rho = self.model.density(self.params)
         K, G = self.model.bulk_modulus(self.params), self.model.shear_modulus(self.params)
         self.rho, self.G = rho, G
-        self.E = 9.0 * K * G / (3.0 * K + G)
+        self.E = young_modulus(K, G)
         self.k_lateral = 2.0 * (K + G / 3.0)  # d sigma_lat / d eps_lat (both lateral)
         self.nu = (3.0 * K - 2.0 * G) / (2.0 * (3.0 * K + G))
         A = section.area

@@ -36,6 +36,7 @@ import numpy as np
 from ...guards import SimulationFailed
 from ...integrate import add_heat, cfl_time_step, drift, internal_energies
 from ...kernels import KernelContext
+from ...materials.base import young_modulus
 from ...neighbours import build_neighbours, mean_neighbours, update_neighbours
 from ...state import BC_FIXED, Particles
 from ..base import register_part
@@ -173,7 +174,7 @@ class SPHPart:
             sel = g.idx[(g.idx >= lo) & (g.idx < hi)]
             k, mu = g.model.bulk_modulus(g.params), g.model.shear_modulus(g.params)
             p.bulk_modulus[sel] = k
-            p.young[sel] = 9.0 * k * mu / (3.0 * k + mu)
+            p.young[sel] = young_modulus(k, mu)
             if s.viscosity:
                 p.av_alpha[sel], p.av_beta[sel] = s.viscosity[g.material]
             if s.time_step_factor:
