@@ -222,6 +222,28 @@ def test_cantilever_of_beams_from_a_deck_deflects_as_PL3_over_3EI():
     assert s.record()["tip_force"] == pytest.approx(1000.0)
 
 
+def test_a_load_books_its_work_as_external_and_restarts_bitwise():
+    """The [[load]]'s work is external (W_external = W_tip + the clamp's,
+    which does none: 1e-12) and positive under the load's own deflection; a
+    run restored in the middle of the ramp continues with the same bits
+    (the load's state: its ramp value, work and accelerations)."""
+    from stepping import restarted_pair
+
+    deck = loads_deck(CANTILEVER.format(materials=MATERIALS, damping="0 1/s",
+                                        ramp="2 ms", t_end="1 s"))
+
+    def advance(st):
+        for _ in range(30):
+            st.step()
+
+    st, st2 = restarted_pair(deck, advance, 30)
+    r, r2 = st.record(), st2.record()
+    assert r["W_tip"] > 0.0
+    assert r["W_external"] == pytest.approx(r["W_tip"], rel=1e-12)
+    assert r["W_tip"] == r2["W_tip"] and r["E_total"] == r2["E_total"]
+    assert np.array_equal(st.part("rod").kin.x, st2.part("rod").kin.x)
+
+
 def test_converted_region_keeps_the_mass_and_gives_one_particle_per_element():
     source = BLOCK + ('\nconvert = {region = {shape = "box", lo = [0.3, -1, -1], '
                       'hi = [0.7, 1, 1]}}')

@@ -122,7 +122,10 @@ class Boundary(Section):
 
 
 class Load(Section):
-    """[[load]]: a force on a set, shared evenly by its nodes or particles."""
+    """[[load]]: a force on a set, shared evenly by its nodes or particles.
+
+    The history reports the force applied now as ``<set>_force`` and its work
+    so far as ``W_<set>``, which is external work (part of ``W_external``)."""
 
     set: reference_to("set") = Field(description="Name of a [[set]].")
     force: ForceVector = Field(description="Total force on the set [N] (N/m in 2D), "
