@@ -507,6 +507,25 @@ def _expanding_gas_deck(outside="remove"):
                       "geometry": {"shape": "box", "lo": [0], "hi": [0.1]}}]}
 
 
+def test_the_domain_check_counts_and_lists_the_rows_outside():
+    """The every-step check of [domain] outside = "remove": count_outside
+    counts, and outside_rows lists in order, exactly the active
+    updated-Lagrangian rows outside the box (against a NumPy mask), on any
+    side and on none."""
+    from sphdyn.events.domain_exit import count_outside, outside_rows
+
+    rng = np.random.default_rng(3)
+    x = rng.uniform(-1.5, 1.5, (5000, 3))
+    active = (rng.uniform(size=5000) > 0.1).astype(np.int8)
+    tl = rng.uniform(size=5000) < 0.1
+    lo, hi = np.full(3, -1.0), np.full(3, 1.0)
+    want = np.flatnonzero((active != 0) & ~tl & np.any((x < lo) | (x > hi), axis=1))
+    n = count_outside(x, active, tl, lo, hi)
+    assert n == want.size > 0
+    assert np.array_equal(outside_rows(x, active, tl, lo, hi, n), want)
+    assert count_outside(x, active, tl, lo - 2.0, hi + 2.0) == 0
+
+
 def test_particles_leaving_the_domain_are_removed_and_booked():
     # the free faces' particles fly off at several hundred m/s and leave the
     # 2 cm margin within 0.1 ms: removed (fixed, out of the lists, active 0),

@@ -16,20 +16,28 @@ stop the run (the guard).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from ..guards import outside_box
 
 
-@njit(cache=True, error_model="numpy")
-def outside_rows(x, active, tl, lo, hi):
-    """Indices (k,) int64 of active, updated-Lagrangian items of ``x`` (N, 3)
-    outside ``[lo, hi]`` (``active`` (N,) int8, ``tl`` (N,) bool)."""
+@njit(cache=True, error_model="numpy", parallel=True)
+def count_outside(x, active, tl, lo, hi):
+    """How many active, updated-Lagrangian items of ``x`` (N, 3) lie outside
+    ``[lo, hi]`` (``active`` (N,) int8, ``tl`` (N,) bool): the every-step
+    check, parallel and allocating nothing."""
     n = 0
-    for i in range(x.shape[0]):
+    for i in prange(x.shape[0]):
         if active[i] != 0 and not tl[i] and outside_box(x, i, lo, hi):
             n += 1
-    out = np.empty(n, np.int64)  # (usually 0,): the count first, no list growing
+    return n
+
+
+@njit(cache=True, error_model="numpy")
+def outside_rows(x, active, tl, lo, hi, n):
+    """Indices (n,) int64, ascending, of the ``n`` items
+    :func:`count_outside` counted."""
+    out = np.empty(n, np.int64)
     k = 0
     for i in range(x.shape[0]):
         if active[i] != 0 and not tl[i] and outside_box(x, i, lo, hi):
@@ -55,9 +63,10 @@ class DomainExit:
 
     def apply(self, stepper) -> None:
         p = self.part.p
-        rows = outside_rows(p.x, p.active, p.tl, self.lo, self.hi)
-        if not rows.size:
+        n = count_outside(p.x, p.active, p.tl, self.lo, self.hi)
+        if n == 0:
             return
+        rows = outside_rows(p.x, p.active, p.tl, self.lo, self.hi, n)
         v = p.v[rows] + 0.5 * stepper.dt_prev * p.a[rows]  # after the coming half kick
         m = p.m[rows]
         self.energy_removed += float(0.5 * np.sum(m * np.sum(v * v, axis=1))
