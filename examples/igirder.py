@@ -59,6 +59,10 @@ VARIANTS = {
     # half the loading rate, as fem_slow: the fair comparison with that reference
     "sph_slow": ("SPH, axial, the load ramped over 64 ms (half the rate)",
                  ['run.t_end="64 ms"', 'boundary.2.ramp_time="64 ms"']),
+    # the particles' fracture-energy length dx, as before 2026-11-27: an SPH crack
+    # softens two particle layers, so the concrete dissipated twice G_F per crack
+    "sph_band1": ("SPH, axial, crack band 1 dx (twice the fracture energy)",
+                  ["sph.crack_band=1"]),
 }
 #: variants of igirder_fem.toml: label and overrides (the reference's own spread)
 FEM_VARIANTS = {

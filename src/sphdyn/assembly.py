@@ -41,6 +41,7 @@ def sph_settings(deck, converted: int = 0, sublayer: int = 0,
         skin_factor=sph.neighbours.skin_factor, cfl=deck.time.cfl,
         stress_exponent=sph.artificial_stress.n, epsilon=eps, total_lagrangian=tl,
         hourglass=sph.hourglass, reference_update_every=sph.reference_update_every,
+        crack_band=sph.crack_band,
         density_limits=tuple((m.min_density_factor, m.max_density_factor)
                              for m in deck.material),
         viscosity=tuple(material_viscosity(sph.viscosity, m) for m in deck.material),

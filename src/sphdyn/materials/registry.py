@@ -127,6 +127,11 @@ class MaterialModel:
         The model writes a scalar damage (0 intact, 1 failed) into
         ``damage``: only then may elements of it erode by damage
         (:mod:`sphdyn.parts.fem.erosion_criteria`).
+    softening : bool
+        The model softens and spreads its fracture energy over the ``size``
+        it is given (crack band): an SPH part then gives it the particles'
+        crack-band length (``[sph] crack_band`` times their size) instead of
+        their size (docs/theory.md, "Fracture energy of an SPH crack").
     fluid : bool
         A fluid (gas, detonation products): no shear stiffness, and its
         particles' time step includes the artificial viscosity's signal
@@ -154,6 +159,7 @@ class MaterialModel:
     schema: Any = None
     initial_stress: bool = False
     has_damage: bool = False
+    softening: bool = False
     fluid: bool = False
     initial_state: Callable[[np.ndarray], tuple[float, float]] | None = None
     released_energy: Callable[[np.ndarray, np.ndarray, np.ndarray], float] | None = None

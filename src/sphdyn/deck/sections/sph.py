@@ -86,6 +86,16 @@ class Sph(Section):
     h_factor: real("smoothing-length factor", lo=0, lo_open=True) = Field(
         1.2, description="Initial smoothing length h0 = h_factor * dx of the "
                          "body.")
+    crack_band: real("crack band", lo=0, lo_open=True) = Field(
+        2.0, description="Width of a crack in particle sizes: the length L = "
+        "crack_band * dx over which a softening material (cscm) spreads its "
+        "fracture energy, G_F = L * (the area under its post-peak stress-strain "
+        "curve). An SPH crack opens between two rows of particles and softens "
+        "both: with h = 1.2 dx a tension crack takes two particle layers in 2D "
+        "and 3D at any dx, so L = 2 dx dissipates G_F per crack area (1.05-1.1 "
+        "G_F measured, as a mesh's one element row), L = dx twice that "
+        "(docs/theory.md, 'Fracture energy of an SPH crack'). Mesh elements use "
+        "their own size.")
     support_scale: real("support scale", lo=0, lo_open=True) = Field(
         1.0, description="kappa: the kernel is evaluated with kappa*h, so the "
                          "support radius is q_max * kappa * h.")

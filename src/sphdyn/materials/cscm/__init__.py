@@ -68,4 +68,5 @@ CSCM = register(MaterialModel(
     history_init=initial_history,
     schema=CscmParams,
     has_damage=True,
+    softening=True,
 ))

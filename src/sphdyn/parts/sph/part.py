@@ -74,6 +74,7 @@ class SPHSettings:
     total_lagrangian: tuple  # per body
     hourglass: float  # total-Lagrangian hourglass coefficient
     reference_update_every: int  # total-Lagrangian reference update (0: never)
+    crack_band: float  # fracture-energy length of a particle, in particle sizes
     #: (min, max) density factors per material index (``particles.mat``): the
     #: updated-Lagrangian density is kept within them times ``rho0``; () no limits
     density_limits: tuple = ()
@@ -117,7 +118,8 @@ class SPHPart:
         # av_*: per-particle viscosity, dt_*: time-step factor and viscous
         # signal weight of its material; av_signal written by the force pass
         for name, tail in (("B", (3, 3)), ("dedt_av", ()), ("S", (3, 3)),
-                           ("size", ()), ("bulk_modulus", ()), ("young", ()),
+                           ("size", ()), ("band", ()), ("bulk_modulus", ()),
+                           ("young", ()),
                            ("as_eps", ()), ("swegle", ()), ("av_alpha", ()),
                            ("av_beta", ()), ("av_signal", ()), ("dt_factor", ()),
                            ("dt_viscous", ())):
@@ -162,6 +164,8 @@ class SPHPart:
         p, s = self.p, self.s
         rows = slice(lo, hi)
         p.size[rows] = p.vol0[rows] ** (1.0 / p.dim)  # particle size, initial dx [m]
+        # the length a crack spreads over, for the materials' fracture energy [m]
+        p.band[rows] = s.crack_band * p.size[rows]
         tl_body = np.asarray(s.total_lagrangian, bool)
         p.tl[rows] = tl_body[p.body[rows]]
         eps = np.asarray(s.epsilon, float)
@@ -295,7 +299,8 @@ class SPHPart:
         p = self.p
         for g in self.groups:
             g.model.update(g.idx, p.L, dt, p.rho, p.sig, p.e, p.c, p.damage,
-                           g.history(p.hist), g.params, p.size)
+                           g.history(p.hist), g.params,
+                           p.band if g.model.softening else p.size)
         self._accelerations()
         add_heat(p.e, p.e_av, p.dedt_av, dt)
 
