@@ -7,7 +7,8 @@ point by tests/test_cscm.py). Whether a whole crack then dissipates G_F per
 unit area depends on how many rows of points it softens: a mesh's crack
 takes one element row (L = the element size); an SPH crack opens between two
 rows of particles and softens both, so L = dx dissipates twice G_F and
-[sph] crack_band = 2 (the default, L = 2 dx) gives G_F.
+[sph] crack_band = 2 (L = 2 dx) gives G_F (the default, 1, keeps the paper's
+and thesis's particle size).
 
 The check: a concrete bar (CSCM, f'c 40 MPa, 16 mm aggregate: G_FT = 79.2
 J/m^2) held at one end and pulled at 0.2 m/s at the other until it has
