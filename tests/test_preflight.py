@@ -8,7 +8,7 @@ import pytest
 from sphdyn.deck import load_deck
 from sphdyn.model import build_model
 from sphdyn.neighbours import max_neighbours
-from sphdyn.preflight import estimate_size, shape_volume
+from sphdyn.preflight import estimate_size, history_width, shape_volume
 from sphdyn.simulation import Simulation
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -60,3 +60,14 @@ def test_neighbour_estimate_is_an_interior_particles_list(tmp_path, deck):
     sim = Simulation.from_deck(d, tmp_path / "o")
     longest = max_neighbours(sim.stepper.part("sph").nl)
     assert estimate_size(d).pairs_per_particle == pytest.approx(longest, rel=0.03)
+
+
+@pytest.mark.parametrize("deck", ["igirder_sph", "disc_impact", "rings_gray2001"])
+def test_history_width_is_the_built_parts_layout(deck):
+    # CSCM concrete beside J2 sublayer particles (igirder_sph) lay their
+    # columns side by side: the estimate counts the joined layout, as built
+    d = load_deck(EXAMPLES / f"{deck}.toml")
+    from sphdyn.assembly import build_stepper
+
+    part = build_stepper(d).part("sph")
+    assert history_width(d) == part.p.hist.shape[1]

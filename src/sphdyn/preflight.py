@@ -191,10 +191,21 @@ class SizeEstimate:
                 f"{show_bytes(self.bytes_neighbours)}{meshes})")
 
 
-def _history_width(deck) -> int:
-    from .materials import get_model
+def history_width(deck) -> int:
+    """Columns of the particles' one history array: the deck's material models,
+    and the uniaxial bar of an axial sublayer, laid side by side as the parts
+    lay them (:func:`~sphdyn.materials.history_layout`; every material
+    counted, an upper bound where a mesh has its own), at least one."""
+    from .materials import UNIAXIAL, get_model, history_layout
 
-    return max([len(get_model(m.model).history_names) for m in deck.material] + [0])
+    models = [get_model(m.model) for m in deck.material]
+    if any(m.sublayer is not None and m.sublayer.stiffness == "axial" for m in deck.mesh):
+        models.append(UNIAXIAL)
+    try:
+        width = len(history_layout(models)[0])
+    except ValueError:  # models that cannot share one array: the build names them
+        width = sum(len(m.history_names) for m in models)
+    return max(width, 1)
 
 
 def estimate_size(deck) -> SizeEstimate:
@@ -213,7 +224,7 @@ def estimate_size(deck) -> SizeEstimate:
     n = float(sum(bodies.values()))
     radius = support_radius(sph) * sph.h_factor * (1.0 + sph.neighbours.skin_factor)
     pairs = ball_volume(radius, dim)
-    per_particle = PARTICLE_BYTES + 8 * _history_width(deck)
+    per_particle = PARTICLE_BYTES + 8 * history_width(deck)
     meshes = {m.name: _element_count(m, dim) for m in deck.mesh if m.file is None}
     return SizeEstimate(bodies, n, pairs, n * per_particle,
                         n * pairs * PAIR_BYTES if n and pairs else 0.0, meshes)
