@@ -23,7 +23,7 @@ from .interactions.wall import STIFFNESS, WallSpec
 from .deck import DeckError
 from .deck.errors import format_problem
 from .detonation import light_explosives
-from .preflight import checked_lattices, support_radius
+from .preflight import checked_lattices, history_models, support_radius
 from .materials import MaterialGroup, get_model, history_layout
 from .materials.uniaxial import UNIAXIAL, uniaxial_params
 from .mesh_model import MeshModel, build_meshes, mesh_node_set
@@ -204,9 +204,7 @@ def build_model(deck) -> Model:
     mat_index = {m.name: k for k, m in enumerate(deck.material)}
     models = {m.name: get_model(m.model) for m in deck.material}
     params = {name: models[name].pack(m.values()) for name, m in mats.items()}
-    axial = [UNIAXIAL] if any(mm.spec.sublayer.stiffness == "axial"
-                              for mm in sublayer_meshes(meshes)) else []
-    hist_names, first = history_layout([*models.values(), *axial])
+    hist_names, first = history_layout(history_models(deck))
     n_hist = len(hist_names)
 
     density_of = np.array([m.density for m in deck.material])

@@ -191,16 +191,26 @@ class SizeEstimate:
                 f"{show_bytes(self.bytes_neighbours)}{meshes})")
 
 
-def history_width(deck) -> int:
-    """Columns of the particles' one history array: the deck's material models,
-    and the uniaxial bar of an axial sublayer, laid side by side as the parts
-    lay them (:func:`~sphdyn.materials.history_layout`; every material
-    counted, an upper bound where a mesh has its own), at least one."""
-    from .materials import UNIAXIAL, get_model, history_layout
+def history_models(deck) -> list:
+    """The material models whose history columns the model's items share: the
+    deck's materials in order, and the uniaxial bar when a sublayer's
+    particles carry the bar axially (``stiffness = "axial"``)."""
+    from .materials import UNIAXIAL, get_model
 
     models = [get_model(m.model) for m in deck.material]
     if any(m.sublayer is not None and m.sublayer.stiffness == "axial" for m in deck.mesh):
         models.append(UNIAXIAL)
+    return models
+
+
+def history_width(deck) -> int:
+    """Columns of the particles' one history array: :func:`history_models`
+    laid side by side as the parts lay them
+    (:func:`~sphdyn.materials.history_layout`; every material counted, an
+    upper bound where a mesh has its own), at least one."""
+    from .materials import history_layout
+
+    models = history_models(deck)
     try:
         width = len(history_layout(models)[0])
     except ValueError:  # models that cannot share one array: the build names them
