@@ -71,7 +71,7 @@ MUTANTS: tuple[Mutant, ...] = (
            ("tests/test_kernels.py::test_grad_factor_and_second_derivative_vs_fd",),
            "cubic spline w'(q)/q on q < 1: constant 12 -> 11"),
     Mutant("moment_matrix_sign", "issue 17 speed", "sphdyn/parts/sph/passes.py",
-           "            m01 -= d0 * g1", "            m01 += d0 * g1",
+           "            m01 -= d0 * (g1 * w)", "            m01 += d0 * (g1 * w)",
            ("tests/test_sph_passes.py::test_correction_is_the_inverse_moment_matrix_of_the_stored_factors",),
            "Randles-Libersky moment matrix: an off-diagonal entry with the wrong sign"),
     Mutant("moment_inverse_entry", "issue 17 speed", "sphdyn/parts/sph/passes.py",
