@@ -51,8 +51,8 @@ def main() -> None:
     def call(scratch) -> float:
         idx = nl.idx.copy()  # the pass partitions rows in place
         t0 = time.perf_counter()
-        velocity_gradient(p.x, p.v, p.h, p.m, p.rho, p.moment_weight, nl.offsets, idx, k.kid,
-                          k.sigma, part.dim, k.support_scale, part.s.correction, F, L, B, count,
+        velocity_gradient(p.x, p.v, p.h, p.m, p.rho, nl.offsets, idx, k.kid, k.sigma,
+                          part.dim, k.support_scale, part.s.correction, F, L, B, count,
                           scratch)
         return time.perf_counter() - t0
 

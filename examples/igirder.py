@@ -53,9 +53,8 @@ VARIANTS = {
     "sph_r025": ("SPH, axial, mass ratio 0.25", ["mesh.{bar}.sublayer.mass_ratio=0.25"]),
     "sph_split": ("SPH, particles of the split steel in 3D (stiffness split)",
                   ['mesh.{bar}.sublayer.stiffness="split"']),
-    # kernel gradients corrected (the bars' particles out of the moment
-    # matrices): the flanges' free faces carry their share of the bending
-    # (78 % of the FEM girders' elastic force without, 97-99 % with)
+    # kernel gradients corrected: the flanges' free faces carry their share of
+    # the bending (78 % of the FEM girders' elastic force without, 93 % with)
     "sph_corr": ("SPH, axial, corrected kernel gradients", ["sph.correction=true"]),
     # half the loading rate, as fem_slow: the fair comparison with that reference
     "sph_slow": ("SPH, axial, the load ramped over 64 ms (half the rate)",

@@ -39,17 +39,15 @@ def _interior(c, layers):
     return np.flatnonzero(ok)
 
 
-def _grad(c, v, correct, with_factors=False, mw=None):
+def _grad(c, v, correct, with_factors=False):
     n = c["x"].shape[0]
-    mw = np.ones(n) if mw is None else mw
     L = np.zeros((n, 3, 3))
     B = np.zeros((n, 3, 3))
     nl = c["nl"]
     F = np.zeros(nl.idx.size, dtype=np.float32)  # as the part stores them
     count = np.zeros(n, np.int32)
-    velocity_gradient(c["x"], v, c["h"], c["m"], c["rho"], mw, nl.offsets, nl.idx,
-                      c["kid"], c["sigma"], c["dim"], 1.0, correct, F, L, B, count,
-                      gradient_scratch(nl.offsets))
+    velocity_gradient(c["x"], v, c["h"], c["m"], c["rho"], nl.offsets, nl.idx, c["kid"], c["sigma"],
+                      c["dim"], 1.0, correct, F, L, B, count, gradient_scratch(nl.offsets))
     return (L, B, F, count) if with_factors else (L, B)
 
 
@@ -125,19 +123,14 @@ def test_raw_gradient_is_the_pair_sum_of_the_stored_factors(dim, kernel):
 
 @pytest.mark.parametrize("dim", [2, 3])
 @pytest.mark.parametrize("kernel", ["cubic_spline", "quintic_spline"])
-@pytest.mark.parametrize("embedded", [False, True])
-def test_correction_is_the_inverse_moment_matrix_of_the_stored_factors(dim, kernel, embedded):
+def test_correction_is_the_inverse_moment_matrix_of_the_stored_factors(dim, kernel):
     """With the correction, B_i = M_i^-1 with the moment matrix written out in
-    NumPy from the pass's stored factors, M_i = sum_j w_j (m_j / rho_i) (x_j -
-    x_i) (x) F_ij (x_i - x_j) (symmetric: B is, exactly), and L_i = L_raw,i B_i
-    with L_raw over all neighbours, to 1e-12 relative (round-off of the sums
-    and of a 3x3 inverse of condition ~10). Both compiled forms of the pass:
-    the 3D cubic spline's (constants) and the general one (the quintic, and
-    2D). A wrong sign, weight or a transposed entry of M fails it at O(1) on
-    this jittered, unequal cloud. ``embedded``: one particle in five has the
-    moment weight w_j = 0 (a sublayer particle): out of M, in L_raw (a pass
-    that ignored the weight, or dropped those pairs from L too, fails at
-    O(0.1))."""
+    NumPy from the pass's stored factors, M_i = sum_j (m_j / rho_i) (x_j - x_i)
+    (x) F_ij (x_i - x_j) (symmetric: B is, exactly), and L_i = L_raw,i B_i, to
+    1e-12 relative (round-off of the sums and of a 3x3 inverse of condition
+    ~10). Both compiled forms of the pass: the 3D cubic spline's (constants)
+    and the general one (the quintic, and 2D). A wrong sign, weight or a
+    transposed entry of M fails it at O(1) on this jittered, unequal cloud."""
     c = _cloud(dim, n_side=8 if dim == 3 else 12, kernel=kernel, jitter=0.3, seed=5)
     rng = np.random.default_rng(11)
     n = c["x"].shape[0]
@@ -148,8 +141,7 @@ def test_correction_is_the_inverse_moment_matrix_of_the_stored_factors(dim, kern
     c["nl"] = nl = build_neighbours(c["x"], c["h"], q, 0.2 * q * c["h"].max(), dim)
     v = rng.normal(size=(n, 3))
     v[:, dim:] = 0.0
-    mw = np.where(rng.uniform(size=n) < 0.2, 0.0, 1.0) if embedded else np.ones(n)
-    L, B, F, count = _grad(c, v, True, with_factors=True, mw=mw)
+    L, B, F, count = _grad(c, v, True, with_factors=True)
     assert np.array_equal(B, B.transpose(0, 2, 1))
     x, m, rho = c["x"], c["m"], c["rho"]
     for i in range(n):
@@ -157,7 +149,7 @@ def test_correction_is_the_inverse_moment_matrix_of_the_stored_factors(dim, kern
         j = nl.idx[lo:lo + count[i]]
         f = F[lo:lo + count[i]].astype(float) * (m[j] / rho[i])
         d = x[i] - x[j]
-        M = -(d[:, :, None] * ((f * mw[j])[:, None] * d)[:, None, :]).sum(axis=0)
+        M = -(d[:, :, None] * (f[:, None] * d)[:, None, :]).sum(axis=0)
         M[dim:, :] = 0.0
         M[:, dim:] = 0.0
         M[dim:, dim:] = np.eye(3 - dim)
@@ -588,8 +580,8 @@ def test_buffered_gradient_rows_give_the_pair_by_pair_bits(correct):
         L = np.zeros((n, 3, 3))
         B = np.zeros((n, 3, 3))
         count = np.zeros(n, np.int32)
-        velocity_gradient(c["x"], v, h, m, c["rho"], np.ones(n), nl.offsets, idx, 0,
-                          c["sigma"], 3, 1.0, correct, F, L, B, count, scratch)
+        velocity_gradient(c["x"], v, h, m, c["rho"], nl.offsets, idx, 0, c["sigma"], 3, 1.0,
+                          correct, F, L, B, count, scratch)
         results.append((L, B, F, count, idx))
     assert (count := results[0][3]).min() > 10 and (lengths - count).min() > 0  # skin pairs
     assert not np.array_equal(results[0][4], nl.idx)  # the partition moved pairs

@@ -146,9 +146,6 @@ class SublayerCoupling(InteractionBase):
         self.rows, self.nodes = rows, nodes
         q.m[nodes] += p.m[rows]
         p.bc[rows] = BC_SLAVE
-        # embedded in the concrete, not part of its discretisation: out of the
-        # kernel correction's moment matrices (parts.sph.passes.velocity_gradient)
-        p.moment_weight[rows] = 0.0
         self.force = np.zeros((rows.size, 3))
         self.L_own = np.zeros((rows.size, 3, 3))  # the bar's own pairs' share of L
         # a one-node "element" per particle: the shared slave kernels with N = 1

@@ -104,9 +104,7 @@ class Sph(Section):
                          "support radius is q_max * kappa * h.")
     correction: StrictBool = Field(
         False, description="Randles-Libersky renormalisation of kernel "
-                           "gradients (first-order exact at free surfaces; a "
-                           "bar's sublayer particles stay out of the "
-                           "concrete's moment matrices, docs/theory.md).")
+                           "gradients.")
     xsph: real("XSPH factor", lo=0, hi=1) = Field(
         0.0, description="XSPH velocity smoothing factor epsilon "
                          "(0 = off).")

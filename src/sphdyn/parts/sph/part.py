@@ -124,9 +124,6 @@ class SPHPart:
                            ("av_beta", ()), ("av_signal", ()), ("dt_factor", ()),
                            ("dt_viscous", ())):
             p.add(name, tail)
-        # 1: in the kernel correction's moment matrices; 0: embedded, not part of
-        # the continuum's discretisation (sublayer particles; velocity_gradient)
-        p.add("moment_weight", (), fill=1.0)
         p.add("tl", (), np.bool_, fill=False)
         p.add("n_support", (), np.int32)  # pairs within the support (velocity_gradient)
         self.as_on = any(e > 0 for e, tl in zip(settings.epsilon, settings.total_lagrangian)
@@ -400,9 +397,9 @@ class SPHPart:
                 self._F_buf = np.empty(int(need * 1.1), dtype=np.float32)
             self.F = self._F_buf[:need]
         if self.has_ul:
-            velocity_gradient(p.x, p.v, p.h, p.m, p.rho, p.moment_weight, nl.offsets, nl.idx,
-                              k.kid, k.sigma, self.dim, k.support_scale, self.s.correction,
-                              self.F, p.L, p.B, p.n_support, self._gradient_scratch())
+            velocity_gradient(p.x, p.v, p.h, p.m, p.rho, nl.offsets, nl.idx, k.kid, k.sigma,
+                              self.dim, k.support_scale, self.s.correction, self.F, p.L,
+                              p.B, p.n_support, self._gradient_scratch())
         if self.tl is not None:
             self.tl.velocity_gradient(p)
         for f in self.pair_filters:

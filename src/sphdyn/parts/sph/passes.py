@@ -67,8 +67,8 @@ def stress_terms(sig, rho, B, P):
                 P[i, a, b] = s0 * B[i, 0, b] + s1 * B[i, 1, b] + s2 * B[i, 2, b]
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _gradient_row(i, x, v, h, m, rho, mw, offsets, idx, kid, sigma, dim, support_scale,
-                  correct, F, L, B, count):
+def _gradient_row(i, x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_scale, correct,
+                  F, L, B, count):
     """Row ``i`` of :func:`velocity_gradient` (its docstring); inlined into
     each of the pass's compiled forms, where ``kid``, ``dim`` and ``correct``
     may be constants."""
@@ -126,11 +126,10 @@ def _gradient_row(i, x, v, h, m, rho, mw, offsets, idx, kid, sigma, dim, support
         l01 += u0 * g1
         l10 += u1 * g0
         l11 += u1 * g1
-        if correct:  # (x_j - x_i) = -d, neighbours in the moment matrix only
-            w = mw[j]
-            m00 -= d0 * (g0 * w)
-            m01 -= d0 * (g1 * w)
-            m11 -= d1 * (g1 * w)
+        if correct:  # (x_j - x_i) = -d
+            m00 -= d0 * g0
+            m01 -= d0 * g1
+            m11 -= d1 * g1
         if three:
             g2 = f * d2
             u2 = v[j, 2] - vi2
@@ -140,9 +139,9 @@ def _gradient_row(i, x, v, h, m, rho, mw, offsets, idx, kid, sigma, dim, support
             l21 += u2 * g1
             l22 += u2 * g2
             if correct:
-                m02 -= d0 * (g2 * w)
-                m12 -= d1 * (g2 * w)
-                m22 -= d2 * (g2 * w)
+                m02 -= d0 * g2
+                m12 -= d1 * g2
+                m22 -= d2 * g2
     count[i] = head - offsets[i]
     _finish_row(i, dim, correct, l00, l01, l02, l10, l11, l12, l20, l21, l22,
                 m00, m01, m02, m11, m12, m22, L, B)
@@ -198,10 +197,9 @@ def _finish_row(i, dim, correct, l00, l01, l02, l10, l11, l12, l20, l21, l22,
 
 #: rows of a chunk's row buffer in :func:`_buffered_row` (pair ``t`` of the
 #: row within the support in column ``t``): x_i - x_j, r^2, h_j, v_j - v_i,
-#: m_j / rho_i, the neighbour's weight in the moment matrix (correction
-#: only), then the pair's m_j F_ij / rho_i and its gradient g
-_D0, _D1, _D2, _R2, _HJ, _U0, _U1, _U2, _WM, _MW, _FW, _G0, _G1, _G2 = range(14)
-GRADIENT_ROWS = 14
+#: m_j / rho_i, then the pair's m_j F_ij / rho_i and its gradient g
+_D0, _D1, _D2, _R2, _HJ, _U0, _U1, _U2, _WM, _FW, _G0, _G1, _G2 = range(13)
+GRADIENT_ROWS = 13
 #: contiguous particle chunks of the buffered pass (each a row buffer)
 GRADIENT_CHUNKS = 64
 
@@ -218,8 +216,8 @@ def gradient_scratch(offsets, scratch=None):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _buffered_row(i, x, v, h, m, rho, mw, offsets, idx, sigma, support_scale, correct, F, L,
-                  B, count, W):
+def _buffered_row(i, x, v, h, m, rho, offsets, idx, sigma, support_scale, correct, F, L, B,
+                  count, W):
     """Row ``i`` of :func:`velocity_gradient` for the 3D cubic spline, the same
     operations in the same order as :func:`_gradient_row` (the same bits),
     in three loops over the row buffer ``W`` (GRADIENT_ROWS, width): (1) gather and
@@ -261,8 +259,6 @@ def _buffered_row(i, x, v, h, m, rho, mw, offsets, idx, sigma, support_scale, co
         W[_U1, t] = v[j, 1] - vi1
         W[_U2, t] = v[j, 2] - vi2
         W[_WM, t] = m[j] * irho
-        if correct:
-            W[_MW, t] = mw[j]
     c = head - o
     count[i] = c
     for t in range(c):
@@ -298,45 +294,44 @@ def _buffered_row(i, x, v, h, m, rho, mw, offsets, idx, sigma, support_scale, co
         l20 += u2 * g0
         l21 += u2 * g1
         l22 += u2 * g2
-        if correct:  # (x_j - x_i) = -d, neighbours in the moment matrix only
-            w = W[_MW, t]
-            m00 -= W[_D0, t] * (g0 * w)
-            m01 -= W[_D0, t] * (g1 * w)
-            m02 -= W[_D0, t] * (g2 * w)
-            m11 -= W[_D1, t] * (g1 * w)
-            m12 -= W[_D1, t] * (g2 * w)
-            m22 -= W[_D2, t] * (g2 * w)
+        if correct:  # (x_j - x_i) = -d
+            m00 -= W[_D0, t] * g0
+            m01 -= W[_D0, t] * g1
+            m02 -= W[_D0, t] * g2
+            m11 -= W[_D1, t] * g1
+            m12 -= W[_D1, t] * g2
+            m22 -= W[_D2, t] * g2
     _finish_row(i, 3, correct, l00, l01, l02, l10, l11, l12, l20, l21, l22,
                 m00, m01, m02, m11, m12, m22, L, B)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _buffered_chunk(t, x, v, h, m, rho, mw, offsets, idx, sigma, support_scale, correct, F,
-                    L, B, count, work):
+def _buffered_chunk(t, x, v, h, m, rho, offsets, idx, sigma, support_scale, correct, F, L, B,
+                    count, work):
     """Chunk ``t`` of :data:`GRADIENT_CHUNKS` (contiguous particles) of the
     buffered pass; a row longer than the buffer takes :func:`_gradient_row`."""
     n = x.shape[0]
     W = work[t]
     for i in range(t * n // GRADIENT_CHUNKS, (t + 1) * n // GRADIENT_CHUNKS):
         if offsets[i + 1] - offsets[i] <= W.shape[1]:
-            _buffered_row(i, x, v, h, m, rho, mw, offsets, idx, sigma, support_scale,
-                          correct, F, L, B, count, W)
+            _buffered_row(i, x, v, h, m, rho, offsets, idx, sigma, support_scale, correct,
+                          F, L, B, count, W)
         else:
-            _gradient_row(i, x, v, h, m, rho, mw, offsets, idx, 0, sigma, 3, support_scale,
+            _gradient_row(i, x, v, h, m, rho, offsets, idx, 0, sigma, 3, support_scale,
                           correct, F, L, B, count)
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def velocity_gradient(x, v, h, m, rho, mw, offsets, idx, kid, sigma, dim, support_scale,
-                      correct, F, L, B, count, work):
+def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_scale, correct,
+                      F, L, B, count, work):
     r"""Velocity gradient with optional Randles-Libersky renormalisation.
 
     .. math::
         L_i = \sum_j \frac{m_j}{\rho_i} (\mathbf v_j - \mathbf v_i) \otimes
               \mathbf g_{ij}\, B_i^T,
         \qquad
-        B_i = \Big[\sum_j w_j\,\frac{m_j}{\rho_i} (\mathbf x_j - \mathbf x_i)
-              \otimes \mathbf g_{ij}\Big]^{-T}
+        B_i = \Big[\sum_j \frac{m_j}{\rho_i} (\mathbf x_j - \mathbf x_i) \otimes
+              \mathbf g_{ij}\Big]^{-T}
 
     (``L[i, a, b] = dv_a/dx_b``). Without correction ``B_i = I``. With it, any
     linear velocity field is differentiated exactly at every particle that
@@ -346,15 +341,7 @@ def velocity_gradient(x, v, h, m, rho, mw, offsets, idx, kid, sigma, dim, suppor
     matrix is symmetric, :math:`\sum_j (m_j/\rho_i) F_{ij}\, \mathbf d \otimes
     \mathbf d` with :math:`\mathbf d = \mathbf x_i - \mathbf x_j`, so its six
     distinct entries are summed (and ``B_i`` is symmetric), and only when the
-    correction is on. The weight :math:`w_j` (``mw``) is 1 for the particles
-    of the continuum and 0 for those embedded in it without being part of
-    its discretisation (a bar's sublayer particles, which overlap the
-    concrete's particles: :mod:`sphdyn.interactions.sublayer`): the
-    correction makes the concrete's own approximation exact for linear
-    fields, and the embedded particles' relative motion enters ``L`` on top
-    of it, as without correction (with them in the moment matrix their
-    volume, 3.6 concrete particles' each in the pull-out test, normalised
-    the bond away: the peak pull fell from 132 to 80 kN).
+    correction is on.
 
     Speed: the row's sums are kept in registers; the pass is compiled in
     four forms (correction on or off, and the 3D cubic spline or any kernel
@@ -391,8 +378,6 @@ def velocity_gradient(x, v, h, m, rho, mw, offsets, idx, kid, sigma, dim, suppor
     m, rho : (N,) masses [kg] (0 for zero-mass particles) and densities
         [kg/m^3]; the weight of pair ij is m_j / rho_i (the energy partner of
         :func:`forces`, see the module docstring).
-    mw : (N,) float, 1 or 0: the particle's weight in its neighbours' moment
-        matrices (read only with ``correct``).
     offsets, idx : CSR neighbour list (``idx`` (nnz,) int32, each row
         reordered in place, see above).
     kid, sigma, dim, support_scale : kernel id, normalisation, dimension (2: z
@@ -419,20 +404,20 @@ def velocity_gradient(x, v, h, m, rho, mw, offsets, idx, kid, sigma, dim, suppor
     if dim == 3 and kid == 0:
         if correct:
             for t in prange(GRADIENT_CHUNKS):
-                _buffered_chunk(t, x, v, h, m, rho, mw, offsets, idx, sigma, support_scale,
-                                True, F, L, B, count, work)
+                _buffered_chunk(t, x, v, h, m, rho, offsets, idx, sigma, support_scale, True,
+                                F, L, B, count, work)
         else:
             for t in prange(GRADIENT_CHUNKS):
-                _buffered_chunk(t, x, v, h, m, rho, mw, offsets, idx, sigma, support_scale,
-                                False, F, L, B, count, work)
+                _buffered_chunk(t, x, v, h, m, rho, offsets, idx, sigma, support_scale, False,
+                                F, L, B, count, work)
     elif correct:
         for i in prange(n):
-            _gradient_row(i, x, v, h, m, rho, mw, offsets, idx, kid, sigma, dim,
-                          support_scale, True, F, L, B, count)
+            _gradient_row(i, x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_scale,
+                          True, F, L, B, count)
     else:
         for i in prange(n):
-            _gradient_row(i, x, v, h, m, rho, mw, offsets, idx, kid, sigma, dim,
-                          support_scale, False, F, L, B, count)
+            _gradient_row(i, x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_scale,
+                          False, F, L, B, count)
 
 @njit(cache=True, error_model="numpy", parallel=True)
 def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, dim, support_scale, alpha, beta,
