@@ -18,7 +18,7 @@ import numba
 import numpy as np
 from numba import njit
 
-from sphdyn.events.domain_exit import count_outside
+from sphdyn.events.domain_exit import count_outside, outside_rows
 from sphdyn.guards import outside_box
 
 
@@ -29,13 +29,7 @@ def _serial_rows(x, active, tl, lo, hi):
     for i in range(x.shape[0]):
         if active[i] != 0 and not tl[i] and outside_box(x, i, lo, hi):
             n += 1
-    out = np.empty(n, np.int64)
-    k = 0
-    for i in range(x.shape[0]):
-        if active[i] != 0 and not tl[i] and outside_box(x, i, lo, hi):
-            out[k] = i
-            k += 1
-    return out
+    return outside_rows(x, active, tl, lo, hi, n)  # the second scan, as it was
 
 
 def main() -> None:
