@@ -12,13 +12,11 @@ Cases: ``sphdyn bench rings2d``, ``rings2d_tl``, ``block3d --particles
 100000`` (particle-steps per second of the stepping alone) and the paper's
 CSCM disc (``sphdyn run examples/disc_impact.toml --max-steps 150``,
 particle-steps per second from its summary, output of the first frame
-included in both; ``CSCM disc corrected`` the same with ``[sph] correction =
-true``, the pass's corrected form), ``hex3d --elements 100000``
-(element-steps per second), and the coarse drop-weight beam in its impact
-(``benchmarks/profile_step.py`` on ``examples/dropweight_coarse.toml``, 300
-steps after 2,000 untimed ones: the ram meets the beam at about step 1,900;
-item-steps per second, the same deck file for both trees); ``--cases`` picks
-some by name (comma-separated).
+included in both), ``hex3d --elements 100000`` (element-steps per second), and the coarse
+drop-weight beam in its impact (``benchmarks/profile_step.py`` on
+``examples/dropweight_coarse.toml``, 300 steps after 2,000 untimed ones: the
+ram meets the beam at about step 1,900; item-steps per second, the same deck
+file for both trees); ``--cases`` picks some by name (comma-separated).
 """
 
 from __future__ import annotations
@@ -35,8 +33,6 @@ CASES = [("rings2d", ["bench", "rings2d", "--steps", "500"]),
          ("rings2d_tl", ["bench", "rings2d_tl", "--steps", "500"]),
          ("block3d 100k", ["bench", "block3d", "--particles", "100000", "--steps", "30"]),
          ("CSCM disc", ["run", "examples/disc_impact.toml", "-q", "--max-steps", "150"]),
-         ("CSCM disc corrected", ["run", "examples/disc_impact.toml", "-q", "--set",
-                                  "sph.correction=true", "--max-steps", "150"]),
          ("hex3d 100k", ["bench", "hex3d", "--elements", "100000", "--steps", "100"]),
          ("HVI coarse impact", ["profile", "--deck", "examples/dropweight_coarse.toml",
                                 "--start-steps", "2000", "--steps", "300"])]
