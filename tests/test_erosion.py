@@ -5,6 +5,7 @@ the master surface that follows erosion, and restart across a conversion."""
 from __future__ import annotations
 
 import copy
+import dataclasses
 import itertools
 import math
 
@@ -391,10 +392,11 @@ def test_master_faces_follow_erosion():
 
 
 # ---------------------------------------------------------------- dynamics
-def _impact(to, per_element=1):
+def _impact(to, per_element=1, interaction_work=False, others=()):
     """A concrete-like block of 4 x 4 x 4 hexes at 20 m/s onto a rigid wall,
     its elements eroding at 0.2 % effective strain, the particles coupled to the
-    remaining elements by penalty and held by the same wall."""
+    remaining elements by penalty and held by the same wall; ``others``
+    (callables of the solid) add interactions."""
     x, cells = block([0, 0, 0.0055], [0.04, 0.04, 0.0455], (4, 4, 4), 3)
     mat = material(**CONCRETE)
     solid = part(x, cells, 3, mat=mat)
@@ -407,10 +409,12 @@ def _impact(to, per_element=1):
     if to == "particles":
         sph = empty_sph(3, mat)
         parts.append(sph)
-        inters += [Wall(copy.copy(spec), sph), PenaltyCoupling("c", sph, solid)]
+        inters += [Wall(dataclasses.replace(spec, name="floor_debris"), sph),
+                   PenaltyCoupling("c", sph, solid)]
     ev = ElementErosion("erosion", solid, {0: ErosionRules(effective_strain=0.002)}, to=to,
                         per_element=per_element, sph=sph)
-    return Stepper(parts, inters, [ev]), ev
+    inters += [make(solid) for make in others]
+    return Stepper(parts, inters, [ev], interaction_work=interaction_work), ev
 
 
 @pytest.mark.parametrize("to", ["particles", "nothing"])

@@ -94,9 +94,12 @@ def test_plain_erosion_from_a_deck_reports_the_lost_mass(tmp_path):
 
 
 def test_restart_across_conversions_from_a_deck_is_bitwise(tmp_path):
-    full = Simulation.from_deck(loads_deck(cube()), tmp_path / "full")
+    """With the interactions' own work books on (``interaction_work``): their
+    columns restart bitwise too, and add up to -E_contact."""
+    books = "interaction_work = true"
+    full = Simulation.from_deck(loads_deck(cube(extra=books)), tmp_path / "full")
     full.run()
-    part = Simulation.from_deck(loads_deck(cube(extra="checkpoint_every = 40")),
+    part = Simulation.from_deck(loads_deck(cube(extra="checkpoint_every = 40\n" + books)),
                                 tmp_path / "part")
     part.run(max_steps=170)
     ck = read_checkpoint(tmp_path / "part/checkpoint.h5")
@@ -107,6 +110,11 @@ def test_restart_across_conversions_from_a_deck_is_bitwise(tmp_path):
     assert list(h_full) == list(h_part)
     for col in h_full:
         assert np.array_equal(h_full[col], h_part[col]), col
+    books = [c for c in h_full if c.startswith("W_contact_")]
+    assert sorted(books) == ["W_contact_cube_debris", "W_contact_events",
+                             "W_contact_floor", "W_contact_floor_cube"]
+    total = sum(h_full[c] for c in books)
+    assert np.allclose(total, -h_full["E_contact"], rtol=0, atol=1e-9 * np.abs(total).max())
     f_full = read_frame(sorted((tmp_path / "full/frames").glob("*.h5"))[-1])[2]
     f_part = read_frame(sorted((tmp_path / "part/frames").glob("*.h5"))[-1])[2]
     assert np.array_equal(f_full["position"], f_part["position"])

@@ -267,6 +267,26 @@ MUTANTS: tuple[Mutant, ...] = (
            ("tests/test_artificial_stress.py::"
             "test_pair_force_is_repulsive_with_the_stated_magnitude",),
            "non-integer exponent n truncated to an integer"),
+    Mutant("sublayer_corrected_own_pairs", "issue 16.2", "sphdyn/interactions/sublayer.py",
+           "if member[j] or fac[q] == 0.0:", "if fac[q] == 0.0:",
+           ("tests/test_sublayer.py::"
+            "test_the_bars_own_pairs_are_out_of_its_velocity_gradient[True]",),
+           "corrected bar particle: its bar's own pairs back in both sums"),
+    Mutant("sublayer_corrected_moment_entry", "issue 16.2", "sphdyn/interactions/sublayer.py",
+           "M[a, b] += (x[j, a] - x[i, a]) * g", "M[a, b] += (x[j, b] - x[i, b]) * g",
+           ("tests/test_sublayer.py::"
+            "test_corrected_concrete_is_exact_around_a_bonded_bar_in_affine_motion",),
+           "corrected bar particle: the moment sum with the wrong component of x_j - x_i"),
+    Mutant("interaction_work_born_rows", "issue 16.1", "sphdyn/interaction_work.py",
+           "acc[n0:] = q.a_ext[n0:]", "acc[n0:] = 0.0",
+           ("tests/test_interaction_work.py::"
+            "test_the_sources_add_up_to_the_interactions_work_through_erosion",),
+           "the loads of particles born in an erosion left out of the events' work"),
+    Mutant("interaction_work_dt", "issue 16.1", "sphdyn/interaction_work.py",
+           "    return w * dt_kick", "    return w",
+           ("tests/test_interaction_work.py::"
+            "test_kick_work_is_the_mass_weighted_power_over_the_kick",),
+           "a source's work over a kick without the kick's length"),
 )
 
 

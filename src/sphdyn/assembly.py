@@ -93,4 +93,5 @@ def build_stepper(deck, model: Model | None = None, events=(), monitors=()) -> S
     if part is not None and deck.domain.outside == "remove":
         events.append(DomainExit(part, model.domain_lo, model.domain_hi))
     dt_max = deck.time.dt_max if deck.time.dt_max is not None else np.inf
-    return Stepper(parts, interactions, events, monitors, dt_max=dt_max)
+    return Stepper(parts, interactions, events, monitors, dt_max=dt_max,
+                   interaction_work=deck.output.interaction_work)

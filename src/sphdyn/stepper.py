@@ -30,6 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from .integrate import KICK_BLOCK, kick, kick_scratch
+from .interaction_work import InteractionWork
 from .state import BC_SLAVE
 
 
@@ -59,9 +60,12 @@ class Stepper:
     monitors : objects with any of ``before_step(stepper, dt, k, part)``,
         ``after_kick(stepper)``, ``after_step(stepper)``.
     dt_max : largest step [s].
+    interaction_work : book each interaction's work apart
+        (:mod:`sphdyn.interaction_work`; columns ``W_contact_<name>``).
     """
 
-    def __init__(self, parts, interactions=(), events=(), monitors=(), dt_max=np.inf):
+    def __init__(self, parts, interactions=(), events=(), monitors=(), dt_max=np.inf,
+                 interaction_work=False):
         self.parts = list(parts)
         self.interactions = list(interactions)
         self.events = list(events)
@@ -75,6 +79,8 @@ class Stepper:
         self.work_contact = 0.0  # work of the interaction forces [J]
         self.work_external = 0.0  # work of the boundary-condition reactions [J]
         self._kick_sums: dict[str, np.ndarray] = {}  # per part, grown with it
+        self.books = (InteractionWork(self.parts, self.interactions, self.events, dofs)
+                      if interaction_work else None)
         for part in self.parts:
             for q in dofs(part):
                 q.add("v_mid", (3,))
@@ -127,8 +133,16 @@ class Stepper:
     def _interaction_forces(self, dt: float) -> None:
         for part in self.parts:
             part.kin.a_ext[:] = 0.0
+        books = self.books
+        if books is not None:
+            books.clear_events()
         for inter in self.interactions:
+            tracked = books is not None and books.tracks(inter.name)
+            if tracked:
+                books.before()
             inter.forces(self.t, dt, inter.part.kin.a_ext)
+            if tracked:
+                books.after(inter.name)
         for part in self.parts:
             part.kin.a += part.kin.a_ext
 
@@ -153,6 +167,8 @@ class Stepper:
         self.work_contact += wc
         self.work_external += we
         self.kinetic, self.dt_step = ke, dt
+        if self.books is not None:
+            self.books.book(dt_kick)
         for inter in self.interactions:
             inter.after_kick(dt_kick)
             w = inter.external_work()  # (gravity) external, not an interaction's
@@ -174,9 +190,13 @@ class Stepper:
         for part in self.parts:
             part.internal_forces(self.t, dt)
         self._interaction_forces(self.dt_contact_step)
+        if self.books is not None and self.events:
+            self.books.before()
         for event in self.events:
             if event.due(self):
                 event.apply(self)
+        if self.books is not None and self.events:
+            self.books.after(InteractionWork.EVENTS)
         self._notify("after_step")
 
     # ------------------------------------------------------------ records
@@ -220,6 +240,8 @@ class Stepper:
         for ev in self.events:
             if hasattr(ev, "columns"):
                 rec.update(ev.columns(self.t))
+        if self.books is not None:
+            rec.update(self.books.columns())
         return rec
 
     def kinetic_now(self) -> float:
@@ -248,6 +270,9 @@ class Stepper:
             groups[f"kin.{part.name}"] = part.kin.arrays()
             if len(dofs(part)) > 1:
                 groups[f"rot.{part.name}"] = part.kin.rot.arrays()
+        if self.books is not None:
+            sc, groups["interaction_work"] = self.books.state()
+            scalars.update({f"books.{k}": v for k, v in sc.items()})
         return scalars, groups
 
     def restore(self, scalars: dict, groups: dict) -> None:
@@ -297,3 +322,6 @@ class Stepper:
         scratch = {id(p.kin): np.zeros_like(p.kin.a_ext) for p in self.parts}
         for inter in self.interactions:
             inter.forces(self.t, self.dt_contact_step, scratch[id(inter.part.kin)])
+        if self.books is not None:
+            self.books.restore({k[len("books."):]: v for k, v in scalars.items()
+                                if k.startswith("books.")}, groups.get("interaction_work", {}))

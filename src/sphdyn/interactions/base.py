@@ -12,8 +12,9 @@ couplings, prescribed motion, loads and damping. The :class:`~sphdyn.stepper.Ste
   mass-based penalty springs use); it also refreshes what it reports;
 * ``after_kick(dt_kick)``: bookkeeping over the kick (impulses);
 * ``external_work()``: the part of its forces' work over the last kick that
-  is external work (gravity), which the stepper books in ``W_external``
-  instead of with the interactions' (``E_contact``);
+  is external work (gravity; such an interaction says ``external = True``),
+  which the stepper books in ``W_external`` instead of with the
+  interactions' (``E_contact``);
 * ``constrain(t, dt)``: after the kick of the step [t, t + dt], the
   tied and hybrid couplings set their slaves' positions and velocities
   from their masters';
@@ -44,6 +45,11 @@ class Interaction(Protocol):
 
 class InteractionBase:
     """Defaults for the optional hooks: nothing to do, nothing to keep."""
+
+    #: True for loads whose work is external work (``external_work``); the
+    #: others' work is the interactions' (``E_contact``, and with ``[output]
+    #: interaction_work`` their own ``W_contact_<name>``)
+    external = False
 
     def stable_dt(self) -> float:
         return np.inf

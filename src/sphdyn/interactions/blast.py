@@ -228,6 +228,8 @@ class BlastLoad(InteractionBase):
     outside the fits' range of scaled distance.
     """
 
+    external = True  # its work is external work (W_external)
+
     def __init__(self, name: str, part, charge: float, point, *, burst: str = "free_air",
                  time: float = 0.0, idx=None, faces=None, elements=None,
                  turned_away: str = "incident"):

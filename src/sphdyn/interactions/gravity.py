@@ -60,6 +60,8 @@ class Gravity(InteractionBase):
     the work done so far [J] (J/m in 2D).
     """
 
+    external = True  # its work is external work (W_external)
+
     def __init__(self, part, g):
         self.part = part
         self.name = f"gravity_{part.name}"

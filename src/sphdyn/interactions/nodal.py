@@ -202,6 +202,8 @@ class NodalLoad(_SetInteraction):
     as external work (``W_external``), as gravity's.
     """
 
+    external = True  # its work is external work (W_external)
+
     def __init__(self, name: str, part, idx, force, ramp_time: float = 0.0,
                  shape: str = "linear"):
         super().__init__(name, part, idx)

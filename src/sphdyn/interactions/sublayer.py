@@ -120,7 +120,7 @@ def bar_directions(x, conn, offsets, slots, nodes, rows, hist, col):
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def gradient_without_set(rows, member, offsets, idx, fac, x, v, m, rho, dim, L, B):
+def gradient_without_set(rows, member, offsets, idx, fac, x, v, m, rho, dim, L, B, sums):
     r"""Corrected velocity gradient of the set's rows from the pairs with the
     particles outside the set only (the concrete around a bar's particle).
 
@@ -143,44 +143,27 @@ def gradient_without_set(rows, member, offsets, idx, fac, x, v, m, rho, dim, L, 
     ``rows`` (S,), ``member`` (N,) bool; ``fac`` (nnz,) the pair factors
     :math:`F_{ij}` [1/m^5 in 3D] before the set's pairs are zeroed; ``x``, ``v``
     (N, 3) [m, m/s]; ``m``, ``rho`` (N,); ``L``, ``B`` (N, 3, 3) rows
-    overwritten [1/s, 1].
+    overwritten [1/s, 1]; ``sums`` (S, 2, 3, 3) scratch.
     """
     for k in prange(rows.shape[0]):
         i = rows[k]
-        l00 = l01 = l02 = l10 = l11 = l12 = l20 = l21 = l22 = 0.0
-        m00 = m01 = m02 = m11 = m12 = m22 = 0.0
+        G, M = sums[k, 0], sums[k, 1]  # the velocity and moment sums (3, 3)
+        G[:] = 0.0
+        M[:] = 0.0
         irho = 1.0 / rho[i]
         for q in range(offsets[i], offsets[i + 1]):
             j = idx[q]
             if member[j] or fac[q] == 0.0:
                 continue
             f = np.float64(fac[q]) * (m[j] * irho)
-            d0 = x[i, 0] - x[j, 0]
-            d1 = x[i, 1] - x[j, 1]
-            d2 = x[i, 2] - x[j, 2]
-            u0 = v[j, 0] - v[i, 0]
-            u1 = v[j, 1] - v[i, 1]
-            u2 = v[j, 2] - v[i, 2]
-            g0 = f * d0
-            g1 = f * d1
-            g2 = f * d2
-            l00 += u0 * g0
-            l01 += u0 * g1
-            l02 += u0 * g2
-            l10 += u1 * g0
-            l11 += u1 * g1
-            l12 += u1 * g2
-            l20 += u2 * g0
-            l21 += u2 * g1
-            l22 += u2 * g2
-            m00 -= d0 * g0
-            m01 -= d0 * g1
-            m02 -= d0 * g2
-            m11 -= d1 * g1
-            m12 -= d1 * g2
-            m22 -= d2 * g2
-        finish_row(i, dim, True, l00, l01, l02, l10, l11, l12, l20, l21, l22,
-                   m00, m01, m02, m11, m12, m22, L, B)
+            for b in range(3):
+                g = f * (x[i, b] - x[j, b])
+                for a in range(3):
+                    G[a, b] += (v[j, a] - v[i, a]) * g
+                    M[a, b] += (x[j, a] - x[i, a]) * g
+        finish_row(i, dim, True, G[0, 0], G[0, 1], G[0, 2], G[1, 0], G[1, 1], G[1, 2],
+                   G[2, 0], G[2, 1], G[2, 2], M[0, 0], M[0, 1], M[0, 2], M[1, 1], M[1, 2],
+                   M[2, 2], L, B)
 
 
 class SublayerCoupling(InteractionBase):
@@ -213,6 +196,7 @@ class SublayerCoupling(InteractionBase):
         p.bc[rows] = BC_SLAVE
         self.force = np.zeros((rows.size, 3))
         self.L_own = np.zeros((rows.size, 3, 3))  # the bar's own pairs' share of L
+        self.sums = np.zeros((rows.size, 2, 3, 3))  # scratch of the corrected rows
         # a one-node "element" per particle: the shared slave kernels with N = 1
         self.master = np.ascontiguousarray(nodes[:, None])
         self.one = np.ones((rows.size, 1))
@@ -236,7 +220,7 @@ class SublayerCoupling(InteractionBase):
         sph, p = self.part, self.part.p
         if sph.s.correction:  # L and B of the concrete pairs alone
             gradient_without_set(self.rows, self.own, sph.nl.offsets, sph.nl.idx, sph.F, p.x,
-                                 p.v, p.m, p.rho, sph.dim, p.L, p.B)
+                                 p.v, p.m, p.rho, sph.dim, p.L, p.B, self.sums)
         else:
             set_pair_gradient(self.rows, self.own, sph.nl.offsets, sph.nl.idx, sph.F, p.x,
                               p.v, p.m, p.rho, p.B, p.B, False, self.L_own)

@@ -63,3 +63,10 @@ class Output(Section):
                           "wall impulse I_wall_<name>), which smooths the "
                           "spikes of first contact.")
     progress: StrictBool = Field(True, description="Show a progress bar.")
+    interaction_work: StrictBool = Field(
+        False, description="Book the work of each interaction (contact, coupling, "
+                           "wall, sublayer) apart, as history columns "
+                           "W_contact_<name> [J], and the events' changes of the "
+                           "loads (erosion) as W_contact_events; their sum is "
+                           "-E_contact (LS-DYNA's sleout). A diagnosis switch: it "
+                           "keeps one acceleration array per interaction and part.")
