@@ -80,3 +80,16 @@ def test_projectile_rebounds_from_the_block_keeping_the_momentum():
 def test_contact_with_a_second_coupling_of_the_particles_is_refused(contact, words):
     with pytest.raises(DeckError, match=words.replace("[", "\\[").replace("]", "\\]")):
         loads_deck(DECK.format(contact=contact, t_end="1 us", steel=STEEL))
+
+
+def test_the_springs_step_is_chosen_in_the_deck():
+    """``stiffness_step`` reaches the coupling (default "current"); a value
+    that is not one of the two is refused naming the key."""
+    for text, largest in (("[mesh.contact]", False),
+                          ('[mesh.contact]\nstiffness_step = "largest"', True)):
+        s = _stepper(contact=text)
+        cp = next(i for i in s.interactions if isinstance(i, PenaltyCoupling))
+        assert cp.largest_step is largest
+    with pytest.raises(DeckError, match="stiffness_step"):
+        loads_deck(DECK.format(contact='[mesh.contact]\nstiffness_step = "smallest"',
+                               t_end="1 us", steel=STEEL))

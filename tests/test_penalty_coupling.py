@@ -309,6 +309,56 @@ def test_particle_at_a_penetration_gets_the_paper_spring_split_by_the_shape_func
     assert cp.count == 0 and not sph.p.a_ext.any() and not solid.nodes.a_ext.any()
 
 
+@pytest.mark.parametrize("step", ["largest", "current"])
+def test_the_mass_spring_keeps_the_stiffness_of_the_largest_step(step):
+    """A particle pressed 0.2 mm into the top face of a block, then drawn back,
+    its penalty force taken at the mid-point of each move (for a linear spring
+    of fixed stiffness the mid-point rule gives its work exactly): loaded at
+    dt = 1e-7 s and unloaded at dt / 2. ``stiffness_step = "largest"``: the
+    force at the shorter step is still alpha m delta / dt^2 of the longer one
+    (1e-12), and the spring gives back what it took (net work 1e-9 of the
+    stored energy: round-off); ``"current"``: alpha m delta / (dt/2)^2, four
+    times, and the cycle makes 1.5 k delta^2 out of nothing (the stored
+    1/2 k delta^2 released as 1/2 4k delta^2), the error the 800 m/s
+    erosion run had as its step dropped (docs/theory.md)."""
+    dt, dx, alpha = 1e-7, 1e-3, 0.1
+    sph = sph_part(3, [0, 0, 0], [2 * dx, dx, dx], dx)
+    sph.p.x[1] = [1.0, 1.0, 0.0]  # out of reach
+    solid = concrete_block([0, 0, 0], [0.004, 0.004, 0.004], (2, 2, 2), 3)
+    solid.nodes.m[:] *= 1e6  # the face point heavier than the particle: k = alpha m / dt^2
+    top = np.array([0.0013, 0.0017, 0.004])  # on a top face, inside it
+    n = np.array([0.0, 0.0, 1.0])
+    cp = PenaltyCoupling("c", sph, solid, alpha=alpha, stiffness_step=step)
+    m, t_p, delta = sph.p.m[0], 0.5 * dx, 0.2e-3
+    k = alpha * m / dt ** 2
+
+    def force(d, rate, dt_now):
+        sph.p.x[0] = top + (t_p - d) * n
+        sph.p.v[0] = -rate * n
+        cp.update_geometry(0.0)
+        sph.p.a_ext[:] = 0.0
+        solid.nodes.a_ext[:] = 0.0
+        cp.forces(0.0, dt_now, sph.p.a_ext)
+        return m * sph.p.a_ext[0] @ n
+
+    steps = 20
+    dd = delta / steps
+    work = 0.0
+    for i in range(steps):  # loading at dt: the force opposes the motion
+        work -= force((i + 0.5) * dd, dd / dt, dt) * dd
+    assert force(delta, 0.0, dt) == pytest.approx(k * delta, rel=1e-12)
+    f_short = force(delta, 0.0, 0.5 * dt)
+    for i in range(steps):  # unloading at dt / 2
+        work += force(delta - (i + 0.5) * dd, -dd / (0.5 * dt), 0.5 * dt) * dd
+    stored = 0.5 * k * delta ** 2
+    if step == "largest":
+        assert f_short == pytest.approx(k * delta, rel=1e-12)
+        assert abs(work) < 1e-9 * stored
+    else:
+        assert f_short == pytest.approx(4.0 * k * delta, rel=1e-12)
+        assert work == pytest.approx(3.0 * stored, rel=1e-9)
+
+
 def test_edge_contact_and_a_subset_of_faces():
     # 2D, a 4 x 4 mm block of 2x2 quads, particles of dx = 1 mm (t_p = 0.5 mm),
     # eq. 8 with alpha 0.1, dt 1e-7 s; forces to 1e-12:

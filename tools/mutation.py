@@ -287,6 +287,11 @@ MUTANTS: tuple[Mutant, ...] = (
            ("tests/test_interaction_work.py::"
             "test_kick_work_is_the_mass_weighted_power_over_the_kick",),
            "a source's work over a kick without the kick's length"),
+    Mutant("penalty_largest_step", "issue 16.1", "sphdyn/interactions/penalty_coupling.py",
+           "dt_k = self._dt_k if self.largest_step else dt", "dt_k = dt",
+           ("tests/test_penalty_coupling.py::"
+            "test_the_mass_spring_keeps_the_stiffness_of_the_largest_step[largest]",),
+           "stiffness_step = largest: the springs take the current step after all"),
 )
 
 

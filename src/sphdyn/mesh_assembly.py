@@ -156,7 +156,8 @@ def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
             out.append(PenaltyCoupling(f"{mm.name}_contact", sph_part, part,
                                        stiffness=con.stiffness, alpha=con.alpha,
                                        thickness_factor=con.thickness_factor,
-                                       friction=con.friction))
+                                       friction=con.friction,
+                                       stiffness_step=con.stiffness_step))
         elif ero is not None and ero.to == "particles" and not (
                 mm.converted is not None and mm.converted.spec.coupling == "penalty"):
             # the debris meets the remaining elements by penalty ([mesh.contact]
@@ -165,7 +166,8 @@ def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
             out.append(PenaltyCoupling(f"{mm.name}_debris", sph_part, part,
                                        stiffness=ero.stiffness, alpha=ero.alpha,
                                        thickness_factor=ero.thickness_factor,
-                                       friction=ero.friction))
+                                       friction=ero.friction,
+                                       stiffness_step=ero.stiffness_step))
     for mm in model.meshes:  # last: they pass on what the bars' nodes were given
         if mm.spec.embed is None:
             continue
@@ -281,7 +283,8 @@ def _coupling(mm: MeshModel, sph_part, part, rows) -> list:
         coupling = PenaltyCoupling(name, sph_part, part, stiffness=conv.stiffness,
                                    alpha=conv.alpha, thickness_factor=conv.thickness_factor,
                                    friction=conv.friction,
-                                   tie_factor=conv.tie_factor or 0.0)
+                                   tie_factor=conv.tie_factor or 0.0,
+                                   stiffness_step=conv.stiffness_step)
         found = coupling.cand.size
     if found == 0:
         raise DeckError([format_problem(

@@ -53,6 +53,20 @@ shape functions at the contact point: linear momentum is conserved exactly
 \mathbf x_a = -N_a \hat{\mathbf e}`), so the interface stores its energy
 (``E_contact``) and gives it back.
 
+Stiffness and the time step. Eq. 8's :math:`\Delta t` is by default the
+step of the evaluation (``stiffness_step = "current"``); with ``"largest"``
+it is the largest stable step so far, :math:`\Delta t_k = \max_{n' \le
+n}\Delta t^{n'}`, so a spring's stiffness never grows while it is loaded.
+One whose stiffness grows gives back more than it took,
+:math:`\tfrac12 k_2\delta^2` against :math:`\tfrac12 k_1\delta^2` (four
+times as much at half the step). Where elements crush the step drops (to
+half and less in the penetration runs) and recovers when they erode. A
+spring at the largest step is stable at every shorter one
+(:math:`\omega\Delta t \le \sqrt{2\alpha}\,\Delta t/\Delta t_k`) and
+softer than eq. 8 at the current step by :math:`(\Delta t/\Delta t_k)^2`
+while the step is down. What each did in the 800 m/s erosion run is in
+docs/theory.md ("SPH-FEM coupling by penalty").
+
 Friction (optional, coefficient :math:`\mu`) acts on the relative tangential
 velocity :math:`\mathbf v_t` of the particle and the face point,
 :math:`\mathbf v_r = \mathbf v_p - \sum_a N_a \mathbf v_a`,
@@ -457,6 +471,10 @@ class PenaltyCoupling(InteractionBase):
     friction : Coulomb coefficient.
     skin_factor : Verlet skin of the candidate list in units of the largest
         contact thickness.
+    stiffness_step : ``"current"`` (default): the mass springs' step is the
+        step of each evaluation; ``"largest"``: the largest stable step so
+        far, so a spring never stiffens as the step drops (module docstring,
+        "Stiffness and the time step").
     tie_factor : 0 (default): contact only, the interface opens under
         tension. > 0: every particle whose closest point on a face lies inside
         the face and within ``tie_factor`` times its size :math:`V^{1/d}` at
@@ -477,7 +495,8 @@ class PenaltyCoupling(InteractionBase):
 
     def __init__(self, name: str, sph_part, solid_part, faces=None, stiffness: str = "mass",
                  alpha: float = 0.1, thickness_factor: float = 0.5, friction: float = 0.0,
-                 skin_factor: float = 1.0, tie_factor: float = 0.0):
+                 skin_factor: float = 1.0, tie_factor: float = 0.0,
+                 stiffness_step: str = "current"):
         if stiffness not in STIFFNESS:
             raise ValueError(f"{name}: stiffness must be one of {tuple(STIFFNESS)}, "
                              f"got {stiffness!r}")
@@ -486,6 +505,11 @@ class PenaltyCoupling(InteractionBase):
                              "and friction >= 0")
         if tie_factor < 0.0:
             raise ValueError(f"{name}: tie_factor must be >= 0")
+        if stiffness_step not in ("largest", "current"):
+            raise ValueError(f"{name}: stiffness_step must be 'largest' or 'current', "
+                             f"got {stiffness_step!r}")
+        self.largest_step = stiffness_step == "largest"
+        self._dt_k = 0.0  # the largest step so far [s] (the springs' step when largest)
         self.name = name
         self.part = sph_part
         self.solid = solid_part
@@ -511,7 +535,7 @@ class PenaltyCoupling(InteractionBase):
         self.n_builds = 0
         self.total_normal = 0.0
         self.total_tie = 0.0
-        self._dt_step = 0.0  # the step of the last force evaluation [s]
+        self._dt_step = 0.0  # the springs' step at the last force evaluation [s]
         self._allocate()
         self._tie(float(tie_factor))
         sph_part.p.on_grow(lambda n_old, n_new: self._allocate())
@@ -667,13 +691,15 @@ class PenaltyCoupling(InteractionBase):
         # the nodes' share goes to their a_ext, except when the caller asks
         # into a scratch array (the stepper's restore refreshes the columns)
         a_n = q.a_ext if a_out is p.a_ext else np.zeros_like(q.a_ext)
-        self._dt_step = dt
-        self._contact(dt, a_out, a_n, motion_dt=dt)
+        self._dt_k = max(self._dt_k, dt)
+        dt_k = self._dt_k if self.largest_step else dt  # the springs' step
+        self._dt_step = dt_k
+        self._contact(dt_k, a_out, a_n, motion_dt=dt)
         if self.tied.size:
             self.total_tie = float(tie_forces(
                 self.tied, self.tie_face, self.tie_xi, self.tie_eta, self.tie_offset, p.x,
                 p.m, p.vol0, p.rho0, p.bulk_modulus, p.dim, q.x, q.m, self.faces,
-                self.method, self.alpha, dt, a_out, a_n, self.tie_shares, self.tie_force))
+                self.method, self.alpha, dt_k, a_out, a_n, self.tie_shares, self.tie_force))
 
     def columns(self, t: float) -> dict[str, float]:
         out = {f"F_{self.name}": self.total_normal, f"contacts_{self.name}": float(self.count)}
@@ -683,7 +709,8 @@ class PenaltyCoupling(InteractionBase):
         return out
 
     def state(self) -> tuple[dict, dict[str, np.ndarray]]:
-        return {}, {"offsets": self.offsets, "cand": self.cand, "xp_ref": self.xp_ref,
+        return {"dt_k": self._dt_k}, {"offsets": self.offsets, "cand": self.cand,
+                                      "xp_ref": self.xp_ref,
                     "xn_ref": self.xn_ref, "pen0": self.pen0,
                     "last_face": self.last_face, "d_last": self.d_last,
                     "face_of": self.face_of}
@@ -691,6 +718,8 @@ class PenaltyCoupling(InteractionBase):
     def restore(self, scalars: dict, arrays: dict) -> None:
         if np.any(self.solid.el.active == 0):  # eroded before the checkpoint
             self._surface_changed()
+        # a checkpoint before 2026-11-27 (session 15): the step of the restart
+        self._dt_k = float(scalars.get("dt_k", 0.0))
         for name in ("pen0", "face_of", "last_face", "d_last"):
             if name in arrays:
                 setattr(self, name, arrays[name].copy())

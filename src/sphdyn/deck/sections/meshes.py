@@ -203,6 +203,15 @@ class PenaltyKeys(Section):
     thickness_factor: real("thickness factor", lo=0, lo_open=True) = Field(
         0.5, description="Penalty contact thickness in units of the particle size "
                          "V^(1/d).")
+    stiffness_step: Literal["current", "largest"] = Field(
+        "current", description="The step dt of the mass stiffness k = alpha m/dt^2: "
+                               "current: the step of each evaluation; largest: the "
+                               "largest stable step so far, so a spring never stiffens "
+                               "when the step drops (as elements crush: a spring loaded "
+                               "at one step and released at half of it gives back four "
+                               "times the energy it took). docs/theory.md, 'SPH-FEM "
+                               "coupling by penalty', has what each did in the 800 m/s "
+                               "penetration run.")
 
 
 class Contact(PenaltyKeys):
@@ -244,10 +253,10 @@ class Convert(PenaltyKeys):
     @model_validator(mode="after")
     def _coupling_keys(self):
         own = {"penalty": ("stiffness", "alpha", "friction", "thickness_factor",
-                           "tie_factor"),
+                           "stiffness_step", "tie_factor"),
                "tied": ("tie_factor",), "hybrid": (), "none": ()}[self.coupling]
         given = [k for k in ("stiffness", "alpha", "friction", "thickness_factor",
-                             "tie_factor")
+                             "stiffness_step", "tie_factor")
                  if k not in own and getattr(self, k) != type(self).model_fields[k].default]
         if given:
             raise problem(f"{', '.join(given)} do not belong to coupling = "
@@ -317,7 +326,7 @@ class MeshErosion(PenaltyKeys):
     def _coupling_keys(self):
         if self.to == "nothing":
             given = [k for k in ("particles_per_element", "stiffness", "alpha", "friction",
-                                 "thickness_factor")
+                                 "thickness_factor", "stiffness_step")
                      if getattr(self, k) != type(self).model_fields[k].default]
             if given:
                 raise problem(f"{', '.join(given)} mean nothing with to = \"nothing\"",
