@@ -7,7 +7,7 @@ the same wall on the particles, the penalty coupling, gravity), the sources'
 columns add up to ``-E_contact`` to round-off, the erosion's change of the
 loads is a source of its own, gravity (external work) is not among them, and
 the books change nothing of the motion; a run restarted from a checkpoint
-books the same bits.
+books the same bits; two interactions with one name are refused.
 """
 
 from __future__ import annotations
@@ -88,3 +88,14 @@ def test_a_restored_run_books_the_same_bits():
     with pytest.raises(ValueError, match="interaction_work"):
         st3, _ = _impact("particles", interaction_work=True)
         st3.restore(*copy.deepcopy(plain.state()))
+
+
+def test_two_interactions_with_one_name_are_refused():
+    """Their checkpoint groups (``interaction.<name>``) and columns would collide."""
+    from sphdyn.interactions import Wall
+
+    def second_floor(solid):
+        return Wall(_impact("nothing")[0].interactions[0].spec, solid)  # named "floor"
+
+    with pytest.raises(ValueError, match="two interactions are named 'floor'"):
+        _impact("nothing", others=(second_floor,))

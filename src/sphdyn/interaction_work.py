@@ -69,9 +69,8 @@ class InteractionWork:
         self._tables = [(f"{part.name}.{j}", part, j) for part in parts
                         for j in range(len(dofs(part)))]
         self._dofs = dofs
+        # (names unique: the stepper checks)
         self.sources = [i.name for i in interactions if not getattr(i, "external", False)]
-        if len(set(self.sources)) != len(self.sources):
-            raise ValueError(f"interaction names are not unique: {self.sources}")
         if events:
             self.sources.append(self.EVENTS)
         self.work = {s: 0.0 for s in self.sources}  # [J]

@@ -69,6 +69,12 @@ class Stepper:
         self.parts = list(parts)
         self.interactions = list(interactions)
         self.events = list(events)
+        for kind, items in (("part", self.parts), ("interaction", self.interactions),
+                            ("event", self.events)):
+            names = [item.name for item in items]
+            twice = sorted({n for n in names if names.count(n) > 1})
+            if twice:  # their checkpoint groups and history columns would collide
+                raise ValueError(f"two {kind}s are named {twice[0]!r}: give each its own name")
         self.monitors = list(monitors)
         self.dt_max = dt_max
         self.t = 0.0
