@@ -388,6 +388,13 @@ def test_conversion_region_without_elements_is_refused(tmp_path, capsys):
          ["no element centroid"], capsys)
 
 
+def test_an_unstable_hourglass_coefficient_is_refused(tmp_path, capsys):
+    """Past 0.15 (the viscous form amplifies a cube's hourglass mode from 0.24:
+    test_fem_solid.py) the deck names the field and its range."""
+    _bad(tmp_path, _bar_text(source=BLOCK + "\nhourglass_coefficient = 0.3"),
+         "mesh[0].hourglass_coefficient", ["0.15", "mesh 'bar'"], capsys)
+
+
 def test_rotations_on_solid_nodes_are_refused(tmp_path, capsys):
     text = _bar_text().replace('type = "fixed"\n', 'type = "fixed"\nrotations = "fixed"\n', 1)
     _bad(tmp_path, text, "boundary[0].rotations", ["no rotational"], capsys)

@@ -368,8 +368,11 @@ class Mesh(Section):
     hourglass: Literal["viscous", "stiffness"] = Field(
         "viscous", description="Flanagan-Belytschko hourglass control form "
                                "(one_point).")
-    hourglass_coefficient: real("hourglass coefficient", lo=0, hi=0.5) = Field(
-        0.1, description="Hourglass coefficient Q_hg (LS-DYNA QH; 0 = off).")
+    hourglass_coefficient: real("hourglass coefficient", lo=0, hi=0.15) = Field(
+        0.1, description="Hourglass coefficient Q_hg (LS-DYNA QH; 0 = off). At most "
+                         "0.15: the viscous form's explicit update amplifies the "
+                         "hourglass mode of a cube past Q_hg = 0.24 at cfl 0.9 "
+                         "(docs/theory.md).")
     q1: real("quadratic bulk viscosity", lo=0) = Field(
         1.5, description="Quadratic bulk-viscosity coefficient.")
     q2: real("linear bulk viscosity", lo=0) = Field(
