@@ -120,6 +120,16 @@ def test_nodes_and_particles_carry_the_bar_mass_from_a_deck():
     assert "bar_sublayer" in [i.name for i in st.interactions]
 
 
+def block_and_bar(correction: bool):
+    """The pull-out block with its bar at rest (no sets), with or without
+    ``[sph] correction``: the stepper, the bar part and the SPH part."""
+    text = deck_text(sets="")
+    if correction:
+        text = text.replace("[output]", "[sph]\ncorrection = true\n[output]")
+    st = build_stepper(loads_deck(text))
+    return st, st.part("bar"), st.part("sph")
+
+
 @pytest.mark.parametrize("correction", [False, True])
 def test_the_bars_own_pairs_are_out_of_its_velocity_gradient(correction):
     """The block at rest, the bar's nodes moving: a bar particle's L comes
@@ -127,11 +137,7 @@ def test_the_bars_own_pairs_are_out_of_its_velocity_gradient(correction):
     not change it (to round-off), while its own velocity does; with and
     without the kernel correction (two code paths: the own pairs' share
     subtracted, or both sums of the corrected row taken without them)."""
-    text = deck_text(sets="")
-    if correction:
-        text = text.replace("[output]", "[sph]\ncorrection = true\n[output]")
-    st = build_stepper(loads_deck(text))
-    bar, sph = st.part("bar"), st.part("sph")
+    st, bar, sph = block_and_bar(correction)
     p = sph.p
     rows = np.flatnonzero(p.body == 1)
     k = rows[0]  # near the block's face: an uneven neighbourhood (L of a rigid
@@ -174,11 +180,7 @@ def test_corrected_concrete_is_exact_around_a_bonded_bar_in_affine_motion():
     g = np.array([[1.0, 0.3, 0.0], [0.2, -0.5, 0.1], [0.0, 0.4, 0.7]])  # dv/dx [1/s]
     errors = {}
     for corr in (True, False):
-        text = deck_text(sets="")
-        if corr:
-            text = text.replace("[output]", "[sph]\ncorrection = true\n[output]")
-        st = build_stepper(loads_deck(text))
-        bar, sph = st.part("bar"), st.part("sph")
+        st, bar, sph = block_and_bar(corr)
         p = sph.p
         bar.kin.v[:] = bar.kin.x @ g.T
         p.v[:] = p.x @ g.T

@@ -58,7 +58,8 @@ class InteractionWork:
     and, with ``events``, one for the events' changes (module docstring).
 
     ``dofs(part)`` gives a part's kinematics tables (the stepper's
-    :func:`sphdyn.stepper.dofs`). The stepper calls :meth:`before` and
+    :func:`sphdyn.stepper.dofs`; they live as long as the part, growing in
+    place). The stepper calls :meth:`before` and
     :meth:`after` around each source's change of ``a_ext``, :meth:`clear_events`
     before the interactions' forces and :meth:`book` after each kick.
     """
@@ -66,9 +67,8 @@ class InteractionWork:
     EVENTS = "events"
 
     def __init__(self, parts, interactions, events, dofs):
-        self._tables = [(f"{part.name}.{j}", part, j) for part in parts
-                        for j in range(len(dofs(part)))]
-        self._dofs = dofs
+        self._tables = [(f"{part.name}.{j}", q) for part in parts
+                        for j, q in enumerate(dofs(part))]
         # (names unique: the stepper checks)
         self.sources = [i.name for i in interactions if not getattr(i, "external", False)]
         if events:
@@ -82,9 +82,6 @@ class InteractionWork:
     def tracks(self, source: str) -> bool:
         return source in self.work
 
-    def _table(self, part, j):
-        return self._dofs(part)[j]
-
     @staticmethod
     def _room(store: dict, key, n: int) -> np.ndarray:
         """A (n, 3) view of ``store[key]``, grown (by 10 %) when too small."""
@@ -95,8 +92,7 @@ class InteractionWork:
 
     def before(self) -> None:
         """Keep every part's ``a_ext`` as it is before a source changes it."""
-        for key, part, j in self._tables:
-            q = self._table(part, j)
+        for key, q in self._tables:
             snap = self._room(self._snap, key, q.n)
             snap[:] = q.a_ext
             self._snap_n[key] = q.n
@@ -104,8 +100,7 @@ class InteractionWork:
     def after(self, source: str) -> None:
         """The source's accelerations: ``a_ext`` now minus before (rows added
         since, by an event, wholly the source's)."""
-        for key, part, j in self._tables:
-            q = self._table(part, j)
+        for key, q in self._tables:
             n0 = self._snap_n[key]
             acc = self._room(self._store, (source, key), q.n)
             np.subtract(q.a_ext[:n0], self._snap[key][:n0], out=acc[:n0])
@@ -115,19 +110,17 @@ class InteractionWork:
     def clear_events(self) -> None:
         """No event change yet this step."""
         if self.EVENTS in self.work:
-            for key, _, _ in self._tables:
+            for key, _ in self._tables:
                 self._acc.pop((self.EVENTS, key), None)
 
     def book(self, dt_kick: float) -> None:
         """Add each source's work over the kick just taken (``v_mid`` set)."""
         for source in self.sources:
             w = 0.0
-            for key, part, j in self._tables:
+            for key, q in self._tables:
                 acc = self._acc.get((source, key))
-                if acc is None:
-                    continue
-                q = self._table(part, j)
-                w += kick_work(acc, q.m, q.bc, q.v_mid, dt_kick)
+                if acc is not None:
+                    w += kick_work(acc, q.m, q.bc, q.v_mid, dt_kick)
             self.work[source] += w
 
     def columns(self) -> dict[str, float]:
@@ -138,8 +131,8 @@ class InteractionWork:
     def state(self) -> tuple[dict, dict[str, np.ndarray]]:
         scalars = {f"work_{k}": s for k, s in enumerate(self.sources)}
         scalars.update({f"value_{k}": self.work[s] for k, s in enumerate(self.sources)})
-        arrays = {f"{k}_{key}": acc for (s, key), acc in self._acc.items()
-                  for k in [self.sources.index(s)]}
+        index = {s: k for k, s in enumerate(self.sources)}
+        arrays = {f"{index[s]}_{key}": acc for (s, key), acc in self._acc.items()}
         return scalars, arrays
 
     def restore(self, scalars: dict, arrays: dict) -> None:

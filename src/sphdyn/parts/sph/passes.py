@@ -144,12 +144,12 @@ def _gradient_row(i, x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sca
                 m22 -= d2 * g2
     count[i] = head - offsets[i]
     finish_row(i, dim, correct, l00, l01, l02, l10, l11, l12, l20, l21, l22,
-                m00, m01, m02, m11, m12, m22, L, B)
+               m00, m01, m02, m11, m12, m22, L, B)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
 def finish_row(i, dim, correct, l00, l01, l02, l10, l11, l12, l20, l21, l22,
-                m00, m01, m02, m11, m12, m22, L, B):
+               m00, m01, m02, m11, m12, m22, L, B):
     """Row ``i``'s ``L`` and ``B`` from its sums (:func:`velocity_gradient`):
     the correction ``Q = M^-1`` of the moment matrix ``M`` (upper triangle
     ``m..``) when ``correct``, and ``L = L_raw Q``, ``B = Q``."""
@@ -302,7 +302,7 @@ def _buffered_row(i, x, v, h, m, rho, offsets, idx, sigma, support_scale, correc
             m12 -= W[_D1, t] * g2
             m22 -= W[_D2, t] * g2
     finish_row(i, 3, correct, l00, l01, l02, l10, l11, l12, l20, l21, l22,
-                m00, m01, m02, m11, m12, m22, L, B)
+               m00, m01, m02, m11, m12, m22, L, B)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
