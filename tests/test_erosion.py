@@ -573,6 +573,32 @@ def test_an_old_checkpoints_born_particles_keep_their_allowance():
     assert np.all(cp3.last_face == -1)
 
 
+def test_a_restore_leaves_the_springs_state_as_the_checkpoint_has_it():
+    """A particle born inside a face's contact thickness (last face unknown,
+    -2; its depth -inf: all of its penetration is to be allowed at its first
+    evaluation) is checkpointed so. The stepper's restore evaluates the
+    interactions once for their columns; that evaluation must not take the
+    allowance at the checkpoint's positions, or the restarted run's next
+    step allows the depth of another position (the 800 m/s penetration's
+    restart differed in its first step: 1914 contacts against 1889). The
+    coupling's arrays after the restore are the checkpoint's, bit for bit,
+    and its columns those of an evaluation."""
+    def model():
+        solid, sph, cp, _ = _warped_column(others=[[0.005, 0.005, -WARP_T + 3e-4]])
+        return Stepper([solid, sph], [cp]), cp
+
+    st, cp = model()
+    cp.last_face[1], cp.d_last[1] = -2, -np.inf
+    cp.update_geometry(0.0)
+    scalars, groups = copy.deepcopy(st.state())
+    st2, cp2 = model()
+    st2.restore(scalars, groups)
+    for name in ("pen0", "last_face", "d_last", "k_last"):
+        assert np.array_equal(getattr(cp2, name), groups["interaction.c"][name]), name
+    assert cp2.last_face[1] == -2 and cp2.pen0[1] == 0.0
+    assert cp2.count == 1  # the pressing particle's spring, counted for the columns
+
+
 def test_a_spring_keeps_its_extension_when_its_face_erodes():
     """A crushed, warped element lies on a 10 mm cube: its top face falls from
     10.5 mm (x = 0) to 9.8 mm (x = 10 mm), below the cube's top at its right

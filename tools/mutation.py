@@ -292,6 +292,23 @@ MUTANTS: tuple[Mutant, ...] = (
            ("tests/test_penalty_coupling.py::"
             "test_the_mass_spring_keeps_the_stiffness_of_the_largest_step[largest]",),
            "stiffness_step = largest: the springs take the current step after all"),
+    Mutant("penalty_spring_energy", "issue 16.1", "sphdyn/interactions/penalty_coupling.py",
+           "ext = min(ext * np.sqrt(k_last[i] / kk), pen)", "ext = min(ext, pen)",
+           ("tests/test_penalty_coupling.py::"
+            "test_a_spring_slid_to_a_heavier_point_of_its_face_keeps_its_energy",),
+           "a spring's stiffness change keeps its extension, not its energy"),
+    Mutant("penalty_behind_edge", "issue 16.1", "sphdyn/interactions/penalty_coupling.py",
+           "            k_last[i] = 0.0\n            continue\n        pen = max(-gap, 0.0)",
+           "            gap = 0.0\n        pen = max(-gap, 0.0)",
+           ("tests/test_penalty_coupling.py::"
+            "test_a_particle_behind_a_faces_edge_keeps_its_allowance",),
+           "a particle behind a face's edge loses its allowance"),
+    Mutant("restore_refresh_state", "issue 16.1", "sphdyn/stepper.py",
+           '            inter.restore(*_own_state(scalars, groups, f"interaction.{inter.name}"))\n',
+           "",
+           ("tests/test_erosion.py::"
+            "test_a_restore_leaves_the_springs_state_as_the_checkpoint_has_it",),
+           "the restore's evaluation for the columns keeps what it did to the springs"),
 )
 
 

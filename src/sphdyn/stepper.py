@@ -39,6 +39,14 @@ def _add(total, value):
     return value if total is None else total + value
 
 
+def _own_state(scalars: dict, groups: dict, key: str) -> tuple[dict, dict]:
+    """The scalars (prefix ``key.`` taken off) and the array group ``key`` of one
+    part or interaction in a checkpoint (:meth:`Stepper.state`)."""
+    pre = key + "."
+    return ({k[len(pre):]: v for k, v in scalars.items() if k.startswith(pre)},
+            groups.get(key, {}))
+
+
 def dofs(part) -> list:
     r"""The kinematics tables the stepper kicks for ``part``: its translations
     ``kin`` and, for parts with rotational degrees of freedom (beams), the
@@ -317,17 +325,19 @@ class Stepper:
         self.work_external = float(scalars["work_external"])
         for kind, items in (("part", self.parts), ("interaction", self.interactions)):
             for item in items:
-                pre = f"{kind}.{item.name}."
-                item.restore({k[len(pre):]: v for k, v in scalars.items()
-                              if k.startswith(pre)}, groups.get(f"{kind}.{item.name}", {}))
+                item.restore(*_own_state(scalars, groups, f"{kind}.{item.name}"))
         for ev in self.events:
             pre = f"event.{ev.name}."
             ev.restore({k[len(pre):]: v for k, v in scalars.items() if k.startswith(pre)})
-        # what interactions report (counts, totals) depends on x, v and dt only;
-        # the accelerations themselves are in the checkpoint
+        # what interactions report (counts, totals) is evaluated again into
+        # scratch arrays (the accelerations themselves are in the checkpoint);
+        # an evaluation may also move an interaction's own state (a penalty
+        # spring's allowance, a contact's), which the checkpoint holds as the
+        # run had it, so that state is put back after it
         scratch = {id(p.kin): np.zeros_like(p.kin.a_ext) for p in self.parts}
         for inter in self.interactions:
             inter.forces(self.t, self.dt_contact_step, scratch[id(inter.part.kin)])
+            inter.restore(*_own_state(scalars, groups, f"interaction.{inter.name}"))
         if self.books is not None:
             self.books.restore({k[len("books."):]: v for k, v in scalars.items()
                                 if k.startswith("books.")}, groups.get("interaction_work", {}))

@@ -21,7 +21,9 @@ thickness :math:`t_p = f_t V_p^{1/d}` (as at the rigid wall,
 * :math:`g = |\mathbf r| - t_p`, :math:`\hat{\mathbf e} = \mathbf r/|\mathbf r|`,
   when it is on the face's boundary and the particle is in front of the
   face's plane (the particle's sphere touches an edge or a corner: continuous
-  with the first case); no contact when it is on the boundary and behind.
+  with the first case); no contact when it is on the boundary and behind
+  (a particle inside the body beside a crater's edge, say: its depth is not
+  measured there, so its allowance, below, stays as it was).
 
 If :math:`g < 0` the penetration :math:`\delta = -g` gives the particle the
 normal force of the wall's spring, :func:`~.wall_contact.spring_acceleration`
@@ -57,15 +59,31 @@ Stiffness and the time step. Eq. 8's :math:`\Delta t` is by default the
 step of the evaluation (``stiffness_step = "current"``); with ``"largest"``
 it is the largest stable step so far, :math:`\Delta t_k = \max_{n' \le
 n}\Delta t^{n'}`, so a spring's stiffness never grows while it is loaded.
-One whose stiffness grows gives back more than it took,
-:math:`\tfrac12 k_2\delta^2` against :math:`\tfrac12 k_1\delta^2` (four
-times as much at half the step). Where elements crush the step drops (to
-half and less in the penetration runs) and recovers when they erode. A
-spring at the largest step is stable at every shorter one
-(:math:`\omega\Delta t \le \sqrt{2\alpha}\,\Delta t/\Delta t_k`) and
-softer than eq. 8 at the current step by :math:`(\Delta t/\Delta t_k)^2`
-while the step is down. What each did in the 800 m/s erosion run is in
-docs/theory.md ("SPH-FEM coupling by penalty").
+Where elements crush the step drops (to half and less in the penetration
+runs) and recovers when they erode. A spring at the largest step is stable
+at every shorter one (:math:`\omega\Delta t \le \sqrt{2\alpha}\,\Delta
+t/\Delta t_k`) and softer than eq. 8 at the current step by
+:math:`(\Delta t/\Delta t_k)^2` while the step is down. What each did in
+the 800 m/s erosion run is in docs/theory.md ("SPH-FEM coupling by
+penalty").
+
+A spring's stiffness changes. :math:`k` of one particle's spring changes
+while it is loaded: with the step (``"current"``), with the mass the face
+point opposes (:math:`1/m_f = \sum_a N_a^2/m_a` varies fourfold across a
+face as the contact point slides, and drops as erosion takes the nodes'
+element shares), and at a switch of face. Applied as it is, a spring whose
+:math:`k` grows from :math:`k_1` to :math:`k_2` gives back :math:`\tfrac12
+k_2 e^2` of the :math:`\tfrac12 k_1 e^2` it took (:math:`e = \delta -
+\delta_0`, its extension): energy from nothing, four times the stored
+energy at half the step. So at each evaluation the extension is scaled to
+keep the spring's energy, :math:`e \leftarrow e\sqrt{k_1/k_2}` (the
+allowance :math:`\delta_0` takes the difference, at least 0), and the
+force is :math:`k_2 e`: a stiffer spring pushes harder by
+:math:`\sqrt{k_2/k_1}` but stores no more energy; a softer one takes its
+extension back from the allowance while there is one (else the difference
+is lost, never made). The spring's force
+remains the gradient of :math:`\tfrac12 k e^2` at fixed :math:`k`, so a
+load-unload cycle at changing :math:`k` does no net work.
 
 Friction (optional, coefficient :math:`\mu`) acts on the relative tangential
 velocity :math:`\mathbf v_t` of the particle and the face point,
@@ -171,7 +189,7 @@ def spring_mass(m_p, inv_f):
 def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, faces,
                             offsets, cand, thickness_factor, method, alpha, friction, dt,
                             a_p, a_n, face_of, shares, force, normal_force, accel, skip,
-                            pen0, last_face, d_last, motion_dt):
+                            pen0, last_face, d_last, k_last, motion_dt):
     r"""Particle-face penalty forces (module docstring) into the particles' and nodes' ``a``.
 
     Parameters
@@ -208,6 +226,12 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
         for a particle that faced none: its whole penetration is allowed). At a switch of face the spring's extension grows
         by at most the approach the motion allows, :math:`|\mathbf v_r|`
         ``motion_dt``; the allowance takes the excess (module docstring).
+    k_last : (N,) in/out, each particle's spring stiffness :math:`k = F_n /
+        (\delta - \delta_0)` [N/m] at the last evaluation (0: not loaded).
+        When it changes under load (the face point's mass, the step, a new
+        face) the extension is scaled so that the spring's energy
+        :math:`\tfrac12 k(\delta - \delta_0)^2` stays what it was
+        (module docstring, "A spring's stiffness changes").
     motion_dt : time [s] the particles moved since the last evaluation (the
         step; 0 when the faces changed under unmoved particles).
 
@@ -250,6 +274,7 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
         if bf < 0:
             pen0[i] = 0.0
             last_face[i] = -1
+            k_last[i] = 0.0
             continue
         r0 = xp[i, 0] - cx
         r1 = xp[i, 1] - cy
@@ -267,8 +292,10 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
             dist = np.sqrt(r0 * r0 + r1 * r1 + r2 * r2)
             gap = dist - tp
             e0, e1, e2 = r0 / dist, r1 / dist, r2 / dist
-        else:
-            gap = 0.0  # behind the plane of a face's boundary: no contact
+        else:  # behind the plane of a face's boundary: no contact and no depth to
+            # measure, so the allowance and the last face's depth are kept
+            k_last[i] = 0.0
+            continue
         pen = max(-gap, 0.0)
         N = face_shapes(xi, eta, nf)
         if last_face[i] != -1 and bf != last_face[i]:  # a switch of face
@@ -280,12 +307,14 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
             pen0[i] = pen
         last_face[i] = bf
         d_last[i] = -gap
-        if pen - pen0[i] <= 0.0:
+        ext = pen - pen0[i]
+        if ext <= 0.0:
+            k_last[i] = 0.0
             continue
         count += 1
-        an = spring_acceleration(pen - pen0[i], method, alpha, dt, kbulk[i], vol0[i],
-                                 rho0[i], dim)
+        an = spring_acceleration(ext, method, alpha, dt, kbulk[i], vol0[i], rho0[i], dim)
         if mp[i] <= 0.0:  # pushed out, no force of its own
+            k_last[i] = 0.0
             accel[i, 0] = an * e0
             accel[i, 1] = an * e1
             accel[i, 2] = an * e2
@@ -295,6 +324,12 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
             continue
         inv_f = face_inverse_mass(mn, faces[bf], N)
         fn = an * (spring_mass(mp[i], inv_f) if method == STIFFNESS_MASS else mp[i])
+        kk = fn / ext
+        if k_last[i] > 0.0 and kk != k_last[i]:  # its energy kept (k_last above)
+            ext = min(ext * np.sqrt(k_last[i] / kk), pen)
+            pen0[i] = pen - ext
+            fn = kk * ext
+        k_last[i] = kk
         f0 = fn * e0
         f1 = fn * e1
         f2 = fn * e2
@@ -531,6 +566,7 @@ class PenaltyCoupling(InteractionBase):
         self.pen0 = np.zeros(sph_part.p.n)
         self.last_face = np.full(sph_part.p.n, -1, dtype=np.int64)
         self.d_last = np.zeros(sph_part.p.n)
+        self.k_last = np.zeros(sph_part.p.n)  # each spring's stiffness [N/m] (the kernel's)
         self.count = 0
         self.n_builds = 0
         self.total_normal = 0.0
@@ -553,6 +589,7 @@ class PenaltyCoupling(InteractionBase):
             # born: faced nothing known, so their whole penetration is allowed
             self.last_face = np.concatenate([self.last_face, np.full(n - old, -2, np.int64)])
             self.d_last = np.concatenate([self.d_last, np.full(n - old, -np.inf)])
+            self.k_last = np.concatenate([self.k_last, np.zeros(n - old)])
         self.face_of = np.full(n, -1, dtype=np.int64)
         self.shares = np.zeros((n, 4, 3))
         self.force = np.zeros((n, 3))
@@ -672,7 +709,7 @@ class PenaltyCoupling(InteractionBase):
             self.offsets, self.cand, self.thickness_factor, self.method, self.alpha,
             self.friction, dt, a_p, a_n, self.face_of, self.shares, self.force,
             self.normal_force, self.accel, self.skip, self.pen0, self.last_face, self.d_last,
-            motion_dt))
+            self.k_last, motion_dt))
         self.total_normal = float(self.normal_force.sum())
 
     # ----------------------------------------------------------- protocol
@@ -713,14 +750,14 @@ class PenaltyCoupling(InteractionBase):
                                       "xp_ref": self.xp_ref,
                     "xn_ref": self.xn_ref, "pen0": self.pen0,
                     "last_face": self.last_face, "d_last": self.d_last,
-                    "face_of": self.face_of}
+                    "k_last": self.k_last, "face_of": self.face_of}
 
     def restore(self, scalars: dict, arrays: dict) -> None:
         if np.any(self.solid.el.active == 0):  # eroded before the checkpoint
             self._surface_changed()
         # a checkpoint before 2026-11-27 (session 15): the step of the restart
         self._dt_k = float(scalars.get("dt_k", 0.0))
-        for name in ("pen0", "face_of", "last_face", "d_last"):
+        for name in ("pen0", "face_of", "last_face", "d_last", "k_last"):
             if name in arrays:
                 setattr(self, name, arrays[name].copy())
         if "fresh" in arrays and "last_face" not in arrays:  # a checkpoint before 2026-11-27

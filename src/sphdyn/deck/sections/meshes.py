@@ -205,13 +205,12 @@ class PenaltyKeys(Section):
                          "V^(1/d).")
     stiffness_step: Literal["current", "largest"] = Field(
         "current", description="The step dt of the mass stiffness k = alpha m/dt^2: "
-                               "current: the step of each evaluation; largest: the "
-                               "largest stable step so far, so a spring never stiffens "
-                               "when the step drops (as elements crush: a spring loaded "
-                               "at one step and released at half of it gives back four "
-                               "times the energy it took). docs/theory.md, 'SPH-FEM "
-                               "coupling by penalty', has what each did in the 800 m/s "
-                               "penetration run.")
+                               "current: the step of each evaluation (a spring that "
+                               "stiffens as the step drops pushes harder but keeps its "
+                               "energy); largest: the largest stable step so far, so a "
+                               "spring never stiffens when the step drops (as elements "
+                               "crush). docs/theory.md, 'SPH-FEM coupling by penalty', "
+                               "has what each did in the 800 m/s penetration run.")
 
 
 class Contact(PenaltyKeys):
