@@ -327,8 +327,7 @@ class Stepper:
             for item in items:
                 item.restore(*_own_state(scalars, groups, f"{kind}.{item.name}"))
         for ev in self.events:
-            pre = f"event.{ev.name}."
-            ev.restore({k[len(pre):]: v for k, v in scalars.items() if k.startswith(pre)})
+            ev.restore(_own_state(scalars, groups, f"event.{ev.name}")[0])
         # what interactions report (counts, totals) is evaluated again into
         # scratch arrays (the accelerations themselves are in the checkpoint);
         # an evaluation may also move an interaction's own state (a penalty

@@ -226,8 +226,9 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
         for a particle that faced none: its whole penetration is allowed). At a switch of face the spring's extension grows
         by at most the approach the motion allows, :math:`|\mathbf v_r|`
         ``motion_dt``; the allowance takes the excess (module docstring).
-    k_last : (N,) in/out, each particle's spring stiffness :math:`k = F_n /
-        (\delta - \delta_0)` [N/m] at the last evaluation (0: not loaded).
+    k_last : (N,) in/out, each particle's spring stiffness :math:`k` [N/m]
+        (:math:`F_n = k(\delta - \delta_0)`) at the last evaluation (0: not
+        loaded).
         When it changes under load (the face point's mass, the step, a new
         face) the extension is scaled so that the spring's energy
         :math:`\tfrac12 k(\delta - \delta_0)^2` stays what it was
@@ -312,9 +313,11 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
             k_last[i] = 0.0
             continue
         count += 1
-        an = spring_acceleration(ext, method, alpha, dt, kbulk[i], vol0[i], rho0[i], dim)
+        # the spring's acceleration per metre of extension [1/s^2]
+        a1 = spring_acceleration(1.0, method, alpha, dt, kbulk[i], vol0[i], rho0[i], dim)
         if mp[i] <= 0.0:  # pushed out, no force of its own
             k_last[i] = 0.0
+            an = a1 * ext
             accel[i, 0] = an * e0
             accel[i, 1] = an * e1
             accel[i, 2] = an * e2
@@ -323,13 +326,12 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
             a_p[i, 2] += accel[i, 2]
             continue
         inv_f = face_inverse_mass(mn, faces[bf], N)
-        fn = an * (spring_mass(mp[i], inv_f) if method == STIFFNESS_MASS else mp[i])
-        kk = fn / ext
+        kk = a1 * (spring_mass(mp[i], inv_f) if method == STIFFNESS_MASS else mp[i])
         if k_last[i] > 0.0 and kk != k_last[i]:  # its energy kept (k_last above)
             ext = min(ext * np.sqrt(k_last[i] / kk), pen)
             pen0[i] = pen - ext
-            fn = kk * ext
         k_last[i] = kk
+        fn = kk * ext
         f0 = fn * e0
         f1 = fn * e1
         f2 = fn * e2
