@@ -309,9 +309,10 @@ def test_particle_at_a_penetration_gets_the_paper_spring_split_by_the_shape_func
     assert cp.count == 0 and not sph.p.a_ext.any() and not solid.nodes.a_ext.any()
 
 
-def _pressed_particle(step="current", node_scale=1e6):
+def _pressed_particle(step="current", node_scale=1e6, faces=None):
     """One particle of dx = 1 mm over the top face of a 4 mm block of 2 mm hexes
-    (its nodes' masses times ``node_scale``), a coupling (alpha 0.1) and
+    (its nodes' masses times ``node_scale``), a coupling (alpha 0.1; master
+    surface ``faces``, default all exterior faces) and
     ``force(point, d, rate, dt)``: the particle's normal force [N] with its
     contact point at ``point`` (on the top face, z = 4 mm), pressed ``d`` into
     it and approaching at ``rate``."""
@@ -321,7 +322,7 @@ def _pressed_particle(step="current", node_scale=1e6):
     solid = concrete_block([0, 0, 0], [0.004, 0.004, 0.004], (2, 2, 2), 3)
     solid.nodes.m[:] *= node_scale
     n = np.array([0.0, 0.0, 1.0])
-    cp = PenaltyCoupling("c", sph, solid, alpha=alpha, stiffness_step=step)
+    cp = PenaltyCoupling("c", sph, solid, faces=faces, alpha=alpha, stiffness_step=step)
     t_p = 0.5 * dx
 
     def force(point, d, rate, dt_now):
@@ -336,7 +337,7 @@ def _pressed_particle(step="current", node_scale=1e6):
     return sph, solid, cp, alpha, force
 
 
-def _cycle_work(force, delta, load, unload, steps=20):
+def _cycle_work(delta, load, unload, steps=20):
     """Work [J] of the normal force on the particle pressed ``delta`` in and drawn
     back, ``steps`` moves each way, the force at each move's mid-point (exact for
     a linear spring of fixed stiffness); ``load(d, rate)`` and ``unload(d, rate)``
@@ -378,7 +379,7 @@ def test_the_mass_spring_keeps_the_stiffness_of_the_largest_step(step):
     def load(d, dd):
         return force(top, d, dd / dt, dt)
 
-    work = _cycle_work(force, delta, load, unload)
+    work = _cycle_work(delta, load, unload)
     assert f_short[0] == pytest.approx((1.0 if step == "largest" else 2.0) * k * delta,
                                        rel=1e-12)
     assert abs(work) < 1e-9 * 0.5 * k * delta ** 2
@@ -433,7 +434,7 @@ def test_a_spring_slid_to_a_heavier_point_of_its_face_keeps_its_energy():
 
     # the unloading's kink (where the spring goes slack, between two mid-points)
     # is the mid-point rule's one error: 5e-4 of the stored energy at 20 moves
-    work = _cycle_work(force, delta, load, unload)
+    work = _cycle_work(delta, load, unload)
     assert abs(work) < 1e-3 * 0.5 * k_c * delta ** 2
 
 
@@ -450,27 +451,49 @@ def test_a_particle_behind_a_faces_edge_keeps_its_allowance():
     2 mm deep that way and took 288 J (docs/theory.md)."""
     from sphdyn.interactions.penalty_geometry import faces_on_nodes
     dt = 1e-7
-    sph, solid, _, alpha, _ = _pressed_particle()
+    solid = concrete_block([0, 0, 0], [0.004, 0.004, 0.004], (2, 2, 2), 3)
     x = solid.nodes.x
     nodes = np.flatnonzero((x[:, 2] > 0.004 - 1e-12) & (x[:, 0] < 0.002 + 1e-12)
                            & (x[:, 1] < 0.002 + 1e-12))
     face = faces_on_nodes(exterior_faces(solid.el.conn), nodes)
     assert face.shape == (1, 4)
-    cp = PenaltyCoupling("c", sph, solid, faces=face, alpha=alpha)
+    sph, solid, cp, alpha, force = _pressed_particle(faces=face)
     cp.pen0[0], cp.last_face[0], cp.d_last[0] = 3e-4, 0, 3.5e-4
-
-    def force(point):
-        sph.p.x[0] = point
-        cp.update_geometry(0.0)
-        sph.p.a_ext[:] = 0.0
-        cp.forces(0.0, dt, sph.p.a_ext)
-        return sph.p.a_ext[0].copy()
-
-    assert not force([0.0025, 0.001, 0.0038]).any()
+    # 0.7 mm into the face's plane (thickness 0.5): the particle's centre 0.2 mm below it
+    assert force([0.0025, 0.001, 0.004], 7e-4, 0.0, dt) == 0.0
     assert (cp.pen0[0], cp.last_face[0], cp.d_last[0], cp.k_last[0]) == (3e-4, 0, 3.5e-4, 0.0)
-    a = force([0.0015, 0.001, 0.0038])
-    assert a == pytest.approx([0.0, 0.0, alpha * 4e-4 / dt ** 2], rel=1e-12,
-                              abs=1e-12 * alpha * 4e-4 / dt ** 2)
+    assert not sph.p.a_ext[0].any()
+    f = force([0.0015, 0.001, 0.004], 7e-4, 0.0, dt)
+    k = alpha * sph.p.m[0] / dt ** 2
+    assert f == pytest.approx(k * 4e-4, rel=1e-12)
+    assert sph.p.a_ext[0, :2] == pytest.approx([0.0, 0.0], abs=1e-12 * f / sph.p.m[0])
+
+
+def test_a_spring_slid_back_takes_its_extension_back_from_the_allowance():
+    """The softening half of the energy rule: a spring whose stiffness falls from
+    k_m to k_c takes its extension back from its allowance, e <- e sqrt(k_m /
+    k_c), while there is one; without one the extension stops at the
+    penetration (the allowance stays >= 0) and the difference is lost. A
+    particle pressed 0.2 mm near a face's corner, slid to its centre and back
+    at that depth: back at the corner its allowance is 0 again and its force
+    k_c delta, as before the slide (1e-12). Pressed at the centre first (no
+    allowance) and slid to the corner: the force k_c delta and the allowance
+    0, not k_c delta sqrt(k_m / k_c) from a negative allowance."""
+    dt, delta = 1e-7, 0.2e-3
+    corner = np.array([0.0038, 0.0038, 0.004])
+    centre = np.array([0.003, 0.003, 0.004])
+    path = [corner + s * (centre - corner) for s in np.linspace(0.0, 1.0, 11)]
+    sph, solid, cp, alpha, force = _pressed_particle("current", node_scale=1e-2)
+    f_corner = force(corner, delta, 0.0, dt)
+    for point in path[1:] + path[::-1][1:]:
+        f = force(point, delta, 0.0, dt)
+    assert f == pytest.approx(f_corner, rel=1e-12) and cp.pen0[0] == pytest.approx(
+        0.0, abs=1e-12 * delta)
+    sph, solid, cp, alpha, force = _pressed_particle("current", node_scale=1e-2)
+    force(centre, delta, 0.0, dt)
+    for point in path[::-1][1:]:
+        f = force(point, delta, 0.0, dt)
+    assert f == pytest.approx(f_corner, rel=1e-12) and cp.pen0[0] == 0.0
 
 
 def test_edge_contact_and_a_subset_of_faces():

@@ -297,6 +297,12 @@ MUTANTS: tuple[Mutant, ...] = (
            ("tests/test_penalty_coupling.py::"
             "test_a_spring_slid_to_a_heavier_point_of_its_face_keeps_its_energy",),
            "a spring's stiffness change keeps its extension, not its energy"),
+    Mutant("penalty_allowance_negative", "issue 16.1",
+           "sphdyn/interactions/penalty_coupling.py",
+           "ext = min(ext * np.sqrt(k_last[i] / kk), pen)", "ext = ext * np.sqrt(k_last[i] / kk)",
+           ("tests/test_penalty_coupling.py::"
+            "test_a_spring_slid_back_takes_its_extension_back_from_the_allowance",),
+           "a softening spring's extension beyond the penetration (a negative allowance)"),
     Mutant("penalty_behind_edge", "issue 16.1", "sphdyn/interactions/penalty_coupling.py",
            "            k_last[i] = 0.0\n            continue\n        pen = max(-gap, 0.0)",
            "            gap = 0.0\n        pen = max(-gap, 0.0)",

@@ -338,5 +338,5 @@ class Stepper:
             inter.forces(self.t, self.dt_contact_step, scratch[id(inter.part.kin)])
             inter.restore(*_own_state(scalars, groups, f"interaction.{inter.name}"))
         if self.books is not None:
-            self.books.restore({k[len("books."):]: v for k, v in scalars.items()
-                                if k.startswith("books.")}, groups.get("interaction_work", {}))
+            self.books.restore(_own_state(scalars, groups, "books")[0],
+                               groups.get("interaction_work", {}))
