@@ -10,7 +10,7 @@ reads), and writes
 
 * docs/figures/penetration.png: the depth against the striking velocity for
   the three models and the modified NDRC formula; the damage in the
-  target's mid-section (y = 0) at 1000 m/s for the three models;
+  target's mid-section (y = 0) of each model's fastest completed run;
 * a table (stdout, markdown): the depth per model and velocity, the NDRC
   depth, and each run's status.
 
@@ -136,7 +136,10 @@ def main() -> None:
     for k, (model, label) in enumerate(MODELS.items()):
         if not results[model]:
             continue
-        fast = max(results[model], key=lambda r: r[0])
+        # the fastest run that completed (a run stopped early has only its
+        # first frame: the panel would show the projectile above the face)
+        done = [r for r in results[model] if r[2] == "completed"] or results[model]
+        fast = max(done, key=lambda r: r[0])
         ce, de, xp, dp = mid_section(fast[3])
         sub = fig.add_subplot(grid[1, k])
         sc = sub.scatter(1e3 * ce[:, 0], 1e3 * ce[:, 1], c=de, s=6, marker="s",

@@ -288,13 +288,14 @@ def test_moving_wall_unit_behaviour():
     for t, touching in ((2.49e-3, 0), (2.51e-3, 1)):
         a, f = np.zeros((1, 3)), np.zeros((1, 3))
         cnt = wall_contact(x, np.zeros((1, 3)), *args, u * t, n, u, 0.5, STIFFNESS_MASS,
-                           0.1, 0.0, 1e-6, a, f)
+                           0.1, 0.0, 1e-6, a, f, np.zeros(1), np.zeros(1))
         assert cnt == touching and (a[0, 1] > 0) == bool(touching)
     belt = np.array([2.0, 0.0, 0.0])  # a wall sliding along x at 2 m/s
     for v, expect_friction in (([2.0, 0.0, 0.0], False), ([0.0, 0.0, 0.0], True)):
         a, f = np.zeros((1, 3)), np.zeros((1, 3))
         wall_contact(np.array([[0.0, 0.2e-3, 0.0]]), np.array([v]), *args,
-                     np.zeros(3), n, belt, 0.5, STIFFNESS_MASS, 0.1, 0.5, 1e-6, a, f)
+                     np.zeros(3), n, belt, 0.5, STIFFNESS_MASS, 0.1, 0.5, 1e-6, a, f,
+                     np.zeros(1), np.zeros(1))
         assert (a[0, 0] != 0.0) == expect_friction
         if expect_friction:
             assert a[0, 0] > 0.0  # dragged along by the wall

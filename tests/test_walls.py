@@ -84,7 +84,7 @@ def test_spring_acceleration_and_force_match_the_paper(dim, method, alpha):
     f = np.full((6, 3), 7.0)
     count = wall_contact(c["x"], np.zeros((6, 3)), c["m"], c["vol0"], c["rho0"], c["kbulk"],
                          dim, np.zeros(3), c["normal"], np.zeros(3), THICKNESS, method, alpha,
-                         0.0, DT, a, f)
+                         0.0, DT, a, f, np.zeros(6), np.zeros(6))
     expect = _expected_acceleration(c, method, alpha)
     assert count == 4
     scale = np.abs(expect).max()
@@ -113,7 +113,7 @@ def test_contact_decided_at_the_thickness_edge_as_the_formula_says(dim):
     a, f = np.zeros((n, 3)), np.zeros((n, 3))
     count = wall_contact(x, np.zeros((n, 3)), one, vol0, 2400.0 * one, 1e10 * one, dim,
                          np.zeros(3), np.array([0.0, 1.0, 0.0]), np.zeros(3), THICKNESS,
-                         STIFFNESS_MASS, 0.1, 0.0, DT, a, f)
+                         STIFFNESS_MASS, 0.1, 0.0, DT, a, f, np.zeros(n), np.zeros(n))
     touching = (THICKNESS * vol0 ** (1.0 / dim) - gap) > 0.0
     assert 0 < touching.sum() < n - 10
     assert count == touching.sum()
@@ -133,7 +133,8 @@ def test_mass_spring_in_numbers():
                               (STIFFNESS_BULK, 0.5, 5e9 * 1e-4 / 2.4e-3)):
         a, f = np.zeros((1, 3)), np.zeros((1, 3))
         wall_contact(x, np.zeros((1, 3)), 2e-3 * one, 1e-6 * one, 2400.0 * one, 1e10 * one,
-                     2, np.zeros(3), normal, np.zeros(3), 0.5, method, alpha, 0.0, 1e-7, a, f)
+                     2, np.zeros(3), normal, np.zeros(3), 0.5, method, alpha, 0.0, 1e-7, a, f,
+                     np.zeros(1), np.zeros(1))
         assert a[0, 1] == pytest.approx(an, rel=1e-12)
         assert f[0, 1] == pytest.approx(2e-3 * an, rel=1e-12)
         assert a[0, 0] == a[0, 2] == 0.0
@@ -165,3 +166,152 @@ def test_wall_interaction_passes_its_spring_to_the_kernel(method, bulk):
     assert np.abs(w.total - total).max() < 1e-12 * np.abs(total).max()
     assert w.columns(0.0)["F_wall_w"] == pytest.approx(total @ c["normal"], rel=1e-12)
     assert w.count == 4
+
+
+# ------------------------------------------------- the spring's energy rule
+M1, VOL1 = 2e-3, 1e-6  # one 2D particle of 1 mm: thickness 0.5 mm
+
+
+def _press(pen, dt, state, alpha=0.1, method=STIFFNESS_MASS):
+    """Normal force [N/m] on one 2D particle of mass M1 pressed ``pen`` [m]
+    into a wall at y = 0 (mass spring eq. 8 unless ``method``), the step
+    ``dt``; ``state`` = (allowance, stiffness) arrays of the particle's spring,
+    carried from call to call."""
+    x = np.array([[0.0, THICKNESS * VOL1 ** 0.5 - pen, 0.0]])
+    a, f = np.zeros((1, 3)), np.zeros((1, 3))
+    wall_contact(x, np.zeros((1, 3)), np.full(1, M1), np.full(1, VOL1), np.full(1, 2400.0),
+                 np.full(1, 1e10), 2, np.zeros(3), np.array([0.0, 1.0, 0.0]), np.zeros(3),
+                 THICKNESS, method, alpha, 0.0, dt, a, f, *state)
+    assert a[0, 1] * M1 == f[0, 1]
+    return f[0, 1]
+
+
+def test_a_wall_spring_keeps_its_energy_when_the_step_changes():
+    """Eq. 8's spring k = alpha m / dt^2 follows the current step. A particle
+    pressed delta = 0.1 mm at dt (force k delta), then held there while the
+    step halves (k x4): the force is sqrt(4) k delta = 2 k delta, not 4 k
+    delta, and the allowance delta / 2, so that 1/2 (4k)(delta/2)^2 = 1/2 k
+    delta^2 is the energy it stored (module docstring of wall_contact). Back at
+    dt the extension returns to delta (allowance 0) and so does the force.
+    Round-off tolerance (1e-12)."""
+    dt, delta, alpha = 2e-7, 0.1e-3, 0.1
+    state = (np.zeros(1), np.zeros(1))
+    k = alpha * M1 / dt ** 2
+    assert _press(delta, dt, state) == pytest.approx(k * delta, rel=1e-12)
+    assert state[1][0] == pytest.approx(alpha / dt ** 2, rel=1e-12)  # per unit mass
+    assert _press(delta, dt / 2, state) == pytest.approx(2.0 * k * delta, rel=1e-12)
+    assert state[0][0] == pytest.approx(delta / 2, rel=1e-12)
+    assert _press(delta, dt, state) == pytest.approx(k * delta, rel=1e-12)
+    assert abs(state[0][0]) < 1e-12 * delta
+    # out of contact: the spring forgets both
+    assert _press(-0.1e-3, dt, state) == 0.0
+    assert state[0][0] == 0.0 and state[1][0] == 0.0
+
+
+def _wall_cycle_work(delta, dt_load, dt_unload, steps=20):
+    """Work [J/m] of the wall's force on the particle pressed ``delta`` in at
+    step ``dt_load`` and drawn back at ``dt_unload``, ``steps`` moves each way,
+    the force at each move's mid-point (exact for a spring of fixed k); the
+    step changes at the deepest point, where the particle is held for one
+    evaluation (no work), so that the extension's zero falls on a move's end
+    and the mid-point rule stays exact."""
+    state = (np.zeros(1), np.zeros(1))
+    dd = delta / steps
+    work = 0.0
+    for i in range(steps):  # the force opposes the motion in
+        work -= _press((i + 0.5) * dd, dt_load, state) * dd
+    _press(delta, dt_unload, state)
+    for i in range(steps):
+        work += _press(delta - (i + 0.5) * dd, dt_unload, state) * dd
+    return work
+
+
+def test_a_wall_spring_gives_back_what_it_took_and_never_more():
+    """Loaded at dt and drawn back at dt / 2 (the step dropped under load, as
+    where a body is crushed): the spring returns the 1/2 k delta^2 it took
+    (net work 1e-9 of it: round-off; applied as it is it returned 1/2 (4k)
+    delta^2, making 1.5 k delta^2). Loaded at dt / 2 and drawn back at dt: the
+    softer spring cannot return more than its penetration allows, so 1/2 (4k
+    - k) delta^2 is lost (1e-9), never made."""
+    dt, delta, alpha = 2e-7, 0.1e-3, 0.1
+    k = alpha * M1 / dt ** 2
+    stored = 0.5 * k * delta ** 2
+    assert abs(_wall_cycle_work(delta, dt, dt / 2)) < 1e-9 * stored
+    assert _wall_cycle_work(delta, dt / 2, dt) == pytest.approx(-3.0 * stored, rel=1e-9)
+    assert abs(_wall_cycle_work(delta, dt, dt)) < 1e-9 * stored
+
+
+def test_the_bulk_wall_spring_is_unchanged_by_the_step():
+    # eq. 9's k = alpha K A / L does not depend on dt: the same force at any
+    # step, never an allowance (round-off)
+    state = (np.zeros(1), np.zeros(1))
+    f1 = _press(0.1e-3, 2e-7, state, alpha=0.5, method=STIFFNESS_BULK)
+    f2 = _press(0.1e-3, 1e-7, state, alpha=0.5, method=STIFFNESS_BULK)
+    assert f1 == f2 == pytest.approx(0.5 * 1e10 * 0.1e-3 * M1 / (2400.0 * VOL1), rel=1e-12)
+    assert state[0][0] == 0.0
+
+
+def _wall_on(p, alpha=0.1):
+    spec = WallSpec("w", np.zeros(3), np.array([0.0, 1.0, 0.0]), STIFFNESS_MASS, alpha, 0.0,
+                    THICKNESS)
+    return Wall(spec, SimpleNamespace(p=p))
+
+
+def _particles(y):
+    p = Particles.allocate(len(y), 2)
+    p.x[:, 1] = y
+    p.m[:] = M1
+    p.vol0[:] = VOL1
+    p.rho0[:] = 2400.0
+    p.add("bulk_modulus", ())
+    return p
+
+
+def test_a_particle_born_inside_the_wall_thickness_is_allowed_its_penetration():
+    """A particle born (an eroded element's, an injected one) 0.2 mm inside the
+    thickness exerts no force there (its allowance is that penetration; a
+    spring never loaded releases nothing: LS-DYNA's IGNORE = 2); pressed 0.05
+    mm deeper it feels eq. 8 of those 0.05 mm; drawn out to 0.1 mm inside and
+    pressed back 0.05 mm, of those 0.05 mm again (the allowance only
+    shrinks). A particle present at the start has none (the first one).
+    Round-off tolerance."""
+    dt, alpha = 2e-7, 0.1
+    t = THICKNESS * VOL1 ** 0.5
+    p = _particles([t - 0.1e-3])
+    w = _wall_on(p, alpha)
+    a = np.zeros((1, 3))
+    w.forces(0.0, dt, a)
+    assert a[0, 1] == pytest.approx(alpha * 0.1e-3 / dt ** 2, rel=1e-12)
+    rows = p.grow(1, notify=False)
+    p.x[rows] = [[0.002, t - 0.2e-3, 0.0]]
+    p.m[rows], p.vol0[rows], p.rho0[rows] = M1, VOL1, 2400.0
+    p.notify_grown(rows.start, rows.stop)
+    for depth, expect in ((0.2e-3, 0.0), (0.25e-3, 0.05e-3), (0.1e-3, 0.0), (0.15e-3, 0.05e-3)):
+        p.x[1, 1] = t - depth
+        a = np.zeros((2, 3))
+        w.forces(0.0, dt, a)
+        assert a[1, 1] == pytest.approx(alpha * expect / dt ** 2, rel=1e-9, abs=1e-6)
+        assert w.count == (2 if expect > 0 else 1)
+
+
+def test_a_wall_springs_state_survives_a_restart():
+    """The allowances and stiffnesses are the wall's checkpoint state: a wall
+    restored from another's state gives the same force bits at the next,
+    shorter step (where the energy rule acts), and so does its count."""
+    dt = 2e-7
+    t = THICKNESS * VOL1 ** 0.5
+    y = [t - 0.1e-3, t - 0.05e-3, t + 1e-3]
+    p = _particles(y)
+    w = _wall_on(p)
+    w.forces(0.0, dt, np.zeros((3, 3)))
+    scalars, arrays = w.state()
+    twin = _wall_on(_particles(y))
+    twin.restore(scalars, {k: v.copy() for k, v in arrays.items()})
+    a, b = np.zeros((3, 3)), np.zeros((3, 3))
+    w.forces(1e-6, 0.7 * dt, a)
+    twin.forces(1e-6, 0.7 * dt, b)
+    assert np.array_equal(a, b) and a[0, 1] > 0.0 and twin.count == w.count == 2
+    fresh = _wall_on(_particles(y))  # without the state: the spring as if new
+    c = np.zeros((3, 3))
+    fresh.forces(1e-6, 0.7 * dt, c)
+    assert not np.allclose(a, c, rtol=1e-3)

@@ -142,7 +142,7 @@ from .penalty_geometry import (candidate_pairs, closest_point, exterior_faces,
                                face_anchors, face_point, face_shapes)
 from .wall import STIFFNESS
 from .wall_contact import (STIFFNESS_BULK, STIFFNESS_MASS, contact_thickness,
-                           spring_acceleration)
+                           keep_spring_energy, spring_acceleration)
 
 #: relative lateral offset under which a clamped closest point counts as inside the face
 _INSIDE_RTOL = 1e-9
@@ -327,10 +327,7 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
             continue
         inv_f = face_inverse_mass(mn, faces[bf], N)
         kk = a1 * (spring_mass(mp[i], inv_f) if method == STIFFNESS_MASS else mp[i])
-        if k_last[i] > 0.0 and kk != k_last[i]:  # its energy kept (k_last above)
-            ext = min(ext * np.sqrt(k_last[i] / kk), pen)
-            pen0[i] = pen - ext
-        k_last[i] = kk
+        ext = keep_spring_energy(i, pen, ext, kk, pen0, k_last)
         fn = kk * ext
         f0 = fn * e0
         f1 = fn * e1

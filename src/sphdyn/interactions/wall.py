@@ -17,7 +17,7 @@ import numpy as np
 
 from .base import InteractionBase
 from .wall_contact import (STIFFNESS_BULK, STIFFNESS_MASS, bulk_contact_time_step, column_sums,
-                           wall_contact)
+                           contact_thickness, wall_contact)
 
 STIFFNESS = {"mass": STIFFNESS_MASS, "bulk": STIFFNESS_BULK}
 
@@ -77,8 +77,29 @@ class Wall(InteractionBase):
         # the sum of F^n dt_kick over the kicks, so it equals the bodies'
         # momentum change through the wall to round-off
         self.impulse = np.zeros(3)
+        # each particle's spring: its allowance [m] and stiffness per unit
+        # mass [1/s^2] of the last evaluation (wall_contact's energy rule);
+        # kept here, not among the particles' state, so that a template's
+        # row copied into injected particles does not carry them
+        self._pen0 = f"wall_allowance_{spec.name}"
+        self._k_last = f"wall_stiffness_{spec.name}"
+        p.add(self._pen0, ())
+        p.add(self._k_last, ())
+        self._point = spec.point_at(0.0)  # the plane of the last evaluation
         self._dt = self._limit()
-        p.on_grow(lambda n_old, n_new: setattr(self, "_dt", self._limit()))
+        p.on_grow(self._grown)
+
+    def _grown(self, n_old: int, n_new: int) -> None:
+        """Particles born inside the thickness take their penetration at the
+        last evaluation's plane as allowance (module docstring of
+        :mod:`.wall_contact`); the bulk spring's step limit is taken again."""
+        p, w = self.part.p, self.spec
+        new = slice(n_old, n_new)
+        gap = (p.x[new] - self._point) @ w.normal
+        pen = contact_thickness(p.vol0[new], p.dim, w.thickness_factor) - gap
+        getattr(p, self._pen0)[new] = np.maximum(pen, 0.0)
+        getattr(p, self._k_last)[new] = 0.0
+        self._dt = self._limit()
 
     def _limit(self) -> float:
         p, w = self.part.p, self.spec
@@ -93,10 +114,12 @@ class Wall(InteractionBase):
 
     def forces(self, t: float, dt: float, a_out: np.ndarray) -> None:
         p, w = self.part.p, self.spec
+        self._point = w.point_at(t)
         self.count = int(wall_contact(
             p.x, p.v, p.m, p.vol0, p.rho0, getattr(p, self._kbulk_name), p.dim,
-            w.point_at(t), w.normal, w.velocity_at(t), w.thickness_factor, w.method,
-            w.alpha, w.friction, dt, a_out, p.wall_force))
+            self._point, w.normal, w.velocity_at(t), w.thickness_factor, w.method,
+            w.alpha, w.friction, dt, a_out, p.wall_force, getattr(p, self._pen0),
+            getattr(p, self._k_last)))
         column_sums(p.wall_force, self.total)
 
     def after_kick(self, dt_kick: float) -> None:
@@ -115,7 +138,14 @@ class Wall(InteractionBase):
         return out
 
     def state(self) -> tuple[dict, dict[str, np.ndarray]]:
-        return {}, {"impulse": self.impulse}
+        p = self.part.p
+        return {}, {"impulse": self.impulse, "allowance": getattr(p, self._pen0),
+                    "stiffness": getattr(p, self._k_last), "point": self._point}
 
     def restore(self, scalars: dict, arrays: dict) -> None:
         self.impulse[...] = arrays["impulse"]
+        if "allowance" in arrays:  # absent in checkpoints before 2026-11-27
+            p = self.part.p
+            setattr(p, self._pen0, arrays["allowance"])
+            setattr(p, self._k_last, arrays["stiffness"])
+            self._point = np.array(arrays["point"], dtype=float)

@@ -28,6 +28,24 @@ compression test): the caller passes the current point
 :math:`\mathbf p(t) = \mathbf p_0 + \mathbf u t`, and friction acts on the
 velocity relative to the wall.
 
+A spring's energy is kept when its stiffness changes under load. The
+mass-based :math:`k_i = \alpha m_i/\Delta t^2` follows the current step,
+which drops as the bodies deform: applied as it is, a spring loaded at
+:math:`k_1` and released at :math:`k_2 > k_1` gives back :math:`\tfrac12 k_2
+e^2` of the :math:`\tfrac12 k_1 e^2` it took. So each particle keeps its
+spring's stiffness per unit mass :math:`k_i/m_i` of the last evaluation and an
+allowance :math:`\delta_{0i}` (penetration without force); the spring acts on
+the extension :math:`e_i = \delta_i - \delta_{0i}`, and when :math:`k` has
+changed from :math:`k_1` to :math:`k_2` the extension is scaled to keep the
+spring's energy, :math:`e \leftarrow \min(e\sqrt{k_1/k_2},\ \delta)` (the
+allowance takes the difference; :func:`keep_spring_energy`, the rule of the
+SPH-FEM penalty coupling). The allowance only shrinks as the particle moves
+out, and is zero for particles present at the start, so with a constant step
+(and always with the bulk spring) the force is eq. 8 or 9 unchanged.
+Particles born during the run (eroded elements, injected particles) inside
+the thickness start with their penetration as allowance (LS-DYNA's IGNORE =
+2): a spring that was never loaded releases no energy.
+
 Optional Coulomb friction opposes the tangential velocity with magnitude
 :math:`\mu |F_n|`, capped so that it cannot reverse the tangential velocity
 within one step (a regularised stick condition).
@@ -75,6 +93,27 @@ def spring_acceleration(pen, method, alpha, dt, kbulk, vol0, rho0, dim):
 
 
 @njit(cache=True, error_model="numpy")
+def keep_spring_energy(i, pen, ext, k, pen0, k_last):
+    r"""The extension [m] of spring ``i`` after its stiffness became ``k``.
+
+    A spring of extension :math:`e` stores :math:`\tfrac12 k_1 e^2`; when its
+    stiffness changes from :math:`k_1` (``k_last[i]``, 0: not loaded at the
+    last evaluation) to :math:`k_2` (``k``) the extension becomes
+    :math:`e\sqrt{k_1/k_2}`, which keeps that energy, at most the
+    penetration ``pen`` [m] (a softer spring takes its extension back from
+    the allowance while there is one; beyond it the difference is lost, never
+    made). ``pen0`` (N,) in/out, the allowance [m], takes ``pen - e``;
+    ``k_last`` (N,) in/out, takes ``k``. ``k`` in any unit proportional to the
+    stiffness (N/m, or N/m per kg of the particle): only the ratio counts.
+    """
+    if k_last[i] > 0.0 and k != k_last[i]:
+        ext = min(ext * np.sqrt(k_last[i] / k), pen)
+        pen0[i] = pen - ext
+    k_last[i] = k
+    return ext
+
+
+@njit(cache=True, error_model="numpy")
 def column_sums(a, out):
     """``out[k] = sum_i a[i, k]`` for ``a`` (N, 3), row by row in order: the
     bits of NumPy's ``a.sum(axis=0)`` (which adds a C-ordered array's rows in
@@ -94,7 +133,8 @@ def column_sums(a, out):
 
 @njit(cache=True, error_model="numpy", parallel=True)
 def wall_contact(x, v, m, vol0, rho, kbulk, dim, point, normal, wall_v,
-                 thickness_factor, method, alpha, friction, dt, a_contact, force):
+                 thickness_factor, method, alpha, friction, dt, a_contact, force,
+                 pen0, k_last):
     r"""Penalty contact accelerations of one rigid wall (gather form).
 
     Parameters
@@ -110,6 +150,11 @@ def wall_contact(x, v, m, vol0, rho, kbulk, dim, point, normal, wall_v,
     a_contact : (N, 3) in/out, contact acceleration is **added**.
     force : (N, 3) out, force on each particle [N] (N/m in 2D); zero for
         zero-mass particles and particles not in contact.
+    pen0 : (N,) in/out, each particle's allowance [m]: the penetration it
+        has without force (module docstring); set to 0 out of contact.
+    k_last : (N,) in/out, each spring's stiffness per unit mass of the last
+        evaluation [1/s^2] (:math:`\alpha/\Delta t^2` for the mass spring);
+        0 out of contact.
 
     Returns
     -------
@@ -130,12 +175,27 @@ def wall_contact(x, v, m, vol0, rho, kbulk, dim, point, normal, wall_v,
         if gap > 0.0:
             gd = gap if dim == 1 else (gap * gap if dim == 2 else gap * gap * gap)
             if gd > far * vol0[i]:
+                pen0[i] = 0.0
+                k_last[i] = 0.0
                 continue
         pen = contact_thickness(vol0[i], dim, thickness_factor) - gap
         if pen <= 0.0:
+            pen0[i] = 0.0
+            k_last[i] = 0.0
+            continue
+        if pen < pen0[i]:
+            pen0[i] = pen
+        ext = pen - pen0[i]
+        if ext <= 0.0:  # within its allowance
+            k_last[i] = 0.0
             continue
         count += 1
-        an = spring_acceleration(pen, method, alpha, dt, kbulk[i], vol0[i], rho[i], dim)
+        # the energy rule compares the stiffness per unit mass; the
+        # acceleration itself is eq. 8 / 9 of the extension (the same bits as
+        # of the penetration while there is no allowance)
+        k1 = spring_acceleration(1.0, method, alpha, dt, kbulk[i], vol0[i], rho[i], dim)
+        ext = keep_spring_energy(i, pen, ext, k1, pen0, k_last)
+        an = spring_acceleration(ext, method, alpha, dt, kbulk[i], vol0[i], rho[i], dim)
         a0 = an * normal[0]
         a1 = an * normal[1]
         a2 = an * normal[2]
