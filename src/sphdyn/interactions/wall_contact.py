@@ -175,8 +175,9 @@ def wall_contact(x, v, m, vol0, rho, kbulk, dim, point, normal, wall_v,
         if gap > 0.0:
             gd = gap if dim == 1 else (gap * gap if dim == 2 else gap * gap * gap)
             if gd > far * vol0[i]:
-                pen0[i] = 0.0
-                k_last[i] = 0.0
+                if pen0[i] != 0.0 or k_last[i] != 0.0:  # (most rows: read, not written)
+                    pen0[i] = 0.0
+                    k_last[i] = 0.0
                 continue
         pen = contact_thickness(vol0[i], dim, thickness_factor) - gap
         if pen <= 0.0:
