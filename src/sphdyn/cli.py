@@ -462,7 +462,8 @@ def build_parser() -> argparse.ArgumentParser:
     r = sub.add_parser("run", help="validate and run a deck")
     r.add_argument("deck")
     r.add_argument("--out", help="output directory (default out/<deck name>)")
-    r.add_argument("--threads", type=_whole(1), default=None, help="Numba threads (default: automatic)")
+    r.add_argument("--threads", type=_whole(1), default=None,
+                   help="Numba threads (default: automatic)")
     r.add_argument("--set", action="append", metavar="KEY=VALUE",
                    help="override a deck value, e.g. --set run.t_end=1e-4")
     r.add_argument("--max-steps", type=_whole(0), help="stop after this many steps")
@@ -481,8 +482,9 @@ def build_parser() -> argparse.ArgumentParser:
                     "e.g. tcp://host:8786 (default: a local cluster of processes)")
     en.add_argument("--workers", type=_whole(1), help="local worker processes (default: one "
                     "per core, at most one per sample)")
-    en.add_argument("--threads", type=_whole(1), default=None, help="Numba threads per sample (default: "
-                    "cores / workers locally, 1 on a scheduler)")
+    en.add_argument("--threads", type=_whole(1), default=None,
+                    help="Numba threads per sample (default: cores / workers locally, 1 on "
+                    "a scheduler)")
     en.add_argument("--out", help="output directory (default out/<deck>-ensemble)")
     en.add_argument("--set", action="append", metavar="KEY=VALUE",
                     help="override a deck value in every sample")
@@ -502,7 +504,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--t-end", type=_duration, help="new end time, later than the "
                    "checkpoint's: seconds or with units, e.g. 2.5e-4 or '250 us' "
                    "(default the deck's)")
-    s.add_argument("--threads", type=_whole(1), default=None, help="Numba threads (default: automatic)")
+    s.add_argument("--threads", type=_whole(1), default=None,
+                   help="Numba threads (default: automatic)")
     s.add_argument("--max-steps", type=_whole(0), help="stop after this many steps")
     s.add_argument("-q", "--quiet", action="store_true")
     s.set_defaults(func=cmd_restart)
@@ -561,7 +564,8 @@ def build_parser() -> argparse.ArgumentParser:
     b = sub.add_parser("bench", help="run a built-in benchmark, print one JSON line")
     b.add_argument("case", choices=("rings2d", "rings2d_tl", "block3d", "hex3d", "hvi"))
     b.add_argument("--steps", type=_whole(1), default=1000)
-    b.add_argument("--threads", type=_whole(1), default=None, help="Numba threads (default: automatic)")
+    b.add_argument("--threads", type=_whole(1), default=None,
+                   help="Numba threads (default: automatic)")
     b.add_argument("--particles", type=_whole(8), help="block3d: approximate particle "
                    "count (the rings cases have a fixed count)")
     b.add_argument("--elements", type=_whole(1), help="hex3d: approximate element count")

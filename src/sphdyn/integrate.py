@@ -46,7 +46,8 @@ def kick(v, a, a_contact, m, bc, bc_v, dt_kick, v_out_mean, sums):
     ``a`` (N, 3) is the total acceleration (including ``a_contact``, the part
     from contact, (N, 3)). ``bc``/``bc_v`` impose fixed or prescribed
     velocities, on every component or (``BC_COMPONENTS | mask``) on the
-    masked ones only, the others free. ``v_out_mean`` (N, 3) receives :math:`\mathbf v^n`. ``sums`` is
+    masked ones only, the others free. ``v_out_mean`` (N, 3) receives
+    :math:`\mathbf v^n`. ``sums`` is
     the (blocks, 3) scratch of :func:`kick_scratch`: each block of
     :data:`KICK_BLOCK` particles is summed in order, then the blocks in order,
     so the energies are the same bits on any number of threads.

@@ -287,7 +287,8 @@ def build_model(deck) -> Model:
     for g in groups:
         if not g.idx.size:  # a debris group, filled during the run
             continue
-        particles.c[g.idx] = g.model.wave_speed(g.params, particles.rho0[g.idx[0]])  # one density per material
+        # one density per material
+        particles.c[g.idx] = g.model.wave_speed(g.params, particles.rho0[g.idx[0]])
         h0 = g.model.initial_history(g.params)
         if len(h0):
             particles.hist[np.ix_(g.idx, g.column + np.arange(len(h0)))] = h0

@@ -40,7 +40,8 @@ from .sections.walls import Wall
 from .values import ExistingFile, NonEmpty, Section
 
 __all__ = [
-    "BeamSection", "Blast", "BlockMesh", "Body", "Boundary", "Convert", "Detonation", "LineMesh", "Load", "Mesh",
+    "BeamSection", "Blast", "BlockMesh", "Body", "Boundary", "Convert", "Detonation",
+    "LineMesh", "Load", "Mesh",
     "MeshGroup", "Contact", "Crack", "Deck", "DeckSections", "Domain",
     "ExistingFile", "Gauge", "Geometry", "MassField", "MaterialSection", "Mesostructure",
     "Output", "ParticleSet", "Probe", "Region", "Run", "Section", "Sph", "Time",

@@ -217,5 +217,6 @@ def plot_mass_histograms(sim, outdir: str | Path) -> list[Path]:
         paths.append(plot_mass_histogram(
             draw.m0 * draw.factors * draw.scale, Path(outdir) / "plots" / name,
             law=distribution(draw.spec), m0=draw.m0, scale=draw.scale,
-            dimension=sim.deck.run.dimension, title=f"{body.name}: {draw.spec['distribution']} masses, seed {seed}"))
+            dimension=sim.deck.run.dimension,
+            title=f"{body.name}: {draw.spec['distribution']} masses, seed {seed}"))
     return paths

@@ -1,7 +1,8 @@
 """The Interaction protocol: forces between parts, or between a part and the world.
 
 Walls, particle-particle contact and (with the FEM issue) the SPH-FEM
-couplings, prescribed motion, loads and damping. The :class:`~sphdyn.stepper.Stepper` asks each interaction
+couplings, prescribed motion, loads and damping. The
+:class:`~sphdyn.stepper.Stepper` asks each interaction
 
 * ``stable_dt()``: its stability limit (``inf`` if it needs none);
 * ``prescribe(t, dt)``: before the kick of the step [t, t + dt], the

@@ -29,7 +29,8 @@ material with the point's volume and mass.
   the total-Lagrangian kernel the pairs are fixed, so the scheme's force
   pass drops them once, :meth:`~sphdyn.parts.sph.tl_scheme.TotalLagrangian.forces_off`), pairs
   of a hybrid and an SPH particle stay: the hybrid particle gets the equal
-  and opposite pair force, which goes to the element's nodes, :math:`\mathbf F_a = N_a(\boldsymbol\xi_h)\,\mathbf F_h`,
+  and opposite pair force, which goes to the element's nodes,
+  :math:`\mathbf F_a = N_a(\boldsymbol\xi_h)\,\mathbf F_h`,
   :math:`\mathbf F_h = m_h(\mathbf a_h + \mathbf a^{ext}_h)`. With
   :math:`\sum_a N_a = 1` linear momentum is conserved exactly.
 * Energy: the element books the strain energy of its material. A hybrid

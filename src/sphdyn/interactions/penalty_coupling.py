@@ -223,7 +223,8 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
         evaluation (-1: none, so no switch is checked; -2: unknown, a particle
         born since or faces renumbered, so any face is a switch) and its
         signed penetration there :math:`d = -g` [m] (:math:`-\infty` with -2
-        for a particle that faced none: its whole penetration is allowed). At a switch of face the spring's extension grows
+        for a particle that faced none: its whole penetration is allowed). At a
+        switch of face the spring's extension grows
         by at most the approach the motion allows, :math:`|\mathbf v_r|`
         ``motion_dt``; the allowance takes the excess (module docstring).
     k_last : (N,) in/out, each particle's spring stiffness :math:`k` [N/m]

@@ -12,5 +12,6 @@ from .mesh import POINT_FIELDS, Elements, MaterialPoints, Nodes
 from .store import STATE, WORK, ArrayStore
 
 __all__ = ["ArrayStore", "BC_COMPONENTS", "BC_FIXED", "BC_FREE", "BC_SLAVE", "BC_VELOCITY",
-           "Elements", "KINEMATICS", "Kinematics", "MaterialPoints", "Nodes", "PARTICLE_FIELDS", "POINT_FIELDS",
+           "Elements", "KINEMATICS", "Kinematics", "MaterialPoints", "Nodes", "PARTICLE_FIELDS",
+           "POINT_FIELDS",
            "Particles", "STATE", "WORK"]

@@ -57,7 +57,8 @@ def gather_nodes(x, v, s, conn, lo, nl, S):
         for I in range(8):
             n = conn[e, I]
             for k in range(3):
-                S[(X_ + 3 * I + k) * LANES + l] = (x[n, k] - s * v[n, k]) - (x[n0, k] - s * v[n0, k])
+                S[(X_ + 3 * I + k) * LANES + l] = ((x[n, k] - s * v[n, k])
+                                                   - (x[n0, k] - s * v[n0, k]))
                 S[(VN_ + 3 * I + k) * LANES + l] = v[n, k]
 
 
