@@ -19,9 +19,10 @@ class Wall(Section):
         description="Normal pointing into the half-space where the bodies "
                     "are (normalised).")
     stiffness: Literal["mass", "bulk"] = Field(
-        "mass", description="Penalty stiffness: mass: k = alpha m/dt^2; "
-                            "bulk: k = alpha K A/L (works for zero-mass "
-                            "particles).")
+        "mass", description="Penalty stiffness: mass: k = alpha m/dt^2 at the "
+                            "current step (a spring whose k changes under load "
+                            "keeps its energy: docs/theory.md); bulk: k = alpha "
+                            "K A/L (works for zero-mass particles).")
     alpha: real("penalty factor", lo=0, lo_open=True) = Field(
         0.1, description="Penalty factor alpha.")
     bulk_modulus: Optional[PositivePressure] = Field(
