@@ -233,14 +233,7 @@ def hex_volume_gradient(xl, g):
         + x5 * (y6 - y4)
         + x6 * (y2 + y3 - y4 - y5)) * TWELFTH
     g[7, 2] = g72
-    return (x0 * g00 + y0 * g01 + z0 * g02
-            + x1 * g10 + y1 * g11 + z1 * g12
-            + x2 * g20 + y2 * g21 + z2 * g22
-            + x3 * g30 + y3 * g31 + z3 * g32
-            + x4 * g40 + y4 * g41 + z4 * g42
-            + x5 * g50 + y5 * g51 + z5 * g52
-            + x6 * g60 + y6 * g61 + z6 * g62
-            + x7 * g70 + y7 * g71 + z7 * g72) / 3.0
+    return (x0 * g00 + y0 * g01 + z0 * g02 + x1 * g10 + y1 * g11 + z1 * g12 + x2 * g20 + y2 * g21 + z2 * g22 + x3 * g30 + y3 * g31 + z3 * g32 + x4 * g40 + y4 * g41 + z4 * g42 + x5 * g50 + y5 * g51 + z5 * g52 + x6 * g60 + y6 * g61 + z6 * g62 + x7 * g70 + y7 * g71 + z7 * g72) / 3.0
 
 
 @njit(cache=True, error_model="numpy")
@@ -465,11 +458,4 @@ def hex_volume_gradient_lanes(S):
             + x5 * (y6 - y4)
             + x6 * (y2 + y3 - y4 - y5)) * TWELFTH
         S[(G_ + 23) * LANES + l] = g72
-        S[VOL_ * LANES + l] = (x0 * g00 + y0 * g01 + z0 * g02
-                               + x1 * g10 + y1 * g11 + z1 * g12
-                               + x2 * g20 + y2 * g21 + z2 * g22
-                               + x3 * g30 + y3 * g31 + z3 * g32
-                               + x4 * g40 + y4 * g41 + z4 * g42
-                               + x5 * g50 + y5 * g51 + z5 * g52
-                               + x6 * g60 + y6 * g61 + z6 * g62
-                               + x7 * g70 + y7 * g71 + z7 * g72) / 3.0
+        S[VOL_ * LANES + l] = (x0 * g00 + y0 * g01 + z0 * g02 + x1 * g10 + y1 * g11 + z1 * g12 + x2 * g20 + y2 * g21 + z2 * g22 + x3 * g30 + y3 * g31 + z3 * g32 + x4 * g40 + y4 * g41 + z4 * g42 + x5 * g50 + y5 * g51 + z5 * g52 + x6 * g60 + y6 * g61 + z6 * g62 + x7 * g70 + y7 * g71 + z7 * g72) / 3.0
