@@ -10,7 +10,8 @@ reads), and writes
 
 * docs/figures/penetration.png: the depth against the striking velocity for
   the three models and the modified NDRC formula; the damage in the
-  target's mid-section (y = 0) of each model's fastest completed run;
+  target's mid-section (a 2 mm layer at y = 0) of each model's fastest
+  completed run;
 * a table (stdout, markdown): the depth per model and velocity, the NDRC
   depth, and each run's status.
 
@@ -88,9 +89,11 @@ def depths(out: Path) -> list[tuple[float, float, str, Path]]:
     return sorted(rows)
 
 
-def mid_section(sample: Path):
-    """Elements' centres (x, z) [m] and damage in the slab |y| < 1 mm of the
-    target's last frame, and the particles' (debris and projectile)."""
+def mid_section(sample: Path, layer: float = 0.002):
+    """Elements' centres (x, z) [m] and damage in the slab 0 <= y < ``layer``
+    [m] of the target's last frame (one layer of the decks' 2 mm elements
+    and particles, whose centres start at y = 1 mm), and the particles'
+    (debris and projectile)."""
     import h5py
 
     from sphdyn.io import read_frame_meshes
@@ -98,10 +101,10 @@ def mid_section(sample: Path):
     last = sorted((sample / "frames").glob("frame_*.h5"))[-1]
     mesh = read_frame_meshes(last)["target"]
     c = mesh.points[mesh.cells].mean(axis=1)
-    keep = np.abs(c[:, 1]) < 1e-3
+    keep = (c[:, 1] >= 0.0) & (c[:, 1] < layer)
     with h5py.File(last, "r") as f:
         x, dmg = f["position"][:], f["damage"][:]
-    slab = np.abs(x[:, 1]) < 1e-3
+    slab = (x[:, 1] >= 0.0) & (x[:, 1] < layer)
     return c[keep][:, [0, 2]], mesh.cell_data["damage"][keep], x[slab][:, [0, 2]], dmg[slab]
 
 
@@ -147,6 +150,7 @@ def main() -> None:
         sub.scatter(1e3 * xp[:, 0], 1e3 * xp[:, 1], c=dp, s=6, cmap="inferno_r", vmin=0,
                     vmax=1, linewidths=0.3, edgecolors="tab:blue")
         sub.set_aspect("equal")
+        sub.set_facecolor("0.8")  # undamaged elements (pale) stand out from empty space
         sub.set_title(f"{label}, {fast[0]:.0f} m/s", fontsize=10)
         sub.set_xlabel("x [mm]")
         sub.set_ylabel("z [mm]")
