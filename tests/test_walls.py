@@ -270,8 +270,9 @@ def _particles(y):
 
 def test_a_particle_born_inside_the_wall_thickness_is_allowed_its_penetration():
     """A particle born (an eroded element's, an injected one) 0.2 mm inside the
-    thickness exerts no force there (its allowance is that penetration; a
-    spring never loaded releases nothing: LS-DYNA's IGNORE = 2); pressed 0.05
+    thickness exerts no force there (its allowance is its penetration at its
+    first evaluation; a spring never loaded releases nothing: LS-DYNA's
+    IGNORE = 2); pressed 0.05
     mm deeper it feels eq. 8 of those 0.05 mm; drawn out to 0.1 mm inside and
     pressed back 0.05 mm, of those 0.05 mm again (the allowance only
     shrinks). A particle present at the start has none (the first one).

@@ -311,9 +311,8 @@ MUTANTS: tuple[Mutant, ...] = (
             "tests/test_walls.py::test_a_bounce_with_the_step_halved_under_load_makes_no_energy"),
            "the wall's spring takes the current step's stiffness as it is (energy made as "
            "the step drops under load)"),
-    Mutant("wall_born_allowance", "issue 16.1", "sphdyn/interactions/wall.py",
-           "getattr(p, self._pen0)[new] = np.maximum(pen, 0.0)",
-           "getattr(p, self._pen0)[new] = 0.0",
+    Mutant("wall_born_allowance", "issue 16.1", "sphdyn/interactions/wall_contact.py",
+           "if pen < pen0[i] or k_last[i] == BORN:", "if pen < pen0[i]:",
            ("tests/test_walls.py::"
             "test_a_particle_born_inside_the_wall_thickness_is_allowed_its_penetration",),
            "a particle born inside the wall's thickness feels its whole penetration"),

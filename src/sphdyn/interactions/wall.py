@@ -16,8 +16,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .base import InteractionBase
-from .wall_contact import (STIFFNESS_BULK, STIFFNESS_MASS, bulk_contact_time_step, column_sums,
-                           contact_thickness, wall_contact)
+from .wall_contact import (BORN, STIFFNESS_BULK, STIFFNESS_MASS, bulk_contact_time_step,
+                           column_sums, wall_contact)
 
 STIFFNESS = {"mass": STIFFNESS_MASS, "bulk": STIFFNESS_BULK}
 
@@ -80,26 +80,15 @@ class Wall(InteractionBase):
         # each particle's spring: its allowance [m] and stiffness per unit
         # mass [1/s^2] of the last evaluation (wall_contact's energy rule);
         # kept here, not among the particles' state, so that a template's
-        # row copied into injected particles does not carry them
+        # row copied into injected particles does not carry them. Rows added
+        # later hold the stiffness's fill, BORN: the kernel takes their
+        # penetration at their first evaluation as allowance
         self._pen0 = f"wall_allowance_{spec.name}"
         self._k_last = f"wall_stiffness_{spec.name}"
         p.add(self._pen0, ())
-        p.add(self._k_last, ())
-        self._point = spec.point_at(0.0)  # the plane of the last evaluation
+        p.add(self._k_last, (), fill=BORN)[:] = 0.0  # present at the start: none
         self._dt = self._limit()
-        p.on_grow(self._grown)
-
-    def _grown(self, n_old: int, n_new: int) -> None:
-        """Particles born inside the thickness take their penetration at the
-        last evaluation's plane as allowance (module docstring of
-        :mod:`.wall_contact`); the bulk spring's step limit is taken again."""
-        p, w = self.part.p, self.spec
-        new = slice(n_old, n_new)
-        gap = (p.x[new] - self._point) @ w.normal
-        pen = contact_thickness(p.vol0[new], p.dim, w.thickness_factor) - gap
-        getattr(p, self._pen0)[new] = np.maximum(pen, 0.0)
-        getattr(p, self._k_last)[new] = 0.0
-        self._dt = self._limit()
+        p.on_grow(lambda n_old, n_new: setattr(self, "_dt", self._limit()))
 
     def _limit(self) -> float:
         p, w = self.part.p, self.spec
@@ -114,10 +103,9 @@ class Wall(InteractionBase):
 
     def forces(self, t: float, dt: float, a_out: np.ndarray) -> None:
         p, w = self.part.p, self.spec
-        self._point = w.point_at(t)
         self.count = int(wall_contact(
             p.x, p.v, p.m, p.vol0, p.rho0, getattr(p, self._kbulk_name), p.dim,
-            self._point, w.normal, w.velocity_at(t), w.thickness_factor, w.method,
+            w.point_at(t), w.normal, w.velocity_at(t), w.thickness_factor, w.method,
             w.alpha, w.friction, dt, a_out, p.wall_force, getattr(p, self._pen0),
             getattr(p, self._k_last)))
         column_sums(p.wall_force, self.total)
@@ -140,7 +128,7 @@ class Wall(InteractionBase):
     def state(self) -> tuple[dict, dict[str, np.ndarray]]:
         p = self.part.p
         return {}, {"impulse": self.impulse, "allowance": getattr(p, self._pen0),
-                    "stiffness": getattr(p, self._k_last), "point": self._point}
+                    "stiffness": getattr(p, self._k_last)}
 
     def restore(self, scalars: dict, arrays: dict) -> None:
         self.impulse[...] = arrays["impulse"]
@@ -148,4 +136,3 @@ class Wall(InteractionBase):
             p = self.part.p
             setattr(p, self._pen0, arrays["allowance"])
             setattr(p, self._k_last, arrays["stiffness"])
-            self._point = np.array(arrays["point"], dtype=float)

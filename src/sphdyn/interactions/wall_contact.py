@@ -42,9 +42,10 @@ allowance takes the difference; :func:`keep_spring_energy`, the rule of the
 SPH-FEM penalty coupling). The allowance only shrinks as the particle moves
 out, and is zero for particles present at the start, so with a constant step
 (and always with the bulk spring) the force is eq. 8 or 9 unchanged.
-Particles born during the run (eroded elements, injected particles) inside
-the thickness start with their penetration as allowance (LS-DYNA's IGNORE =
-2): a spring that was never loaded releases no energy.
+Particles born during the run (eroded elements, injected particles; their
+stiffness marked :data:`BORN`) take their penetration at their first
+evaluation as allowance (LS-DYNA's IGNORE = 2): a spring that was never
+loaded releases no energy.
 
 Optional Coulomb friction opposes the tangential velocity with magnitude
 :math:`\mu |F_n|`, capped so that it cannot reverse the tangential velocity
@@ -58,6 +59,8 @@ from numba import njit, prange
 
 STIFFNESS_MASS = 0
 STIFFNESS_BULK = 1
+#: a spring's stiffness marking a particle born since the last evaluation
+BORN = -1.0
 
 
 @njit(cache=True, error_model="numpy")
@@ -154,7 +157,8 @@ def wall_contact(x, v, m, vol0, rho, kbulk, dim, point, normal, wall_v,
         has without force (module docstring); set to 0 out of contact.
     k_last : (N,) in/out, each spring's stiffness per unit mass of the last
         evaluation [1/s^2] (:math:`\alpha/\Delta t^2` for the mass spring);
-        0 out of contact.
+        0 out of contact; :data:`BORN` for a particle born since the last
+        evaluation (its penetration becomes its allowance).
 
     Returns
     -------
@@ -184,7 +188,7 @@ def wall_contact(x, v, m, vol0, rho, kbulk, dim, point, normal, wall_v,
             pen0[i] = 0.0
             k_last[i] = 0.0
             continue
-        if pen < pen0[i]:
+        if pen < pen0[i] or k_last[i] == BORN:
             pen0[i] = pen
         ext = pen - pen0[i]
         if ext <= 0.0:  # within its allowance
