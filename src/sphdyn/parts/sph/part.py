@@ -206,8 +206,8 @@ class SPHPart:
                                  "add particles of a material the model already has")
             g.idx = np.concatenate([g.idx, new[p.mat[new] == mat]])
         self._derive(n_old, n_new)
-        self.nl = build_neighbours(p.x, p.h, self.kernel.radius_factor, self.skin,
-                                   self.dim, active=self.ul_active)
+        # rebuilt for the new count (the list's storage reused, its builds counted on)
+        self.nl = update_neighbours(self.nl, p.x, p.h, self.dim, self.ul_active)
         if self.tl is None and p.tl.any():  # the first total-Lagrangian particles
             self.tl = TotalLagrangian(p, np.flatnonzero(p.tl), self.kernel, p.young,
                                       self.s.hourglass, self.s.alpha, self.s.beta)
@@ -246,8 +246,9 @@ class SPHPart:
         p.dedt_av[rows] = 0.0
         p.av_signal[rows] = 0.0
         self.ul_active = self._active_mask()
-        self.nl = build_neighbours(p.x, p.h, self.kernel.radius_factor, self.skin, self.dim,
-                                   active=self.ul_active)
+        # rebuilt for the new active set (in place: a blast removes particles at
+        # most steps, so its storage is reused and its builds counted on)
+        self.nl = update_neighbours(self.nl, p.x, p.h, self.dim, self.ul_active)
         self._swegle_at = None
 
     # ----------------------------------------------------------- protocol
