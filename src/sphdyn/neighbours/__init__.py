@@ -35,48 +35,58 @@ threads (bitwise-reproducible runs and restarts).
 Algorithm
 ---------
 1. Bounding box of the active particles (x, y in 2D; x, y, z in 3D).
-2. *Large-h split.* With ``h_cut`` the ``(B+1)``-th largest active ``h``
-   (``B = _BIG_MAX = 64``), if the largest pair radius ``rf*h_max + skin``
-   exceeds ``_BIG_RADIUS_RATIO = 1.5`` times ``rf*h_cut + skin``, the (at
-   most ``B``) particles with ``h > h_cut`` are kept out of the grid in a
-   separate "big" list; otherwise ``h_cut = h_max`` and the big list is
-   empty. This keeps the cells sized by the bulk of the particles when a
-   few particles have a much larger ``h`` (a single-grid cell size equal to
-   the maximum radius would put ``(h_max/h)^dim`` times more candidates in
-   every cell).
-3. Uniform grid of cell size ``cs >= (rf*h_cut + skin) * (1 + 1e-6)`` (the
-   largest pair radius among grid particles, with a margin covering rounding
-   in the cell-index computation). If the grid would have more than
-   ``4 * n_grid + 64`` cells (very sparse clouds, far-apart bodies) the cell
+2. *Split by h* (``grid._choose_h_cut``). When ``h`` varies (largest pair
+   radius ``rf*h_max + skin`` more than ``_SPLIT_MIN_RATIO = 1.05`` times
+   the smallest), the particles with ``h > t`` go to a second, coarse grid
+   and the rest to the fine grid, whose cells are then sized by
+   ``h_cut = max{h <= t}`` instead of ``h_max``. The threshold ``t`` is the
+   best of 32 equal steps between ``h_min`` and ``h_max`` by an estimate of
+   the candidate tests (uniform cloud, ``_split_cost``); a split is taken
+   only if that estimate is below ``_SPLIT_GAIN = 0.75`` of one grid's.
+   Without it, a few large-h particles (explosive products, eroded
+   elements' particles, a graded spacing) set the cell size of every
+   particle: ``(h_max/h)^dim`` times more candidates per cell.
+3. Each grid is uniform over its own particles' box with cell size
+   ``cs >= (rf*h_top + skin) * (1 + 1e-6)`` (``h_top`` its largest h: the
+   largest pair radius among its particles, with a margin covering rounding
+   in the cell-index computation). If a grid would have more than
+   ``4 * n_grid + 64`` cells (very sparse clouds, far-apart bodies) its cell
    size is enlarged until it does not. Degenerate extents (line, plane,
-   single point) give one cell along the flat axes.
-4. Counting sort of the grid particles by flat cell index (stable: ascending
-   particle index within a cell); positions and ``h`` are copied in cell
-   order so that the candidate loop reads contiguous memory, and cells along
-   x are contiguous so each (y, z) row of the stencil is one index range.
+   single point) give one cell along the flat axes. Cell indices of a
+   particle outside a grid's box are clamped to the box (its true stencil's
+   cells within the box are among the clamped stencil's).
+4. Counting sort of each grid's particles by flat cell index (stable:
+   ascending particle index within a cell); positions and ``h`` are copied
+   in cell order so that the candidate loop reads contiguous memory, and
+   cells along x are contiguous so each (y, z) row of the stencil is one
+   index range.
 5. Rows, two passes in ``prange`` over particles visited in cell order
-   (cache locality). Particle ``i`` scans the grid cells within ``k_i``
-   cells of its own cell (``k_i = 1`` for grid particles,
-   ``k_i = ceil(r_i / cs)`` with ``r_i = rf*0.5*(h_i + h_cut) + skin`` for
-   big particles), then tests every big particle directly.
-   (a) Count: branch-free, vectorised candidate loop -> ``counts``; prefix
-   sum -> ``offsets``. (b) Fill: candidates in blocks of 64 give a hit
-   bit mask (vectorised), set bits are visited with count-trailing-zeros and
-   the hits collected in a per-chunk scratch buffer, then stored sorted into
-   ``idx[offsets[i]:offsets[i+1]]`` (rank sort for rows <= 128 entries,
-   heap sort above). Every pair is examined from both ends; each row is
-   written only by its own iteration (gather form, race free). A row whose
-   length differed between the passes (impossible: identical expressions)
-   would raise ``RuntimeError`` rather than write out of bounds.
+   (fine grid, then coarse; cache locality). Particle ``i`` scans, in each
+   grid, the cells within ``k_i`` cells of its own (``k_i = 1`` when its
+   largest pair radius with the grid, ``r_i = rf*0.5*(h_i + h_top) +
+   skin``, fits the grid's cells: always in the coarse grid and for the
+   fine grid's own particles; else ``k_i = ceil(r_i / cs)``).
+   (a) Count: branch-free, vectorised candidate loop -> ``counts`` (``i``
+   itself, found in its grid, subtracted with the same test); prefix sum ->
+   ``offsets``. (b) Fill: candidates in blocks of 64 give a hit bit mask
+   (vectorised), set bits are visited with count-trailing-zeros and the
+   hits other than ``i`` collected in a per-chunk scratch buffer, then
+   stored sorted into ``idx[offsets[i]:offsets[i+1]]`` (rank sort for rows
+   <= 128 entries, heap sort above). Every pair is examined from both ends;
+   each row is written only by its own iteration (gather form, race free).
+   A row whose length differed between the passes (impossible: identical
+   expressions) would raise ``RuntimeError`` rather than write out of
+   bounds.
 
-Cost: ``O(N * (3^dim * n_per_cell + n_big))`` per build; memory ``O(N +
-n_cells + nnz)``.
+Cost: ``O(N * 3^dim * (n_per_fine_cell + n_per_coarse_cell) + n_coarse *
+(2k + 1)^dim * n_per_fine_cell)`` per build; memory ``O(N + n_cells +
+nnz)``.
 
-Limitations: a single uniform grid. If ``h`` varies smoothly over a large
-ratio (so that more than ``B`` particles have a large ``h``) the cell size is
-set by the largest ``h`` and small-``h`` regions scan proportionally more
-candidates. Clouds whose bounding box is huge compared to the particle
-spacing (hit the cell cap) also scan more candidates per cell.
+Limitations: two grids. An ``h`` spread over several scales (a
+fine-to-coarse graded spacing over a factor 10 or more) still scans more
+candidates than a tree or a grid per scale would. Clouds whose bounding box
+is huge compared to the particle spacing (hit the cell cap) also scan more
+candidates per cell.
 
 Modules
 -------

@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from .grid import _bin_particles, _grid_setup
-from .rows import _collect_row, _count_row
+from .grid import _bounds, _choose_h_cut, _make_grid
+from .rows import _collect_cells, _count_cells
 
 # Rows up to this length are sorted by rank sort, longer ones by heap sort.
 _RANK_SORT_MAX = 128
@@ -75,25 +75,26 @@ def _sorted_store(buf, n, out, pos):
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def _count_rows(visit, n_grid, counts, x, h, dim, half_rf, skin, r_grid, lo,
-                inv_cs, nc, cell_start, order, xs, ys, zs, hs, h_cut, big):
+def _count_rows(visit, counts, x, h, dim, half_rf, skin, fine, coarse):
     """Pass 1: ``counts[i + 1]`` = number of neighbours of ``i``.
 
-    ``visit`` lists the grid particles in cell order (``visit[t] ==
-    order[t]`` for ``t < n_grid``) followed by the big particles.
+    ``visit`` lists the fine grid's particles in cell order followed by the
+    coarse grid's (``fine``, ``coarse``: :func:`.grid._make_grid`).
     """
+    has_coarse = coarse[5][-1] > 0
     for t in prange(visit.shape[0]):
         i = visit[t]
-        s_self = t if t < n_grid else -1
-        counts[i + 1] = _count_row(i, s_self, x, h, dim, half_rf, skin,
-                                   r_grid, lo, inv_cs, nc, cell_start, xs, ys,
-                                   zs, hs, h_cut, big)
+        n = _count_cells(i, x, h, dim, half_rf, skin, *fine)
+        if has_coarse:
+            n += _count_cells(i, x, h, dim, half_rf, skin, *coarse)
+        # i itself was counted (it is in one of the grids): the same test
+        r = half_rf * (h[i] + h[i]) + skin
+        counts[i + 1] = n - (0.0 < r * r)
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def _fill_rows(visit, n_grid, offsets, idx, max_row, x, h, dim, half_rf, skin,
-               r_grid, lo, inv_cs, nc, cell_start, order, xs, ys, zs, hs,
-               h_cut, big):
+def _fill_rows(visit, offsets, idx, max_row, x, h, dim, half_rf, skin, fine,
+               coarse):
     """Pass 2: write every row of ``idx`` sorted ascending.
 
     ``visit`` is processed in ``_FILL_CHUNK``-sized chunks, each with its own
@@ -104,14 +105,15 @@ def _fill_rows(visit, n_grid, offsets, idx, max_row, x, h, dim, half_rf, skin,
     nv = visit.shape[0]
     nchunk = (nv + _FILL_CHUNK - 1) // _FILL_CHUNK
     bad = 0
+    has_coarse = coarse[5][-1] > 0
     for c in prange(nchunk):
         buf = np.empty(max_row + 1, dtype=np.int32)
         for t in range(c * _FILL_CHUNK, min(nv, (c + 1) * _FILL_CHUNK)):
             i = visit[t]
-            s_self = t if t < n_grid else -1
-            n = _collect_row(i, s_self, buf, x, h, dim, half_rf, skin, r_grid,
-                             lo, inv_cs, nc, cell_start, order, xs, ys, zs,
-                             hs, h_cut, big)
+            n = _collect_cells(i, 0, buf, x, h, dim, half_rf, skin, *fine)
+            if has_coarse:
+                n = _collect_cells(i, n, buf, x, h, dim, half_rf, skin,
+                                   *coarse)
             cnt = offsets[i + 1] - offsets[i]
             if n != cnt:
                 bad += 1
@@ -195,20 +197,22 @@ def _build_csr(x, h, act, rf, skin, dim, offsets_buf=None, idx_buf=None):
         if idx_buf is None:
             idx_buf = np.empty(0, dtype=np.int32)
         return offsets, idx_buf[:0], idx_buf, 0.0, 0
-    cs, lo, nc, h_cut, r_grid, big_mask = _grid_setup(xa, ha, rf, skin, dim)
+    h_cut, big_mask = _choose_h_cut(ha, xa, rf, skin, dim)
+    half_rf = rf * 0.5
     if big_mask is None:
-        grid_ids = act_ids
         big = np.empty(0, dtype=np.int64)
+        fine, cs = _make_grid(x, h, act_ids, h_cut, half_rf, skin, dim,
+                              _bounds(xa, dim))
     else:
-        grid_ids = act_ids[~big_mask]
         big = act_ids[big_mask]
-    cell_start, order, xs, ys, zs, hs = _bin_particles(x, h, grid_ids, lo,
-                                                       1.0 / cs, nc, dim)
-    n_grid = order.shape[0]
-    visit = np.concatenate((order.astype(np.int64), big))
-    args = (x, h, dim, rf * 0.5, skin, r_grid, lo, 1.0 / cs, nc, cell_start,
-            order, xs, ys, zs, hs, h_cut, big)
-    _count_rows(visit, n_grid, offsets, *args)
+        fine, cs = _make_grid(x, h, act_ids[~big_mask], h_cut, half_rf,
+                              skin, dim)
+    coarse, _ = _make_grid(x, h, big, float(h[big].max()) if big.shape[0]
+                           else 0.0, half_rf, skin, dim)
+    visit = np.concatenate((fine[6].astype(np.int64),
+                            coarse[6].astype(np.int64)))
+    args = (x, h, dim, half_rf, skin, fine, coarse)
+    _count_rows(visit, offsets, *args)
     max_row = int(offsets.max())
     np.cumsum(offsets, out=offsets)
     nnz = int(offsets[-1])
@@ -217,7 +221,7 @@ def _build_csr(x, h, act, rf, skin, dim, offsets_buf=None, idx_buf=None):
         # a longer list writes them, so it costs no memory before)
         idx_buf = np.empty(int(nnz * (1.0 + _IDX_HEADROOM)), dtype=np.int32)
     idx = idx_buf[:nnz]
-    bad = _fill_rows(visit, n_grid, offsets, idx, max_row, *args)
+    bad = _fill_rows(visit, offsets, idx, max_row, *args)
     if bad:
         raise RuntimeError(f"neighbour search: {bad} rows changed length "
                            "between count and fill passes")

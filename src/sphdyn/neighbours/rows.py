@@ -1,10 +1,12 @@
 """Candidate loops of one row: count (pass 1) and collect (pass 2).
 
-Particle ``i`` scans the grid cells of its stencil (:func:`.grid._stencil`)
-and then tests every big (large-h) particle directly, with the pair test of
-the package docstring. ``_count_row`` only counts (branch-free loop);
-``_collect_row`` writes the hits, found 64 candidates at a time through a
-bit mask and count-trailing-zeros (``_cttz``).
+Particle ``i`` scans the cells of its stencil (:func:`.grid._stencil`) in
+the fine grid and then in the coarse grid (the large-h particles; empty when
+there is one grid), with the pair test of the package docstring. A grid is
+the tuple of :func:`.grid._make_grid`, unpacked. ``_count_cells`` only
+counts (branch-free loop); ``_collect_cells`` writes the hits, found 64
+candidates at a time through a bit mask and count-trailing-zeros
+(``_cttz``).
 """
 
 from __future__ import annotations
@@ -18,21 +20,18 @@ from .grid import _stencil
 
 
 @njit(cache=True, error_model="numpy")
-def _count_row(i, s_self, x, h, dim, half_rf, skin, r_grid, lo, inv_cs, nc,
-               cell_start, xs, ys, zs, hs, h_cut, big):
-    """Number of neighbours of particle ``i``.
-
-    ``s_self`` is the sorted position of ``i`` in the grid (-1 if ``i`` is a
-    big particle). The candidate loop is branch-free (it also counts ``i``
-    itself, which is subtracted afterwards with the identical test).
-    """
+def _count_cells(i, x, h, dim, half_rf, skin, lo, inv_cs, nc, r_grid, h_top,
+                 cell_start, order, xs, ys, zs, hs):
+    """Candidates of a grid (:func:`.grid._make_grid`'s tuple, unpacked)
+    within the pair radius of ``i`` (``i`` itself included if it is in the
+    grid); branch-free, vectorised loop."""
     xi0 = x[i, 0]
     xi1 = x[i, 1]
     xi2 = x[i, 2]
     hi = h[i]
     nx, ny = nc[0], nc[1]
     x0, x1, y0, y1, z0, z1 = _stencil(i, x, h, dim, half_rf, skin, r_grid,
-                                      lo, inv_cs, nc, h_cut)
+                                      lo, inv_cs, nc, h_top)
     n = 0
     for zc in range(z0, z1 + 1):
         for yc in range(y0, y1 + 1):
@@ -52,20 +51,6 @@ def _count_row(i, s_self, x, h, dim, half_rf, skin, r_grid, lo, inv_cs, nc,
                     d1 = xi1 - ys[s]
                     r = half_rf * (hi + hs[s]) + skin
                     n += d0 * d0 + d1 * d1 < r * r
-    if s_self >= 0:
-        r = half_rf * (hi + hi) + skin
-        n -= 0.0 < r * r
-    for b in range(big.shape[0]):
-        j = big[b]
-        d0 = xi0 - x[j, 0]
-        d1 = xi1 - x[j, 1]
-        d2 = d0 * d0 + d1 * d1
-        if dim == 3:
-            dz = xi2 - x[j, 2]
-            d2 = d2 + dz * dz
-        r = half_rf * (hi + h[j]) + skin
-        if d2 < r * r and j != i:
-            n += 1
     return n
 
 
@@ -81,16 +66,16 @@ def _cttz(typingctx, v):
 
 
 @njit(cache=True, error_model="numpy")
-def _collect_row(i, s_self, buf, x, h, dim, half_rf, skin, r_grid, lo,
-                 inv_cs, nc, cell_start, order, xs, ys, zs, hs, h_cut, big):
-    """Write the neighbours of ``i`` (unsorted) to ``buf``; return how many.
-
-    Entries beyond ``buf.shape[0]`` are counted but not written.
+def _collect_cells(i, n, buf, x, h, dim, half_rf, skin, lo, inv_cs, nc,
+                   r_grid, h_top, cell_start, order, xs, ys, zs, hs):
+    """Append the neighbours of ``i`` in a grid (:func:`.grid._make_grid`'s
+    tuple, unpacked) to ``buf[n:]``; return the new count (entries beyond
+    ``buf.shape[0]`` counted, not written).
 
     Candidates are tested in blocks of 64: a branch-free (vectorisable) loop
     sets bit ``k`` of a 64-bit mask for a hit at ``s = b0 + k``, then only
     the set bits are visited (count-trailing-zeros), so the scalar part costs
-    O(hits) instead of O(candidates).
+    O(hits) instead of O(candidates). ``i`` itself is skipped.
     """
     xi0 = x[i, 0]
     xi1 = x[i, 1]
@@ -98,8 +83,7 @@ def _collect_row(i, s_self, buf, x, h, dim, half_rf, skin, r_grid, lo,
     hi = h[i]
     nx, ny = nc[0], nc[1]
     x0, x1, y0, y1, z0, z1 = _stencil(i, x, h, dim, half_rf, skin, r_grid,
-                                      lo, inv_cs, nc, h_cut)
-    n = 0
+                                      lo, inv_cs, nc, h_top)
     nbuf = buf.shape[0]
     one = np.uint64(1)
     for zc in range(z0, z1 + 1):
@@ -126,23 +110,10 @@ def _collect_row(i, s_self, buf, x, h, dim, half_rf, skin, r_grid, lo,
                         hit = d0 * d0 + d1 * d1 < r * r
                         m |= np.uint64(hit) << np.uint64(s - b0)
                 while m != 0:
-                    s = b0 + np.int64(_cttz(m))
-                    if s != s_self:
+                    j = order[b0 + np.int64(_cttz(m))]
+                    if j != i:
                         if n < nbuf:
-                            buf[n] = order[s]
+                            buf[n] = j
                         n += 1
                     m &= m - one
-    for b in range(big.shape[0]):
-        j = big[b]
-        d0 = xi0 - x[j, 0]
-        d1 = xi1 - x[j, 1]
-        d2 = d0 * d0 + d1 * d1
-        if dim == 3:
-            dz = xi2 - x[j, 2]
-            d2 = d2 + dz * dz
-        r = half_rf * (hi + h[j]) + skin
-        if d2 < r * r and j != i:
-            if n < nbuf:
-                buf[n] = j
-            n += 1
     return n

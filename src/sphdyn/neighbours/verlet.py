@@ -45,7 +45,8 @@ class NeighbourList:
     cell_size : float
         Grid cell size of the last build [m] (diagnostic).
     n_big : int
-        Number of large-h particles kept out of the grid (diagnostic).
+        Number of large-h particles in the coarse grid of the last build
+        (0: one grid; diagnostic).
     """
 
     def __init__(self, offsets, idx, x_ref, h_ref, skin, radius_factor, dim,
