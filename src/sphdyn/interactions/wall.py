@@ -88,7 +88,11 @@ class Wall(InteractionBase):
         p.add(self._pen0, ())
         p.add(self._k_last, (), fill=BORN)[:] = 0.0  # present at the start: none
         self._dt = self._limit()
-        p.on_grow(lambda n_old, n_new: setattr(self, "_dt", self._limit()))
+        p.on_grow(self._grown)
+
+    def _grown(self, n_old: int, n_new: int) -> None:
+        """Particles were added: the bulk spring's step limit again."""
+        self._dt = self._limit()
 
     def _limit(self) -> float:
         p, w = self.part.p, self.spec
