@@ -296,6 +296,26 @@ def test_a_particle_born_inside_the_wall_thickness_is_allowed_its_penetration():
         assert w.count == (2 if expect > 0 else 1)
 
 
+def test_the_bulk_springs_step_limit_follows_particles_born_later():
+    """Half the bulk spring's limit 2 sqrt(rho V0 / (alpha K V0^((d-2)/d)))
+    over all particles, the born ones included: a particle of a quarter of
+    the volume added later (2D: k independent of V0) halves the step.
+    Round-off tolerance."""
+    alpha, kb = 0.5, 10e9
+    p = _particles([1.0])
+    p.bulk_modulus[:] = kb
+    spec = WallSpec("w", np.zeros(3), np.array([0.0, 1.0, 0.0]), STIFFNESS_BULK,
+                    alpha, 0.0, THICKNESS)
+    w = Wall(spec, SimpleNamespace(p=p))
+    dt0 = 0.5 * 2.0 * np.sqrt(2400.0 * VOL1 / (alpha * kb))
+    assert w.stable_dt() == pytest.approx(dt0, rel=1e-12)
+    rows = p.grow(1, notify=False)
+    p.m[rows], p.vol0[rows], p.rho0[rows] = M1 / 4, VOL1 / 4, 2400.0
+    p.bulk_modulus[rows] = kb
+    p.notify_grown(rows.start, rows.stop)
+    assert w.stable_dt() == pytest.approx(0.5 * dt0, rel=1e-12)
+
+
 def test_a_wall_springs_state_survives_a_restart():
     """The allowances and stiffnesses are the wall's checkpoint state: a wall
     restored from another's state gives the same force bits at the next,
