@@ -181,10 +181,10 @@ def test_lattice_inexact_spacing(dim):
     assert_same(nl, kdtree_neighbours(x, h, RF, skin, dim))
 
 
-@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("dim", [1, 2, 3])
 def test_h_varying_by_factor_10(dim):
-    """Log-uniform h over a factor 10 (single grid sized by h_max) checked
-    with per-particle query_ball_point radii."""
+    """Log-uniform h over a factor 10 (split into a fine and a coarse grid)
+    checked with per-particle query_ball_point radii."""
     rng = np.random.default_rng(20 + dim)
     n = 2000
     x, h = random_cloud(rng, n, dim, h0=0.004 if dim == 2 else 0.01,
@@ -194,7 +194,9 @@ def test_h_varying_by_factor_10(dim):
     assert_same(nl, brute_force_neighbours(x, h, RF, skin, dim))
     assert_same(nl, kdtree_neighbours(x, h, RF, skin, dim, ball=True))
     assert_well_formed(nl)
-    assert max_neighbours(nl) > 3 * mean_neighbours(nl) > 0
+    assert nl.n_big > 0
+    if dim > 1:  # on a line the row lengths grow only as h, not h^dim
+        assert max_neighbours(nl) > 3 * mean_neighbours(nl) > 0
 
 
 @pytest.mark.parametrize("dim", [2, 3])
