@@ -167,7 +167,7 @@ def _bounds(xg, dim):
 
 
 def _split_cost(n, n_big, h_cut, h_max, rf, skin, dim, vol):
-    """Estimated cost of a build whose grid holds the ``n - n_big``
+    """Estimated cost of a build whose fine grid holds the ``n - n_big``
     particles with ``h <= h_cut`` and whose coarse grid the ``n_big`` others
     (arrays of candidates), in pair tests, for particles spread uniformly
     over the volume ``vol``.
