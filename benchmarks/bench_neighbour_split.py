@@ -78,6 +78,7 @@ def _deck_state(deck, start, cache):
     out = (sph.p.x.copy(), sph.p.h.copy(), sph.nl.radius_factor,
            sph.nl.skin, act)
     if cache:
+        os.makedirs(os.path.dirname(os.path.abspath(cache)), exist_ok=True)
         np.savez(cache, x=out[0], h=out[1], rf=out[2], skin=out[3],
                  act=out[4])
     return out
