@@ -228,7 +228,7 @@ def test_many_large_h_particles_use_coarse_grid(dim):
     the coarse grid (more than the 64 the single grid once set aside); the
     fine grid's cells follow the bulk (1.5^dim fewer candidates per cell).
     In 2D the split pays less (the square, not the cube, of the radius
-    ratio, against the cost of the second grid's rows): h 1.2-2.1x there."""
+    ratio, against the cost of the second grid's rows): h 1.1-2.0x there."""
     rng = np.random.default_rng(50 + dim)
     n = 6000
     x, h = random_cloud(rng, n, dim, h0=0.015 if dim == 2 else 0.04)
