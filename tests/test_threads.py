@@ -103,6 +103,22 @@ def test_a_machine_already_loaded_starts_on_one_thread():
     assert tuner.current == 2 and tuner.switches == 1 and used.index(2) < 25
 
 
+def test_long_steps_space_the_trials_by_their_window():
+    # steps of a second (the 5 mm blast slab's detonation) and 1.4 s on one
+    # thread: a trial window is min_steps = 8 of them, 11.2 s, 44.8 times the
+    # nominal 0.25 s, so the schedule stretches by 44.8: the next trials come
+    # 20 x 44.8 = 896 and 40 x 44.8 = 1792 s of stepping after the trial
+    # window (8 steps) ends, not 20 and 40 s (without the stretch: 11.2 s on
+    # the slow count per 20-80 s, 12-36 % of the run)
+    tuner, _ = _tuner()
+    used = _drive(tuner, lambda n, k: 1.0 if n == 2 else 1.4, 3000)
+    assert tuner.current == 2 and tuner.switches == 0
+    starts = [k for k in range(1, len(used)) if used[k] == 1 and used[k - 1] == 2]
+    assert np.array_equal(np.diff(starts), [8 + 896, 8 + 1792]), starts
+    slow = 1.4 * used.count(1)  # seconds on one thread: three trials, 33.6 s
+    assert slow == pytest.approx(3 * 8 * 1.4) and slow / (slow + used.count(2)) < 0.012
+
+
 def test_a_big_node_tries_half_its_cores():
     tuner = ThreadTuner(32, set_threads=lambda n: None, load=-32.0)
     assert tuner.start == 32 and tuner.other == 16

@@ -66,8 +66,13 @@ class ThreadTuner:
     comes after ``warmup`` steps and one reference window; the next after
     ``period`` seconds of stepping, a period that doubles after every trial
     that changed nothing (up to ``max_period``) and starts again from
-    ``period`` after a switch. A trial on the slower count costs one window at
-    its speed, so a long run loses well under 1 %.
+    ``period`` after a switch. These times stretch with the windows: steps
+    longer than ``window / min_steps`` make a window ``s`` times longer than
+    ``window`` (with steps of a second, eight of them make an 8-second window,
+    ``s`` = 32), and the next trial comes ``s`` times later, so a trial on
+    the slower count costs the same share of the stepping whatever the step:
+    one window at its speed per 40-320 windows, and a long run loses well
+    under 1 %.
 
     ``clock`` and ``set_threads`` (``n -> None``) are injectable for tests.
     """
@@ -99,6 +104,7 @@ class ThreadTuner:
         self._win_time = 0.0
         self._win_work = 0.0
         self._win_steps = 0
+        self._stretch = 1.0  # the last trial window's length over ``window``
         self.set_threads(self.current)
 
     @property
@@ -121,6 +127,8 @@ class ThreadTuner:
         if self._win_time < self.window or self._win_steps < self.min_steps:
             return
         rate = self._win_work / max(self._win_time, 1e-12)
+        # the length min_steps of this window's steps take, over ``window``
+        stretch = self.min_steps * self._win_time / (self._win_steps * self.window)
         self._since_trial += self._win_time
         self._win_time = self._win_work = 0.0
         self._win_steps = 0
@@ -131,10 +139,13 @@ class ThreadTuner:
                 self._wait = self.period
             else:
                 self._wait = min(2.0 * self._wait, self.max_period)
+            # steps longer than window / min_steps make longer windows: the
+            # schedule stretches with them (the trials' share stays the same)
+            self._stretch = max(1.0, stretch)
             self.trial = None
             self.set_threads(self.current)
             self._since_trial = 0.0
-        elif self.trials == 0 or self._since_trial >= self._wait:
+        elif self.trials == 0 or self._since_trial >= self._wait * self._stretch:
             self.reference = rate
             self.trial = self.other if self.current == self.n_max else self.n_max
             self.trials += 1
