@@ -522,6 +522,31 @@ def test_a_particle_born_inside_the_contact_thickness_keeps_that_penetration_fre
     assert cp.pen0[0] == pytest.approx(0.002, rel=1e-12)
 
 
+def test_particles_born_keep_the_others_contact_of_the_step():
+    """A particle pressing on the cube's top face (1 mm into its 5 mm
+    thickness, no allowance); then one more particle is born (an element
+    converted later in the same step): the first keeps its face, its force
+    and its shares of the nodes (what withdraw_forces takes back if another
+    element erodes, and what diagnostics read), the new one has none. Before
+    2026-11-28 growth cleared them all."""
+    solid, sph, cp = _cube_and_particle([0.005, 0.005, 0.014], 2.4e-3, 1e-6, 0.012)
+    p = sph.p
+    cp.last_face[:] = -1  # present from the start: no allowance
+    cp.update_geometry(0.0)
+    cp.forces(0.0, 1e-6, np.zeros((1, 3)))
+    face, force, shares = cp.face_of.copy(), cp.force.copy(), cp.shares.copy()
+    assert face[0] >= 0 and force[0, 2] > 0.0 and np.any(shares[0] != 0.0)
+    rows = p.grow(1, notify=False)
+    p.x[rows] = [0.005, 0.005, 0.03]
+    p.m[rows], p.vol0[rows], p.rho0[rows], p.rho[rows] = 2.4e-3, 1e-6, RHO, RHO
+    p.h[rows] = p.h0[rows] = 0.012
+    p.notify_grown(rows.start, rows.stop)
+    assert cp.face_of.shape == (2,) and cp.face_of[0] == face[0] and cp.face_of[1] == -1
+    assert np.array_equal(cp.force[0], force[0]) and np.all(cp.force[1] == 0.0)
+    assert np.array_equal(cp.shares[0], shares[0]) and np.all(cp.shares[1] == 0.0)
+    assert cp.normal_force.shape == (2,) and cp.accel.shape == (2, 3)
+
+
 #: the warped face's normal, a particle's contact thickness f_t V^(1/3) and
 #: the extension e of the spring pressing on it [m] (_warped_column)
 WARP_N = np.array([0.07, 0.0, 1.0]) / np.hypot(0.07, 1.0)

@@ -485,6 +485,13 @@ def _max_shift(x, x_ref, rows):
     return m
 
 
+def _extended(a: np.ndarray, n: int, fill) -> np.ndarray:
+    """``a`` (rows, ...) with rows appended up to ``n``, each holding ``fill``."""
+    out = np.full((n,) + a.shape[1:], fill, dtype=a.dtype)
+    out[:a.shape[0]] = a
+    return out
+
+
 class PenaltyCoupling(InteractionBase):
     """Penalty contact of an SPH part's particles with a solid part's faces.
 
@@ -574,27 +581,42 @@ class PenaltyCoupling(InteractionBase):
         self._dt_step = 0.0  # the springs' step at the last force evaluation [s]
         self._allocate()
         self._tie(float(tie_factor))
-        sph_part.p.on_grow(lambda n_old, n_new: self._allocate())
+        sph_part.p.on_grow(self._grown)
 
     # ------------------------------------------------------------- set-up
-    def _allocate(self) -> None:
+    def _grown(self, n_old: int, n_new: int) -> None:
+        """Particles born (:meth:`ArrayStore.grow`): the arrays extended, the
+        rows of the others kept (this step's contact of each, which
+        :meth:`withdraw_forces` and the diagnostics read)."""
+        self._allocate(keep=True)
+
+    def _allocate(self, keep: bool = False) -> None:
         """Work arrays, the time-step limit and the candidate list for the particles
         (particles added since the last call take their allowance at their
-        first contact evaluation)."""
+        first contact evaluation). The last evaluation's per-particle results
+        (face, shares, forces) are kept for the rows that exist when ``keep``
+        (growth), and cleared otherwise (the faces were renumbered)."""
         p = self.part.p
         n = p.n
         old = self.pen0.size
         if n > old:
-            self.pen0 = np.concatenate([self.pen0, np.zeros(n - old)])
+            self.pen0 = _extended(self.pen0, n, 0.0)
             # born: faced nothing known, so their whole penetration is allowed
-            self.last_face = np.concatenate([self.last_face, np.full(n - old, -2, np.int64)])
-            self.d_last = np.concatenate([self.d_last, np.full(n - old, -np.inf)])
-            self.k_last = np.concatenate([self.k_last, np.zeros(n - old)])
-        self.face_of = np.full(n, -1, dtype=np.int64)
-        self.shares = np.zeros((n, 4, 3))
-        self.force = np.zeros((n, 3))
-        self.normal_force = np.zeros(n)
-        self.accel = np.zeros((n, 3))
+            self.last_face = _extended(self.last_face, n, -2)
+            self.d_last = _extended(self.d_last, n, -np.inf)
+            self.k_last = _extended(self.k_last, n, 0.0)
+        if keep:
+            self.face_of = _extended(self.face_of, n, -1)
+            self.shares = _extended(self.shares, n, 0.0)
+            self.force = _extended(self.force, n, 0.0)
+            self.normal_force = _extended(self.normal_force, n, 0.0)
+            self.accel = _extended(self.accel, n, 0.0)
+        else:
+            self.face_of = np.full(n, -1, dtype=np.int64)
+            self.shares = np.zeros((n, 4, 3))
+            self.force = np.zeros((n, 3))
+            self.normal_force = np.zeros(n)
+            self.accel = np.zeros((n, 3))
         skip = np.zeros(n, dtype=np.bool_)
         if hasattr(self, "tied"):
             skip[self.tied] = True
