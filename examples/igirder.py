@@ -219,7 +219,8 @@ def quasi_static(curve: tuple, ramp: float) -> tuple[np.ndarray, np.ndarray]:
     crack sets it ringing; at the decks' rate it moves the FEM girders'
     curves by up to 10-13 % of their peak against each other): the
     quasi-static force-displacement response, as reactions from an explicit
-    run of a static test are filtered. The first half-window stays as it is."""
+    run of a static test are filtered. The first and last half-windows stay
+    as they are."""
     from sphdyn.interactions.nodal import ramp as ramp_value
 
     d, f = curve
