@@ -80,7 +80,8 @@ VARIANTS = {
     # the particles 1.5x finer (dx = 20/3 mm, six layers through a flange; the
     # bars' trusses as long): how much of the difference to FEM is resolution
     "sph_fine": ("SPH, axial, dx 6.67 mm (89,100 particles)",
-                 [f"body.girder.dx={0.02 / 3!r}", f"mesh.{{bar}}.line.element_length={0.02 / 3!r}"]),
+                 [f"body.girder.dx={0.02 / 3!r}",
+                  f"mesh.{{bar}}.line.element_length={0.02 / 3!r}"]),
 }
 #: variants of igirder_fem.toml: label and overrides (the reference's own spread)
 FEM_VARIANTS = {
