@@ -104,7 +104,7 @@ class ThreadTuner:
         self._win_time = 0.0
         self._win_work = 0.0
         self._win_steps = 0
-        self._stretch = 1.0  # the last trial window's length over ``window``
+        self._stretch = 1.0  # min_steps of the last trial's steps over ``window`` (>= 1)
         self.set_threads(self.current)
 
     @property
