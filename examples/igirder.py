@@ -205,11 +205,12 @@ def table_row(model: str, out: Path, d: np.ndarray, f: np.ndarray) -> tuple:
 
 def ramp_time(model: str) -> float:
     """The load's ramp time of a model [s]: the deck's, or a variant's override."""
+    from sphdyn.deck.units import TIME, to_si
+
     overrides = {**VARIANTS, **FEM_VARIANTS}.get(model, ("", []))[1]
     for o in overrides:
         if o.startswith("boundary.2.ramp_time="):
-            value, unit = o.split("=", 1)[1].strip('"').split()
-            return float(value) * {"ms": 1e-3, "s": 1.0}[unit]
+            return to_si(o.split("=", 1)[1].strip('"'), TIME)
     return RAMP_TIME
 
 
@@ -226,9 +227,9 @@ def quasi_static(curve: tuple, ramp: float) -> tuple[np.ndarray, np.ndarray]:
 
     d, f = curve
     t = np.linspace(0.0, ramp, 8001)
-    dt = DEPTH * np.array([ramp_value(ti, ramp, "smooth") for ti in t])
-    dt = dt[dt <= d.max()]
-    return dt, moving_average(np.interp(dt, d, f), FIRST_MODE / (t[1] - t[0]))
+    d_t = DEPTH * np.array([ramp_value(ti, ramp, "smooth") for ti in t])  # d at t
+    d_t = d_t[d_t <= d.max()]
+    return d_t, moving_average(np.interp(d_t, d, f), FIRST_MODE / (t[1] - t[0]))
 
 
 def worst_difference(ref: tuple, other: tuple) -> float:
