@@ -484,6 +484,32 @@ def test_sure_elastic_test_never_passes_a_yielding_stress():
     assert inside > 500 and said > 0.8 * inside
 
 
+def test_max_principal_and_its_bound():
+    # max_principal() against numpy's eigenvalues (1e-12 of the tensor's
+    # size: the trigonometric formula loses a few digits near equal
+    # eigenvalues); max_principal_bound() (m + 2 sqrt(J2/3), which lets the
+    # damage update skip asin and cos where tau_t cannot rise) is never below
+    # it, compared exactly in floating point as the update compares it, over
+    # 20,000 random strains of sizes 1e-9 to 1e-1; it is attained where the
+    # two smaller eigenvalues are equal (cos(pi/6 - theta) = 1), and it is
+    # not a loose bound elsewhere (within a factor 2 of the deviatoric part).
+    rng = np.random.default_rng(5)
+    for _ in range(20000):
+        e = rng.normal(size=6) * 10.0 ** rng.uniform(-9, -1)
+        t = np.array([[e[0], e[3], e[5]], [e[3], e[1], e[4]], [e[5], e[4], e[2]]])
+        lam = np.linalg.eigvalsh(t)
+        size = np.abs(lam).max()
+        e1 = cscm.max_principal(tuple(e))
+        assert abs(e1 - lam[-1]) <= 1e-12 * size
+        ub = cscm.max_principal_bound(tuple(e))
+        assert ub >= e1
+        m = lam.mean()
+        assert ub - m <= 2.0 * (lam[-1] - m) + 1e-12 * size
+    for a, b in ((3e-3, -1e-3), (-2e-4, -5e-4), (1.0, 1.0)):
+        e = (a, b, b, 0.0, 0.0, 0.0)
+        assert cscm.max_principal_bound(e) == pytest.approx(max(a, b), rel=1e-14)
+
+
 def test_pressure_free_elastic_bound():
     # surely_elastic() first compares sqrt(J2') with P_R0_ELASTIC for J1 >= 0
     # (no exponentials). (1) The bound is its formula, 0.999 min(Q1(0), Q2(0), 1)

@@ -44,7 +44,7 @@ and group kernel). The names of all of them are available from this package.
 
 from ..registry import MaterialModel, register
 from .damage import (DMAX, brittle_softening_c, ductile_softening_a, logistic_damage,
-                     max_principal, transition)
+                     max_principal, max_principal_bound, transition)
 from .defaults import (CONSTANT_DEFAULTS, GFC_PER_GFT, MPA, NU, PARAM_NAMES,
                        PSI_PER_MPA, default_parameters, elastic_moduli,
                        fracture_energy_tension)

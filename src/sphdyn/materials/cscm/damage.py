@@ -65,14 +65,23 @@ def logistic_damage(tau, r0, rate, shape, dmax):
 
 
 @njit(cache=True, error_model="numpy")
-def max_principal(e):
-    """Largest eigenvalue of a symmetric 6-tuple (trigonometric formula)."""
+def _mean_and_j2(e):
+    """Mean ``m``, deviator diagonal ``d0, d1, d2`` and ``J2`` of a symmetric 6-tuple."""
     m = (e[0] + e[1] + e[2]) / 3.0
     d0 = e[0] - m
     d1 = e[1] - m
     d2 = e[2] - m
     j2 = (0.5 * (d0 * d0 + d1 * d1 + d2 * d2)
           + e[3] * e[3] + e[4] * e[4] + e[5] * e[5])
+    return m, d0, d1, d2, j2
+
+
+@njit(cache=True, error_model="numpy")
+def max_principal(e):
+    """Largest eigenvalue of a symmetric 6-tuple (trigonometric formula):
+    ``m + 2 sqrt(J2/3) cos(pi/6 - theta)``, ``sin(3 theta) = (3 sqrt(3)/2)
+    J3 / J2^(3/2)``."""
+    m, d0, d1, d2, j2 = _mean_and_j2(e)
     if j2 <= 1e-300:
         return m
     j3 = (d0 * (d1 * d2 - e[4] * e[4]) - e[3] * (e[3] * d2 - e[4] * e[5])
@@ -81,3 +90,13 @@ def max_principal(e):
     x = min(1.0, max(-1.0, x))
     th = math.asin(x) / 3.0   # in [-pi/6, pi/6]; largest eigenvalue:
     return m + 2.0 * math.sqrt(j2 / 3.0) * math.cos(math.pi / 6.0 - th)
+
+
+@njit(cache=True, error_model="numpy")
+def max_principal_bound(e):
+    """``m + 2 sqrt(J2/3)``, a bound of :func:`max_principal` without its
+    ``asin`` and ``cos``: the same ``m`` and ``2 sqrt(J2/3)``, times
+    ``cos(...) <= 1`` there, so in floating point too
+    ``max_principal(e) <= max_principal_bound(e)`` (rounding is monotone)."""
+    m, _, _, _, j2 = _mean_and_j2(e)
+    return m + 2.0 * math.sqrt(j2 / 3.0)

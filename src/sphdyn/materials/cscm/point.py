@@ -14,7 +14,7 @@ from ..base import (P_G, P_K, ddot6, energy_increment, jaumann_rotate, load_sym6
                     p_wave_speed, rate_split, scale6, store_sym6, young_modulus)
 from ..elastic import elastic_increment
 from .damage import (DMAX, brittle_softening_c, ductile_softening_a, logistic_damage,
-                     max_principal, transition)
+                     max_principal, max_principal_bound, transition)
 from .layout import (H_DB, H_DD, H_EPS, H_ERODED, H_EV, H_KAPPA, H_R0C, H_R0T, H_RATE,
                      H_RF, H_RFMAX, H_SVP, H_TC, H_TT, P_ALPHA, P_BB, P_DD,
                      P_DMAX_POWER, P_ERODE, P_ERODE_STRAIN, P_ETA0C, P_ETA0T, P_GFC,
@@ -190,10 +190,13 @@ def cscm_point(h, deps, dt, p, size):
                     h[H_R0T] = max(math.sqrt(E) * max_principal(e_on), 1e-30)
                 else:
                     h[H_R0C] = max(math.sqrt(max(0.5 * ddot6(s_on, e_on), 0.0)), 1e-30)
-        # damage evolution
+        # damage evolution. logistic_damage is 0 while the damage state
+        # variable has not passed its threshold, so the softening
+        # parameters (transition, pow, log) are formed only past it, and the
+        # largest principal strain only where its bound could raise tau_t:
+        # the same results, with the transcendental functions skipped
         if h[H_R0T] > 0.0 or h[H_R0C] > 0.0:
             J1v, rv = j1_radius(svp)
-            gscale = rf ** p[P_REPOW] if irate else 1.0
             # rate-enhanced thresholds (choice [D]; notes sec. 1.9 [R] only
             # say that they increase with rate): r0 x the largest dynamic-to-
             # static strength ratio reached, so that damage starts at the
@@ -206,31 +209,35 @@ def cscm_point(h, deps, dt, p, size):
                     h[H_RFMAX] = rf
                 rscale = h[H_RFMAX]
             if J1v < 0.0 and h[H_R0T] > 0.0:
-                tau = math.sqrt(E) * max(max_principal(eps), 0.0)
-                if tau > h[H_TT]:
-                    h[H_TT] = tau
-                tr = transition(J1v, rv, p[P_PWRT])
-                gf = (p[P_GFS] + tr * (p[P_GFT] - p[P_GFS])) * gscale
+                sqrt_e = math.sqrt(E)
+                if sqrt_e * max_principal_bound(eps) > h[H_TT]:
+                    tau = sqrt_e * max(max_principal(eps), 0.0)
+                    if tau > h[H_TT]:
+                        h[H_TT] = tau
                 r0 = h[H_R0T] * rscale
-                cc = brittle_softening_c(r0, size, gf, p[P_DD])
-                db = logistic_damage(h[H_TT], r0, cc, p[P_DD], DMAX)
-                if db > h[H_DB]:
-                    h[H_DB] = db
+                if h[H_TT] > r0:
+                    tr = transition(J1v, rv, p[P_PWRT])
+                    gf = (p[P_GFS] + tr * (p[P_GFT] - p[P_GFS])) * damage_scale(rf, irate, p)
+                    cc = brittle_softening_c(r0, size, gf, p[P_DD])
+                    db = logistic_damage(h[H_TT], r0, cc, p[P_DD], DMAX)
+                    if db > h[H_DB]:
+                        h[H_DB] = db
             elif J1v >= 0.0 and h[H_R0C] > 0.0:
                 tau = math.sqrt(max(0.5 * ddot6(svp, eps), 0.0))
                 if tau > h[H_TC]:
                     h[H_TC] = tau
-                tr = transition(J1v, rv, p[P_PWRC])
-                gf = (p[P_GFS] + tr * (p[P_GFC] - p[P_GFS])) * gscale
                 r0 = h[H_R0C] * rscale
-                aa = ductile_softening_a(r0, size, gf, p[P_BB], p[P_LI2B])
-                # maximum ductile damage vs confinement: choice [D] (formula
-                # not retrieved, notes sec. 1.9): DMAX (sqrt(3 J2')/J1)^power
-                ratio = math.sqrt(3.0) * rv / J1v if J1v > 0.0 else 1.0
-                dmax = DMAX * (min(ratio, 1.0) ** p[P_DMAX_POWER])
-                dd = logistic_damage(h[H_TC], r0, aa, p[P_BB], dmax)
-                if dd > h[H_DD]:
-                    h[H_DD] = dd
+                if h[H_TC] > r0:
+                    tr = transition(J1v, rv, p[P_PWRC])
+                    gf = (p[P_GFS] + tr * (p[P_GFC] - p[P_GFS])) * damage_scale(rf, irate, p)
+                    aa = ductile_softening_a(r0, size, gf, p[P_BB], p[P_LI2B])
+                    # maximum ductile damage vs confinement: choice [D] (formula
+                    # not retrieved, notes sec. 1.9): DMAX (sqrt(3 J2')/J1)^power
+                    ratio = math.sqrt(3.0) * rv / J1v if J1v > 0.0 else 1.0
+                    dmax = DMAX * (min(ratio, 1.0) ** p[P_DMAX_POWER])
+                    dd = logistic_damage(h[H_TC], r0, aa, p[P_BB], dmax)
+                    if dd > h[H_DD]:
+                        h[H_DD] = dd
     h[H_RF] = rf
     for k in range(6):
         h[H_SVP + k] = svp[k]
@@ -258,6 +265,14 @@ def cscm_point(h, deps, dt, p, size):
             h[H_SVP + 3 + k] = 0.0
         return (m, m, m, 0.0, 0.0, 0.0), 1.0
     return scale6(svp, 1.0 - d), d
+
+
+@njit(cache=True, error_model="numpy")
+def damage_scale(rf, irate, p):
+    """Fracture-energy scale ``rf^REPOW`` of the rate effects (1 without them):
+    the softening's ``GF`` grows with the dynamic-to-static strength ratio
+    ``rf`` (notes sec. 1.10 [V name, R form])."""
+    return rf ** p[P_REPOW] if irate else 1.0
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
