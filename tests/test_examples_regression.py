@@ -38,6 +38,14 @@ meridian's exact curvature, and a trial between the apex and J1 = 0 taking
 the nearer of the two pieces' closest points (deliberate, docs/cscm.md:
 returns move within the 1e-11 tolerance, or to the nearer piece); the 15
 decks with a plastic CSCM point in their steps were rewritten.
+2026-11-28 (issue 17): the SPH force pass works each pair once and writes
+both particles (the slab colouring, parts/sph/colouring.py): the order of
+every particle's sum changed (round-off). The 22 decks with an
+updated-Lagrangian SPH body were rewritten: particle arrays within 1e-12 of
+their largest value (the detonation decks' shock fronts: gurney_1d 1.7e-7,
+sod_shock_tube 1.5e-9 of the largest acceleration), history columns the
+same except those that vanish by symmetry (which move by their own size,
+1e-45 to 1e-2 N); the FEM and total-Lagrangian decks are bitwise as before.
 """
 
 import subprocess

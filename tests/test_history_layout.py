@@ -113,22 +113,28 @@ def _run(*bodies):
 
 def test_concrete_and_steel_particles_in_one_part_match_their_runs_alone():
     """A CSCM block and a J2 block (120 mm apart, beyond each other's supports)
-    stretched in one run give the same stress and history, bit for bit, as
-    each block alone (one material in the deck, its columns from 0) at the
-    same fixed step: each kernel works on its own columns (the steel's
-    plastic strain in the column after CSCM's), the
-    other columns of its rows stay at zero. The steel has yielded and the
-    concrete's state moved, so a wrong column would show."""
+    stretched in one run give the same stress and history as each block
+    alone (one material in the deck, its columns from 0) at the same fixed
+    step: each kernel works on its own columns (the steel's plastic strain in
+    the column after CSCM's), the other columns of its rows stay at zero. The
+    steel has yielded and the concrete's state moved, so a wrong column would
+    show at O(1). Tolerance 1e-13 of each array's largest value: the force
+    pass's slabs span the whole part (parts/sph/colouring.py), so with the
+    other block present the particles' sums are added in another order
+    (round-off, 2e-15 seen); the columns left at zero are compared exactly."""
     both = _run(("concrete", "concrete", 0), ("steel", "steel", 120))
     alone_c = _run(("concrete", "concrete", 0))
     alone_s = _run(("steel", "steel", 120))
     cscm = get_model("cscm").history_names
     nc = alone_c.n
     assert both.hist_names == list(cscm) + ["plastic_strain"]
-    assert np.array_equal(both.sig[:nc], alone_c.sig)
-    assert np.array_equal(both.sig[nc:], alone_s.sig)
-    assert np.array_equal(both.hist[:nc, :len(cscm)], alone_c.hist)
-    assert np.array_equal(both.hist[nc:, len(cscm)], alone_s.hist[:, 0])
+    def same(a, b):
+        return np.abs(a - b).max() <= 1e-13 * np.abs(b).max()
+
+    assert same(both.sig[:nc], alone_c.sig)
+    assert same(both.sig[nc:], alone_s.sig)
+    assert same(both.hist[:nc, :len(cscm)], alone_c.hist)
+    assert same(both.hist[nc:, len(cscm)], alone_s.hist[:, 0])
     assert np.all(both.hist[:nc, len(cscm)] == 0.0) and np.all(both.hist[nc:, :len(cscm)] == 0.0)
     eps_p = history_column(both, "plastic_strain")[nc:]
     assert eps_p.max() > 1e-3

@@ -6,6 +6,7 @@ import pytest
 from sphdyn import kernels
 from sphdyn.geometry import box_lattice
 from sphdyn.neighbours import build_neighbours
+from sphdyn.parts.sph.colouring import pair_colouring
 from sphdyn.parts.sph.passes import (GRADIENT_CHUNKS, GRADIENT_ROWS, forces, gradient_scratch,
                                      stress_terms,
                                      update_density_and_h, velocity_gradient, xsph_velocity)
@@ -189,7 +190,7 @@ def _forces(c, sig, v=None, correct=False, alpha=0.0, beta=0.0, cs=1000.0):
     P = np.zeros((n, 3, 3))
     stress_terms(sig, c["rho"], B, P)
     forces(c["x"], v, c["m"], c["rho"], c["h"], np.full(n, cs), P, F,
-           nl.offsets, count, nl.idx, c["dim"], 1.0, np.full(n, alpha), np.full(n, beta),
+           nl.offsets, count, nl.idx, *pair_colouring(c["x"], nl.offsets, nl.idx), c["dim"], 1.0, np.full(n, alpha), np.full(n, beta),
            a, dedt, np.zeros(n))
     return a, dedt
 
@@ -242,7 +243,8 @@ def test_rows_hold_the_pairs_within_the_support_first(dim):
     stress_terms(sig, c["rho"], B, P)
     a_all, heat_all = np.zeros_like(a_head), np.zeros_like(heat_head)
     forces(x, v, c["m"], c["rho"], h, np.full(x.shape[0], 1000.0), P, F, nl.offsets,
-           np.diff(nl.offsets).astype(np.int32), nl.idx, dim, 1.0, np.ones(x.shape[0]),
+           np.diff(nl.offsets).astype(np.int32), nl.idx,
+           *pair_colouring(x, nl.offsets, nl.idx), dim, 1.0, np.ones(x.shape[0]),
            np.full(x.shape[0], 2.0), a_all, heat_all, np.zeros(x.shape[0]))
     assert np.array_equal(a_head, a_all) and np.array_equal(heat_head, heat_all)
 
@@ -505,18 +507,27 @@ def test_pair_stress_and_viscosity_match_their_formulas(alpha, beta, approach):
     # each particle its own coefficients: the pair takes their means
     alphas, betas = alpha * np.array([0.5, 1.5]), beta * np.array([1.5, 0.5])
     signal = np.zeros(2)
-    forces(x, v, m, rho, h, c, P, F, offsets, count, idx, 3, support_scale, alphas, betas,
-           a, dedt, signal)
+    col = pair_colouring(x, offsets, idx)
+    forces(x, v, m, rho, h, c, P, F, offsets, count, idx, *col, 3, support_scale, alphas,
+           betas, a, dedt, signal)
     acc, heat, pi = _pair_acceleration(x, v, m, rho, h, c, S, B, F[0], support_scale,
                                        alpha, beta)
     assert (pi != 0.0) == approach
     scale = m[1] * np.abs(F[0] * (x[0] - x[1])).max() * (np.abs(S).max() + abs(pi))
     assert np.abs(a[0] - acc).max() < 1e-12 * scale
     assert dedt[0] == pytest.approx(heat, rel=1e-12, abs=0.0)
+    # particle 1's terms, written to its row by row 0 (the pass works each
+    # pair once): the same formula with the particles swapped
+    sw = slice(None, None, -1)
+    acc1, heat1, _ = _pair_acceleration(x[sw], v[sw], m[sw], rho[sw], h[sw], c[sw], S[sw],
+                                        B[sw], F[1], support_scale, alpha, beta)
+    scale1 = m[0] * np.abs(F[0] * (x[0] - x[1])).max() * (np.abs(S).max() + abs(pi))
+    assert np.abs(a[1] - acc1).max() < 1e-12 * scale1
+    assert dedt[1] == pytest.approx(heat1, rel=1e-12, abs=0.0)
     if approach:
         # the viscous part alone, separately: with zero stress the
         # acceleration is -m_j Pi_ij g_ij exactly
-        forces(x, v, m, rho, h, c, np.zeros_like(P), F, offsets, count, idx, 3,
+        forces(x, v, m, rho, h, c, np.zeros_like(P), F, offsets, count, idx, *col, 3,
                support_scale, alphas, betas, a, dedt, signal)
         expect = -m[1] * pi * F[0] * (x[0] - x[1])
         assert np.allclose(a[0], expect, rtol=1e-12, atol=0.0)
@@ -527,8 +538,9 @@ def test_pair_stress_and_viscosity_match_their_formulas(alpha, beta, approach):
         mu = hij * np.dot(v[0] - v[1], d) / (np.dot(d, d) + 0.01 * hij ** 2)
         expect = alpha * 0.5 * (c[0] + c[1]) + beta * abs(mu)
         assert signal[0] == pytest.approx(expect, rel=1e-12)
+        assert signal[1] == signal[0]
     else:
-        assert signal[0] == 0.0  # no approaching pair, no viscous signal
+        assert signal[0] == 0.0 and signal[1] == 0.0  # no approaching pair, no viscous signal
 
 
 def test_history_counts_particles_held_at_a_density_limit():

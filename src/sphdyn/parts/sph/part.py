@@ -41,6 +41,7 @@ from ...neighbours import build_neighbours, mean_neighbours, update_neighbours
 from ...state import BC_FIXED, Particles
 from ..base import register_part
 from .artificial_stress import artificial_stress_forces, artificial_stress_tensor
+from .colouring import pair_colouring
 from .passes import (forces, gradient_scratch, stress_terms, update_density_and_h,
                      velocity_gradient, xsph_velocity)
 from .swegle import FLAG_FRACTION, REL_STRESS_TOL, count_unstable, stress_scale, swegle_indicator
@@ -140,6 +141,9 @@ class SPHPart:
         # row buffers of velocity_gradient, sized for the list they were made for
         self._scratch = None
         self._scratch_list = None
+        # the force pass's slab colouring, made for the list it was made for
+        self._colouring = None
+        self._colouring_list = None
         #: callables run after every pass of :meth:`_gradients` (before the
         #: stress divergence): a coupling may zero pair factors ``F`` there
         self.pair_filters: list = []
@@ -373,6 +377,7 @@ class SPHPart:
         nl.idx = arrays["nl_idx"].copy()
         nl.x_ref = arrays["nl_x_ref"].copy()
         nl.h_ref = arrays["nl_h_ref"].copy()
+        self._colouring_list = None  # the restored list's slabs
         # the lists were built without the particles removed by then
         self.ul_active = self._active_mask()
         nl.active_ref = None if self.ul_active is None else self.ul_active.copy()
@@ -416,8 +421,10 @@ class SPHPart:
         if self.has_ul:
             stress_terms(p.sig, p.rho, p.B, p.S)
             alpha, beta, signal = self._viscosity_arrays()
+            col = self._pair_colouring()
             forces(p.x, p.v, p.m, p.rho, p.h, p.c, p.S, self.F, nl.offsets, p.n_support,
-                   nl.idx, self.dim, k.support_scale, alpha, beta, p.a, p.dedt_av, signal)
+                   nl.idx, col.rank, col.order, col.start, self.dim, k.support_scale, alpha,
+                   beta, p.a, p.dedt_av, signal)
         if self.as_on:
             artificial_stress_tensor(p.sig, p.rho, p.as_eps, p.R, p.Q)
             artificial_stress_forces(p.x, p.m, p.h, p.R, self.F, nl.offsets, nl.idx,
@@ -435,6 +442,17 @@ class SPHPart:
             self._scratch = gradient_scratch(nl.offsets, self._scratch)
             self._scratch_list = (id(nl), nl.n_builds)
         return self._scratch
+
+    def _pair_colouring(self):
+        """The slabs of :func:`.colouring.pair_colouring` for the current list,
+        at the positions it was built from; made again after a rebuild or a
+        restore."""
+        nl = self.nl
+        key = (id(nl), nl.n_builds, id(nl.idx))
+        if self._colouring_list != key:
+            self._colouring = pair_colouring(nl.x_ref, nl.offsets, nl.idx, nl.active_ref)
+            self._colouring_list = key
+        return self._colouring
 
     def _viscosity_arrays(self):
         """``(alpha, beta, signal)`` for :func:`.passes.forces`: the particles'

@@ -1,8 +1,11 @@
-r"""Gather-form SPH passes of the updated-Lagrangian ("Eulerian kernel") solid scheme.
+r"""SPH passes of the updated-Lagrangian ("Eulerian kernel") solid scheme.
 
-Each pass loops over particles ``i`` in ``prange`` and over the neighbours ``j``
-of ``i`` (CSR rows ``idx[offsets[i]:offsets[i+1]]``) and writes only row ``i``,
-so the loops are race-free. Pair quantities use the mean smoothing length
+Each pass but :func:`forces` loops over particles ``i`` in ``prange`` and over
+the neighbours ``j`` of ``i`` (CSR rows ``idx[offsets[i]:offsets[i+1]]``) and
+writes only row ``i`` (gather form), so the loops are race-free;
+:func:`forces` works each pair once and writes both rows, race-free by the
+slab colouring of :mod:`.colouring`. Pair quantities use the mean smoothing
+length
 
 .. math:: h_{ij} = \kappa \, (h_i + h_j) / 2,
 
@@ -419,9 +422,109 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
             _gradient_row(i, x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_scale,
                           False, F, L, B, count)
 
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _force_row(i, x, v, m, rho, h, c, P, F, offsets, count, idx, rank, three, support_scale,
+               alpha, beta, a, dedt_av, signal):
+    """Row ``i`` of :func:`forces`: its own pairs (``rank[j] > rank[i]``), their
+    terms added to row ``i`` and written to row ``j``."""
+    per_particle = alpha.shape[0] > 1
+    want_signal = signal.shape[0] > 0
+    p00 = P[i, 0, 0]
+    p01 = P[i, 0, 1]
+    p02 = P[i, 0, 2]
+    p10 = P[i, 1, 0]
+    p11 = P[i, 1, 1]
+    p12 = P[i, 1, 2]
+    p20 = P[i, 2, 0]
+    p21 = P[i, 2, 1]
+    p22 = P[i, 2, 2]
+    xi0 = x[i, 0]
+    xi1 = x[i, 1]
+    xi2 = x[i, 2]
+    vi0 = v[i, 0]
+    vi1 = v[i, 1]
+    vi2 = v[i, 2]
+    hi = h[i]
+    ci = c[i]
+    rhoi = rho[i]
+    mi = m[i]
+    ri = rank[i]
+    alphai = alpha[i] if per_particle else alpha[0]
+    betai = beta[i] if per_particle else beta[0]
+    a0 = a1 = a2 = 0.0
+    heat = 0.0
+    sig_max = 0.0
+    for k in range(offsets[i], offsets[i] + count[i]):
+        j = idx[k]
+        if rank[j] < ri:  # worked by row j
+            continue
+        f = F[k]
+        mj = m[j]
+        if f == 0.0 or (mj == 0.0 and mi == 0.0):  # taken out by a coupling; no mass
+            continue
+        d0 = xi0 - x[j, 0]
+        d1 = xi1 - x[j, 1]
+        w0 = vi0 - v[j, 0]
+        w1 = vi1 - v[j, 1]
+        if three:
+            d2 = xi2 - x[j, 2]
+            w2 = vi2 - v[j, 2]
+        else:
+            d2 = 0.0
+            w2 = 0.0
+        g0 = f * d0
+        g1 = f * d1
+        g2 = f * d2
+        f0 = (p00 + P[j, 0, 0]) * g0 + (p01 + P[j, 0, 1]) * g1 + (p02 + P[j, 0, 2]) * g2
+        f1 = (p10 + P[j, 1, 0]) * g0 + (p11 + P[j, 1, 1]) * g1 + (p12 + P[j, 1, 2]) * g2
+        f2 = 0.0
+        if three:
+            f2 = ((p20 + P[j, 2, 0]) * g0 + (p21 + P[j, 2, 1]) * g1
+                  + (p22 + P[j, 2, 2]) * g2)
+        # artificial viscosity, approaching pairs only
+        vx = w0 * d0 + w1 * d1 + w2 * d2
+        q = 0.0
+        if vx < 0.0:
+            hij = support_scale * 0.5 * (hi + h[j])
+            r2 = d0 * d0 + d1 * d1 + d2 * d2
+            mu = hij * vx / (r2 + 0.01 * hij * hij)
+            if per_particle:
+                aij = 0.5 * (alphai + alpha[j]) * 0.5 * (ci + c[j])
+                bij = 0.5 * (betai + beta[j])
+            else:
+                aij = alphai * 0.5 * (ci + c[j])
+                bij = betai
+            pi_ij = (-aij * mu + bij * mu * mu) / (0.5 * (rhoi + rho[j]))
+            if want_signal:
+                s_ij = aij - bij * mu  # mu < 0
+                if mj != 0.0 and s_ij > sig_max:
+                    sig_max = s_ij
+                if mi != 0.0 and s_ij > signal[j]:
+                    signal[j] = s_ij
+            f0 -= pi_ij * g0
+            f1 -= pi_ij * g1
+            f2 -= pi_ij * g2
+            q = 0.5 * pi_ij * (w0 * g0 + w1 * g1 + w2 * g2)
+        a0 += mj * f0
+        a1 += mj * f1
+        a2 += mj * f2
+        heat += mj * q
+        a[j, 0] -= mi * f0
+        a[j, 1] -= mi * f1
+        a[j, 2] -= mi * f2
+        dedt_av[j] += mi * q
+    a[i, 0] += a0
+    a[i, 1] += a1
+    a[i, 2] += a2
+    dedt_av[i] += heat
+    if want_signal and sig_max > signal[i]:
+        signal[i] = sig_max
+
+
 @njit(cache=True, error_model="numpy", parallel=True)
-def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, dim, support_scale, alpha, beta,
-           a, dedt_av, signal):
+def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, rank, order, start, dim,
+           support_scale, alpha, beta, a, dedt_av, signal):
     r"""Acceleration from the stress divergence and Monaghan artificial viscosity.
 
     Symmetric (momentum-conserving) form of Gray, Monaghan & Swift (2001),
@@ -454,6 +557,17 @@ def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, dim, support_scale, al
     contribute nothing; a zero-mass particle still gets an acceleration (it
     moves as an interpolation point).
 
+    Each pair is worked once, by the row of lower ``rank``, and its terms
+    written to both rows (:math:`\mathbf g_{ji} = -\mathbf g_{ij}`,
+    :math:`\Pi_{ji} = \Pi_{ij}`: the pair's acceleration terms are
+    :math:`m_j \mathbf f_{ij}` on i and :math:`-m_i \mathbf f_{ij}` on j, its
+    heating and signal speed the same on both), the slabs of
+    :func:`~sphdyn.parts.sph.colouring.pair_colouring` taken in two colours
+    so that no two threads write one row: half the arithmetic of a gather
+    over both rows (BENCHMARKS.md, 2026-11-28). The order of each row's
+    additions is fixed by the colouring, so the results are the same for
+    any number of threads.
+
     Parameters
     ----------
     x, v : (N, 3) positions [m], velocities [m/s].
@@ -465,6 +579,8 @@ def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, dim, support_scale, al
     offsets, count, idx : the neighbour list and the pairs within the support
         at the head of each row (:func:`velocity_gradient`); only those are
         visited.
+    rank, order, start : the list's slab colouring
+        (:class:`~sphdyn.parts.sph.colouring.PairColouring`).
     alpha, beta : (N,) artificial-viscosity coefficients of each particle
         [-], or (1,) the one value of all (no per-pair means to form).
     a : (N, 3) out, acceleration [m/s^2].
@@ -474,87 +590,20 @@ def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, dim, support_scale, al
     """
     n = x.shape[0]
     three = dim == 3
-    per_particle = alpha.shape[0] > 1
-    want_signal = signal.shape[0] > 0
     for i in prange(n):
-        p00 = P[i, 0, 0]
-        p01 = P[i, 0, 1]
-        p02 = P[i, 0, 2]
-        p10 = P[i, 1, 0]
-        p11 = P[i, 1, 1]
-        p12 = P[i, 1, 2]
-        p20 = P[i, 2, 0]
-        p21 = P[i, 2, 1]
-        p22 = P[i, 2, 2]
-        xi0 = x[i, 0]
-        xi1 = x[i, 1]
-        xi2 = x[i, 2]
-        vi0 = v[i, 0]
-        vi1 = v[i, 1]
-        vi2 = v[i, 2]
-        hi = h[i]
-        ci = c[i]
-        rhoi = rho[i]
-        alphai = alpha[i] if per_particle else alpha[0]
-        betai = beta[i] if per_particle else beta[0]
-        a0 = a1 = a2 = 0.0
-        heat = 0.0
-        sig_max = 0.0
-        for k in range(offsets[i], offsets[i] + count[i]):
-            j = idx[k]
-            f = F[k]
-            mj = m[j]
-            if f == 0.0 or mj == 0.0:  # a pair a coupling took out; a zero-mass j
-                continue
-            d0 = xi0 - x[j, 0]
-            d1 = xi1 - x[j, 1]
-            w0 = vi0 - v[j, 0]
-            w1 = vi1 - v[j, 1]
-            if three:
-                d2 = xi2 - x[j, 2]
-                w2 = vi2 - v[j, 2]
-            else:
-                d2 = 0.0
-                w2 = 0.0
-            g0 = f * d0
-            g1 = f * d1
-            g2 = f * d2
-            f0 = (p00 + P[j, 0, 0]) * g0 + (p01 + P[j, 0, 1]) * g1 + (p02 + P[j, 0, 2]) * g2
-            f1 = (p10 + P[j, 1, 0]) * g0 + (p11 + P[j, 1, 1]) * g1 + (p12 + P[j, 1, 2]) * g2
-            f2 = 0.0
-            if three:
-                f2 = ((p20 + P[j, 2, 0]) * g0 + (p21 + P[j, 2, 1]) * g1
-                      + (p22 + P[j, 2, 2]) * g2)
-            # artificial viscosity, approaching pairs only
-            vx = w0 * d0 + w1 * d1 + w2 * d2
-            if vx < 0.0:
-                hij = support_scale * 0.5 * (hi + h[j])
-                r2 = d0 * d0 + d1 * d1 + d2 * d2
-                mu = hij * vx / (r2 + 0.01 * hij * hij)
-                if per_particle:
-                    aij = 0.5 * (alphai + alpha[j]) * 0.5 * (ci + c[j])
-                    bij = 0.5 * (betai + beta[j])
-                else:
-                    aij = alphai * 0.5 * (ci + c[j])
-                    bij = betai
-                pi_ij = (-aij * mu + bij * mu * mu) / (0.5 * (rhoi + rho[j]))
-                if want_signal:
-                    s_ij = aij - bij * mu  # mu < 0
-                    if s_ij > sig_max:
-                        sig_max = s_ij
-                f0 -= pi_ij * g0
-                f1 -= pi_ij * g1
-                f2 -= pi_ij * g2
-                heat += 0.5 * mj * pi_ij * (w0 * g0 + w1 * g1 + w2 * g2)
-            a0 += mj * f0
-            a1 += mj * f1
-            a2 += mj * f2
-        a[i, 0] = a0
-        a[i, 1] = a1
-        a[i, 2] = a2
-        dedt_av[i] = heat
-        if want_signal:
-            signal[i] = sig_max
+        a[i, 0] = 0.0
+        a[i, 1] = 0.0
+        a[i, 2] = 0.0
+        dedt_av[i] = 0.0
+    for i in prange(signal.shape[0]):
+        signal[i] = 0.0
+    slabs = start.shape[0] - 1
+    for colour in range(2):
+        for t in prange((slabs - colour + 1) // 2):
+            s = colour + 2 * t
+            for r in range(start[s], start[s + 1]):
+                _force_row(order[r], x, v, m, rho, h, c, P, F, offsets, count, idx, rank,
+                           three, support_scale, alpha, beta, a, dedt_av, signal)
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
