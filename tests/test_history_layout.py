@@ -128,6 +128,7 @@ def test_concrete_and_steel_particles_in_one_part_match_their_runs_alone():
     cscm = get_model("cscm").history_names
     nc = alone_c.n
     assert both.hist_names == list(cscm) + ["plastic_strain"]
+
     def same(a, b):
         return np.abs(a - b).max() <= 1e-13 * np.abs(b).max()
 

@@ -190,8 +190,8 @@ def _forces(c, sig, v=None, correct=False, alpha=0.0, beta=0.0, cs=1000.0):
     P = np.zeros((n, 3, 3))
     stress_terms(sig, c["rho"], B, P)
     forces(c["x"], v, c["m"], c["rho"], c["h"], np.full(n, cs), P, F,
-           nl.offsets, count, nl.idx, *pair_colouring(c["x"], nl.offsets, nl.idx), c["dim"], 1.0, np.full(n, alpha), np.full(n, beta),
-           a, dedt, np.zeros(n))
+           nl.offsets, count, nl.idx, *pair_colouring(c["x"], nl.offsets, nl.idx), c["dim"],
+           1.0, np.full(n, alpha), np.full(n, beta), a, dedt, np.zeros(n))
     return a, dedt
 
 
