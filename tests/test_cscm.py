@@ -730,6 +730,23 @@ def test_rate_enhanced_damage_thresholds():
     assert np.array_equal(a["stress"], b["stress"])
 
 
+def test_fracture_energy_grows_with_rate_by_repow():
+    # notes sec. 1.10 [V name, R form]: with rate effects the softening's GF
+    # is multiplied by rf^REPOW (rf the dynamic-to-static strength ratio).
+    # (1) damage_scale is that formula (and 1 without rate effects), exactly;
+    # (2) in uniaxial tension at 100/s to 0.3 % strain (rf reaches 2.9),
+    # REPOW 0, 1, 2 leave less and less damage (measured 0.97, 0.70, 0.33): a
+    # missing or constant scale would give three equal values.
+    for repow in (0.0, 1.0, 2.0):
+        p = packed(rate_effects=True, repow=repow)
+        assert cscm.damage_scale(1.7, True, p) == 1.7 ** repow
+        assert cscm.damage_scale(1.7, False, p) == 1.0
+    final = [drive("cscm", {**BASE, "rate_effects": True, "repow": repow},
+                   "uniaxial-tension", strain=0.003, n_steps=600, rate=100.0)["damage"][-1]
+             for repow in (0.0, 1.0, 2.0)]
+    assert final[0] > final[1] + 0.1 > final[2] + 0.2
+
+
 def test_deck_keys_reach_the_parameters():
     # [[material]] cap_retraction, rate_thresholds and recovery 10-11 (RECOV
     # option 2) are packed into the parameter vector of the model.

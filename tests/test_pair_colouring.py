@@ -82,13 +82,16 @@ def _gather(c, alpha, beta, support_scale=1.0):
     return a, heat, sig
 
 
-def _run(c, alpha, beta, col=None):
+def _run(c, alpha, beta, signal=True):
+    """The pass on the cloud, its outputs filled with NaN first (it must write
+    every row); ``signal=False``: the signal speed not wanted."""
     n = c["x"].shape[0]
     nl = c["nl"]
-    col = pair_colouring(c["x"], nl.offsets, nl.idx) if col is None else col
-    a, heat, sig = np.full((n, 3), np.nan), np.full(n, np.nan), np.full(n, np.nan)
+    a, heat = np.full((n, 3), np.nan), np.full(n, np.nan)
+    sig = np.full(n if signal else 0, np.nan)
     forces(c["x"], c["v"], c["m"], c["rho"], c["h"], c["c"], c["P"], c["F"], nl.offsets,
-           c["count"], nl.idx, *col, c["dim"], 1.0, alpha, beta, a, heat, sig)
+           c["count"], nl.idx, *pair_colouring(c["x"], nl.offsets, nl.idx), c["dim"], 1.0,
+           alpha, beta, a, heat, sig)
     return a, heat, sig
 
 
@@ -141,11 +144,7 @@ def test_each_pair_once_equals_the_gather_over_both_rows(dim, shape):
     ma = (c["m"][:, None] * a).sum(axis=0)
     assert np.abs(ma).max() <= 1e-13 * (c["m"][:, None] * np.abs(a)).sum()
     # one value for all (no pair means), the signal not wanted
-    a1 = np.zeros((n, 3))
-    heat1 = np.zeros(n)
-    col = pair_colouring(c["x"], nl.offsets, nl.idx)
-    forces(c["x"], c["v"], c["m"], c["rho"], c["h"], c["c"], c["P"], c["F"], nl.offsets,
-           c["count"], nl.idx, *col, dim, 1.0, alpha[:1], beta[:1], a1, heat1, np.zeros(0))
+    a1, heat1, _ = _run(c, alpha[:1], beta[:1], signal=False)
     a1_ref, heat1_ref, _ = _gather(c, np.full(n, alpha[0]), np.full(n, beta[0]))
     assert np.abs(a1 - a1_ref).max() <= 1e-13 * np.abs(a1_ref).max()
     assert np.abs(heat1 - heat1_ref).max() <= 1e-13 * np.abs(heat1_ref).max()

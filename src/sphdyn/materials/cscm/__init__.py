@@ -51,7 +51,7 @@ from .defaults import (CONSTANT_DEFAULTS, GFC_PER_GFT, MPA, NU, PARAM_NAMES,
 from .layout import *  # noqa: F401,F403  (P_* parameter and H_* history indices)
 from .layout import HISTORY_NAMES, N_PARAMS
 from .packing import cscm_parameters, dilog_neg, initial_history, kappa0, pack_cscm
-from .point import N_STRIPES, cscm_point, cscm_update
+from .point import N_STRIPES, cscm_point, cscm_update, damage_scale
 from .projection import (NGOLDEN, NSCAN, project, project_from_trial, project_global,
                          project_on_meridian, yield_fraction)
 from .schema import CscmParams

@@ -448,7 +448,7 @@ class SPHPart:
         at the positions it was built from; made again after a rebuild or a
         restore."""
         nl = self.nl
-        key = (id(nl), nl.n_builds, id(nl.idx))
+        key = (id(nl), nl.n_builds)
         if self._colouring_list != key:
             self._colouring = pair_colouring(nl.x_ref, nl.offsets, nl.idx, nl.active_ref)
             self._colouring_list = key
