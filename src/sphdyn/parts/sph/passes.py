@@ -199,10 +199,9 @@ def finish_row(i, dim, correct, l00, l01, l02, l10, l11, l12, l20, l21, l22,
 
 
 #: rows of a chunk's row buffer in :func:`_buffered_row` (pair ``t`` of the
-#: row within the support in column ``t``): x_i - x_j, r^2, h_j, v_j - v_i,
-#: m_j / rho_i, then the pair's m_j F_ij / rho_i and its gradient g
-_D0, _D1, _D2, _R2, _HJ, _U0, _U1, _U2, _WM, _FW, _G0, _G1, _G2 = range(13)
-GRADIENT_ROWS = 13
+#: row within the support in column ``t``): r^2 and h_j
+_R2, _HJ = range(2)
+GRADIENT_ROWS = 2
 #: contiguous particle chunks of the buffered pass (each a row buffer)
 GRADIENT_CHUNKS = 64
 
@@ -223,10 +222,14 @@ def _buffered_row(i, x, v, h, m, rho, offsets, idx, sigma, support_scale, correc
                   count, W):
     """Row ``i`` of :func:`velocity_gradient` for the 3D cubic spline, the same
     operations in the same order as :func:`_gradient_row` (the same bits),
-    in three loops over the row buffer ``W`` (GRADIENT_ROWS, width): (1) gather and
-    partition, (2) the kernel factors and the pair gradients, pair by pair
-    independent, which the compiler turns into SIMD instructions, (3) the
-    row's sums, in the row's order."""
+    in three loops: (1) the partition, keeping ``r^2`` and ``h_j`` of the
+    pairs within the support in the row buffer ``W`` (GRADIENT_ROWS, width),
+    (2) their kernel factors, pair by pair independent, which the compiler
+    turns into SIMD instructions, into ``F``, (3) the row's sums, in the
+    row's order, the neighbours' positions and velocities read again. Only
+    two numbers per pair go through the buffer: the first loop is bound by
+    its stores (BENCHMARKS.md, 2026-11-28 later), and reading a neighbour
+    again, just read, costs less than storing what the sums need."""
     xi0 = x[i, 0]
     xi1 = x[i, 1]
     xi2 = x[i, 2]
@@ -251,17 +254,9 @@ def _buffered_row(i, x, v, h, m, rho, offsets, idx, sigma, support_scale, correc
             idx[k] = idx[head]
             F[k] = 0.0
             idx[head] = j
-        t = head - o
+        W[_R2, head - o] = r2
+        W[_HJ, head - o] = hj
         head += 1
-        W[_D0, t] = d0
-        W[_D1, t] = d1
-        W[_D2, t] = d2
-        W[_R2, t] = r2
-        W[_HJ, t] = hj
-        W[_U0, t] = v[j, 0] - vi0
-        W[_U1, t] = v[j, 1] - vi1
-        W[_U2, t] = v[j, 2] - vi2
-        W[_WM, t] = m[j] * irho
     c = head - o
     count[i] = c
     for t in range(c):
@@ -270,24 +265,23 @@ def _buffered_row(i, x, v, h, m, rho, offsets, idx, sigma, support_scale, correc
         scale = sigma * ih2 * ih2
         scale *= ih
         # the kernel's own w'(q)/q, inlined: both pieces formed, one selected
-        fk = np.float64(np.float32(scale * dwdq_over_q(0, simd_sqrt(W[_R2, t]) * ih)))
-        F[o + t] = fk
-        f = fk * W[_WM, t]
-        W[_FW, t] = f
-        W[_G0, t] = f * W[_D0, t]
-        W[_G1, t] = f * W[_D1, t]
-        W[_G2, t] = f * W[_D2, t]
+        F[o + t] = np.float32(scale * dwdq_over_q(0, simd_sqrt(W[_R2, t]) * ih))
     l00 = l01 = l02 = l10 = l11 = l12 = l20 = l21 = l22 = 0.0
     m00 = m01 = m02 = m11 = m12 = m22 = 0.0
-    for t in range(c):
-        if W[_FW, t] == 0.0:
+    for k in range(o, head):
+        j = idx[k]
+        f = np.float64(F[k]) * (m[j] * irho)
+        if f == 0.0:
             continue
-        g0 = W[_G0, t]
-        g1 = W[_G1, t]
-        g2 = W[_G2, t]
-        u0 = W[_U0, t]
-        u1 = W[_U1, t]
-        u2 = W[_U2, t]
+        d0 = xi0 - x[j, 0]
+        d1 = xi1 - x[j, 1]
+        d2 = xi2 - x[j, 2]
+        g0 = f * d0
+        g1 = f * d1
+        g2 = f * d2
+        u0 = v[j, 0] - vi0
+        u1 = v[j, 1] - vi1
+        u2 = v[j, 2] - vi2
         l00 += u0 * g0
         l01 += u0 * g1
         l02 += u0 * g2
@@ -298,12 +292,12 @@ def _buffered_row(i, x, v, h, m, rho, offsets, idx, sigma, support_scale, correc
         l21 += u2 * g1
         l22 += u2 * g2
         if correct:  # (x_j - x_i) = -d
-            m00 -= W[_D0, t] * g0
-            m01 -= W[_D0, t] * g1
-            m02 -= W[_D0, t] * g2
-            m11 -= W[_D1, t] * g1
-            m12 -= W[_D1, t] * g2
-            m22 -= W[_D2, t] * g2
+            m00 -= d0 * g0
+            m01 -= d0 * g1
+            m02 -= d0 * g2
+            m11 -= d1 * g1
+            m12 -= d1 * g2
+            m22 -= d2 * g2
     finish_row(i, 3, correct, l00, l01, l02, l10, l11, l12, l20, l21, l22,
                m00, m01, m02, m11, m12, m22, L, B)
 
@@ -352,10 +346,10 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
     carry no branch on the kernel or the dimension and no moment sums they
     do not use (BENCHMARKS.md, 2026-11-26: a spilled sum cost more than its
     arithmetic). The 3D cubic-spline forms work each row through a row
-    buffer (:func:`_buffered_row`): the kernel factors and pair gradients of
-    a row's pairs, independent of each other, are formed in SIMD
-    instructions; the sums keep the row's order, so the bits are those of
-    the pair-by-pair row (BENCHMARKS.md, 2026-11-27 later).
+    buffer (:func:`_buffered_row`): the kernel factors of a row's pairs,
+    independent of each other, are formed in SIMD instructions; the sums
+    keep the row's order, so the bits are those of the pair-by-pair row
+    (BENCHMARKS.md, 2026-11-27 later and 2026-11-28 later).
 
     The pass also stores the kernel-gradient factor of every pair,
 
