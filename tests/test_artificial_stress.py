@@ -84,9 +84,10 @@ def _cloud(dim, n_side=8, dx=0.01, hfac=1.3, jitter=0.2, seed=0):
     F = np.zeros(nl.idx.size, dtype=np.float32)
     L = np.zeros((n, 3, 3))
     B = np.zeros((n, 3, 3))
-    velocity_gradient(x, np.zeros((n, 3)), h, m, rho, nl.offsets, nl.idx, kid,
-                      kernels.normalisation(kid, dim), dim, 1.0, False, F, L, B,
-                      np.zeros(n, np.int32), gradient_scratch(nl.offsets))
+    velocity_gradient(x, np.zeros((n, 3)), h, m, rho, nl.offsets, nl.idx,
+                      np.diff(nl.offsets).astype(np.int32), kid, kernels.normalisation(kid, dim),
+                      dim, 1.0, False, F, L, B, np.zeros(n, np.int32),
+                      gradient_scratch(nl.offsets))
     sig = rng.normal(scale=1e6, size=(n, 3, 3))
     sig = 0.5 * (sig + sig.transpose(0, 2, 1))
     if dim == 2:

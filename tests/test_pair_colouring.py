@@ -17,7 +17,8 @@ import pytest
 
 from sphdyn import kernels
 from sphdyn.neighbours import build_neighbours
-from sphdyn.parts.sph.colouring import MAX_SLABS, pair_colouring
+from sphdyn.parts.sph.colouring import (MAX_SLABS, balanced_bounds, colour_pairs,
+                                        own_pairs_first, pair_colouring)
 from sphdyn.parts.sph.passes import forces, gradient_scratch, velocity_gradient
 
 
@@ -39,15 +40,16 @@ def _cloud(dim, shape, dx=0.01, seed=0):
     v = rng.normal(scale=5.0, size=(n, 3))
     if dim == 2:
         v[:, 2] = 0.0
+    col, n_own = colour_pairs(x, nl.offsets, nl.idx)
     F = np.zeros(nl.idx.size, np.float32)
     count = np.zeros(n, np.int32)
-    velocity_gradient(x, v, h, m, rho, nl.offsets, nl.idx, kid,
+    velocity_gradient(x, v, h, m, rho, nl.offsets, nl.idx, n_own, kid,
                       kernels.normalisation(kid, dim), dim, 1.0, False, F,
                       np.zeros((n, 3, 3)), np.zeros((n, 3, 3)), count,
                       gradient_scratch(nl.offsets))
     P = rng.normal(scale=1.0, size=(n, 3, 3))  # sigma B / rho^2 [Pa m^6/kg^2]
     return dict(x=x, v=v, m=m, rho=rho, h=h, c=rng.uniform(2000.0, 4000.0, n), P=P,
-                F=F, count=count, nl=nl, dim=dim)
+                F=F, count=count, nl=nl, dim=dim, col=col, n_own=n_own)
 
 
 def _gather(c, alpha, beta, support_scale=1.0):
@@ -55,11 +57,11 @@ def _gather(c, alpha, beta, support_scale=1.0):
     from the formula of :func:`forces` (pairs with ``F = 0`` or a zero-mass
     neighbour contribute nothing; in 2D no z component)."""
     x, v, m, rho, h, cs, P, F = (c[k] for k in ("x", "v", "m", "rho", "h", "c", "P", "F"))
-    nl, count = c["nl"], c["count"]
+    nl = c["nl"]
     n = x.shape[0]
     a, heat, sig = np.zeros((n, 3)), np.zeros(n), np.zeros(n)
     for i in range(n):
-        for k in range(nl.offsets[i], nl.offsets[i] + count[i]):
+        for k in range(nl.offsets[i], nl.offsets[i + 1]):  # whole rows (skin: F = 0)
             j = nl.idx[k]
             if F[k] == 0.0 or m[j] == 0.0:
                 continue
@@ -90,8 +92,8 @@ def _run(c, alpha, beta, signal=True):
     a, heat = np.full((n, 3), np.nan), np.full(n, np.nan)
     sig = np.full(n if signal else 0, np.nan)
     forces(c["x"], c["v"], c["m"], c["rho"], c["h"], c["c"], c["P"], c["F"], nl.offsets,
-           c["count"], nl.idx, *pair_colouring(c["x"], nl.offsets, nl.idx), c["dim"], 1.0,
-           alpha, beta, a, heat, sig)
+           c["count"], nl.idx, c["col"].order, c["col"].start, c["dim"], 1.0, alpha, beta, a,
+           heat, sig)
     return a, heat, sig
 
 
@@ -190,3 +192,73 @@ def test_a_far_particle_makes_thicker_slabs_not_huge_arrays():
     active[0] = False
     _, _, start_active = pair_colouring(x, offsets, idx, active)
     assert start_active.size - 1 >= 2
+
+
+def test_balanced_bounds_split_the_weight_evenly_or_give_up():
+    # 100 points of weight 1 at y = 0..99: quantile bounds, the largest
+    # multiple of 4 slabs whose inner slabs are at least `width` thick.
+    y = np.arange(100.0)
+    w = np.ones(100, np.int64)
+    assert np.array_equal(balanced_bounds(y, w, 20.0), [24.0, 49.0, 74.0])  # 4 slabs of 25
+    b = balanced_bounds(y, w, 10.0)  # 9 slabs of 10 fit: 8 of 12.5
+    assert b.size == 7 and np.diff(b).min() >= 10.0
+    counts = np.bincount(np.searchsorted(b, y, side="right"))
+    assert counts.size == 8 and counts.min() == 12 and counts.max() == 13
+    assert balanced_bounds(y, w, 30.0) is None  # 3 slabs at most: not 4
+    # points without weight (no pairs) do not count, wherever they are
+    y2 = np.concatenate([y, [1.0e4]])
+    assert np.array_equal(balanced_bounds(y2, np.append(w, 0), 20.0), [24.0, 49.0, 74.0])
+
+
+def test_slabs_share_the_pairs_evenly_where_the_body_allows():
+    # A cylinder lying along x (a disc's cross-section in y-z): slabs of
+    # equal thickness hold few pairs at the ends, many in the middle, which
+    # a static two-thread split of each colour shares unevenly. The slabs
+    # hold equal shares instead (within two rows' weight: the bounds fall on
+    # particles), a multiple of 4 of them, each pair still in one slab or two
+    # adjacent ones.
+    rng = np.random.default_rng(5)
+    g = np.arange(-20, 21) * 0.01
+    x = np.stack(np.meshgrid(g, g[:4], g, indexing="ij"), -1).reshape(-1, 3)
+    x = x[x[:, 0] ** 2 + x[:, 2] ** 2 <= 0.2 ** 2]
+    x += 0.002 * rng.uniform(-1, 1, x.shape)
+    h = np.full(x.shape[0], 0.012)
+    nl = build_neighbours(x, h, kernels.support(0), 0.1 * 0.024, 3)
+    rank, order, start = pair_colouring(x, nl.offsets, nl.idx)
+    slabs = start.size - 1
+    assert slabs >= 8 and slabs % 4 == 0
+    slab = np.repeat(np.arange(slabs), np.diff(start))[rank]
+    rows = np.repeat(np.arange(x.shape[0]), np.diff(nl.offsets))
+    assert np.abs(slab[rows] - slab[nl.idx]).max() <= 1
+    weight = np.bincount(slab[rows], minlength=slabs)
+    assert np.abs(weight - weight.mean()).max() <= 2 * np.diff(nl.offsets).max()
+    # slabs of equal thickness (as many as fit) would not: the end ones hold
+    # under 2/3 of the mean
+    y = x[:, 0] - x[:, 0].min()
+    longest = np.abs(x[rows, 0] - x[nl.idx, 0]).max()
+    thin = int(y.max() / longest)
+    uniform = np.bincount(np.minimum((y / (y.max() / thin)).astype(int), thin - 1)[rows])
+    assert uniform[0] < (2 / 3) * uniform.mean() and uniform[-1] < (2 / 3) * uniform.mean()
+    assert np.abs(weight - weight.mean()).max() < 0.1 * weight.mean()
+
+
+def test_own_pairs_first_puts_each_pair_in_one_row_head():
+    # Each row's first n_own pairs are those of higher rank (the pairs the
+    # force pass works from this row), in the order they had, the others
+    # after them in theirs; every pair of the symmetric list is own in
+    # exactly one of its two rows.
+    c = _cloud(3, (12, 5, 4), seed=6)
+    nl = c["nl"]
+    rng = np.random.default_rng(1)
+    for i in range(c["x"].shape[0]):  # rows out of order
+        row = nl.idx[nl.offsets[i]:nl.offsets[i + 1]]
+        row[:] = rng.permutation(row)
+    before = nl.idx.copy()
+    rank = pair_colouring(c["x"], nl.offsets, nl.idx).rank
+    n_own = own_pairs_first(rank, nl.offsets, nl.idx)
+    for i in range(c["x"].shape[0]):
+        old = before[nl.offsets[i]:nl.offsets[i + 1]]
+        new = nl.idx[nl.offsets[i]:nl.offsets[i + 1]]
+        assert list(new[:n_own[i]]) == [j for j in old if rank[j] > rank[i]]
+        assert list(new[n_own[i]:]) == [j for j in old if rank[j] < rank[i]]
+    assert 2 * n_own.sum() == nl.idx.size

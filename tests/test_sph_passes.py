@@ -6,7 +6,7 @@ import pytest
 from sphdyn import kernels
 from sphdyn.geometry import box_lattice
 from sphdyn.neighbours import build_neighbours
-from sphdyn.parts.sph.colouring import pair_colouring
+from sphdyn.parts.sph.colouring import colour_pairs
 from sphdyn.parts.sph.passes import (GRADIENT_CHUNKS, GRADIENT_ROWS, forces, gradient_scratch,
                                      stress_terms,
                                      update_density_and_h, velocity_gradient, xsph_velocity)
@@ -40,15 +40,20 @@ def _interior(c, layers):
     return np.flatnonzero(ok)
 
 
-def _grad(c, v, correct, with_factors=False):
+def _grad(c, v, correct, with_factors=False, n_own=None):
+    """The gradient pass on the cloud; rows of one part (``count`` all the
+    pairs within the support) unless ``n_own`` is given (colour_pairs)."""
     n = c["x"].shape[0]
     L = np.zeros((n, 3, 3))
     B = np.zeros((n, 3, 3))
     nl = c["nl"]
     F = np.zeros(nl.idx.size, dtype=np.float32)  # as the part stores them
     count = np.zeros(n, np.int32)
-    velocity_gradient(c["x"], v, c["h"], c["m"], c["rho"], nl.offsets, nl.idx, c["kid"], c["sigma"],
-                      c["dim"], 1.0, correct, F, L, B, count, gradient_scratch(nl.offsets))
+    if n_own is None:
+        n_own = np.diff(nl.offsets).astype(np.int32)
+    velocity_gradient(c["x"], v, c["h"], c["m"], c["rho"], nl.offsets, nl.idx, n_own, c["kid"],
+                      c["sigma"], c["dim"], 1.0, correct, F, L, B, count,
+                      gradient_scratch(nl.offsets))
     return (L, B, F, count) if with_factors else (L, B)
 
 
@@ -180,19 +185,22 @@ def test_boundary_gradient_is_wrong_without_correction(dim):
     assert np.abs(L - A).max() > 0.1 * np.abs(A).max()
 
 
-def _forces(c, sig, v=None, correct=False, alpha=0.0, beta=0.0, cs=1000.0):
+def _forces(c, sig, v=None, correct=False, alpha=0.0, beta=0.0, cs=1000.0, full=False):
+    """The force pass on the cloud (its list coloured: the own pairs first);
+    ``full``: also returns the pass's inputs."""
     n = c["x"].shape[0]
     v = np.zeros((n, 3)) if v is None else v
-    L, B, F, count = _grad(c, v, correct, with_factors=True)
+    nl = c["nl"]
+    col, n_own = colour_pairs(c["x"], nl.offsets, nl.idx)
+    L, B, F, count = _grad(c, v, correct, with_factors=True, n_own=n_own)
     a = np.zeros((n, 3))
     dedt = np.zeros(n)
-    nl = c["nl"]
     P = np.zeros((n, 3, 3))
     stress_terms(sig, c["rho"], B, P)
-    forces(c["x"], v, c["m"], c["rho"], c["h"], np.full(n, cs), P, F,
-           nl.offsets, count, nl.idx, *pair_colouring(c["x"], nl.offsets, nl.idx), c["dim"],
-           1.0, np.full(n, alpha), np.full(n, beta), a, dedt, np.zeros(n))
-    return a, dedt
+    forces(c["x"], v, c["m"], c["rho"], c["h"], np.full(n, cs), P, F, nl.offsets, count,
+           nl.idx, col.order, col.start, c["dim"], 1.0, np.full(n, alpha), np.full(n, beta),
+           a, dedt, np.zeros(n))
+    return (a, dedt, (col, n_own, P, F)) if full else (a, dedt)
 
 
 @pytest.mark.parametrize("dim", [2, 3])
@@ -203,8 +211,9 @@ def test_rows_hold_the_pairs_within_the_support_first(dim):
     # (F = 0, r >= support), the factors those of the kernel in single
     # precision (to float32's 1.2e-7); L is the same as from the sorted rows (to
     # round-off: only zero terms moved) and bitwise the same on a second
-    # call (the head's order is kept). The forces pass visits only the head:
-    # the same accelerations as over whole rows (count = row length).
+    # call (the head's order is kept). The forces pass visits only the head
+    # of each row's own part: the same accelerations as over the whole own
+    # part (count = n_own, its skin pairs with F = 0).
     c = _cloud(dim, n_side=8, jitter=0.3)
     x, h = c["x"], c["h"]
     q = kernels.support(c["kid"])
@@ -238,13 +247,11 @@ def test_rows_hold_the_pairs_within_the_support_first(dim):
     assert np.allclose(L, L0, rtol=0.0, atol=1e-13 * np.abs(L0).max())
     sig = np.random.default_rng(5).normal(scale=1e6, size=(x.shape[0], 3, 3))
     sig = 0.5 * (sig + sig.transpose(0, 2, 1))
-    a_head, heat_head = _forces(c, sig, v=v, correct=True, alpha=1.0, beta=2.0)
-    P = np.zeros_like(sig)
-    stress_terms(sig, c["rho"], B, P)
+    a_head, heat_head, (col, n_own, P, F) = _forces(c, sig, v=v, correct=True, alpha=1.0,
+                                                    beta=2.0, full=True)
     a_all, heat_all = np.zeros_like(a_head), np.zeros_like(heat_head)
-    forces(x, v, c["m"], c["rho"], h, np.full(x.shape[0], 1000.0), P, F, nl.offsets,
-           np.diff(nl.offsets).astype(np.int32), nl.idx,
-           *pair_colouring(x, nl.offsets, nl.idx), dim, 1.0, np.ones(x.shape[0]),
+    forces(x, v, c["m"], c["rho"], h, np.full(x.shape[0], 1000.0), P, F, nl.offsets, n_own,
+           nl.idx, col.order, col.start, dim, 1.0, np.ones(x.shape[0]),
            np.full(x.shape[0], 2.0), a_all, heat_all, np.zeros(x.shape[0]))
     assert np.array_equal(a_head, a_all) and np.array_equal(heat_head, heat_all)
 
@@ -501,15 +508,15 @@ def test_pair_stress_and_viscosity_match_their_formulas(alpha, beta, approach):
     support_scale = 1.2
     F = np.array([-4e9, -4e9])  # the pair factor of both rows (a symmetric pair)
     offsets, idx = np.array([0, 1, 2]), np.array([1, 0], dtype=np.int32)
-    count = np.ones(2, np.int32)
     a = np.zeros((2, 3))
     dedt = np.zeros(2)
     # each particle its own coefficients: the pair takes their means
     alphas, betas = alpha * np.array([0.5, 1.5]), beta * np.array([1.5, 0.5])
     signal = np.zeros(2)
-    col = pair_colouring(x, offsets, idx)
-    forces(x, v, m, rho, h, c, P, F, offsets, count, idx, *col, 3, support_scale, alphas,
-           betas, a, dedt, signal)
+    col, count = colour_pairs(x, offsets, idx)  # the pair is row 0's own
+    assert list(count) == [1, 0]
+    forces(x, v, m, rho, h, c, P, F, offsets, count, idx, col.order, col.start, 3,
+           support_scale, alphas, betas, a, dedt, signal)
     acc, heat, pi = _pair_acceleration(x, v, m, rho, h, c, S, B, F[0], support_scale,
                                        alpha, beta)
     assert (pi != 0.0) == approach
@@ -527,8 +534,8 @@ def test_pair_stress_and_viscosity_match_their_formulas(alpha, beta, approach):
     if approach:
         # the viscous part alone, separately: with zero stress the
         # acceleration is -m_j Pi_ij g_ij exactly
-        forces(x, v, m, rho, h, c, np.zeros_like(P), F, offsets, count, idx, *col, 3,
-               support_scale, alphas, betas, a, dedt, signal)
+        forces(x, v, m, rho, h, c, np.zeros_like(P), F, offsets, count, idx, col.order,
+               col.start, 3, support_scale, alphas, betas, a, dedt, signal)
         expect = -m[1] * pi * F[0] * (x[0] - x[1])
         assert np.allclose(a[0], expect, rtol=1e-12, atol=0.0)
         assert heat > 0.0  # viscosity only heats
@@ -584,19 +591,34 @@ def test_buffered_gradient_rows_give_the_pair_by_pair_bits(correct):
         row = nl.idx[nl.offsets[i]:nl.offsets[i + 1]]
         row[:] = rng.permutation(row)
     lengths = np.diff(nl.offsets)
-    results = []
-    for width in (None, 0, int(np.median(lengths))):
-        scratch = gradient_scratch(nl.offsets) if width is None else np.zeros((GRADIENT_CHUNKS, GRADIENT_ROWS, width))
-        idx = nl.idx.copy()
-        F = np.zeros(idx.size, np.float32)
-        L = np.zeros((n, 3, 3))
-        B = np.zeros((n, 3, 3))
-        count = np.zeros(n, np.int32)
-        velocity_gradient(c["x"], v, h, m, c["rho"], nl.offsets, idx, 0, c["sigma"], 3, 1.0,
-                          correct, F, L, B, count, scratch)
-        results.append((L, B, F, count, idx))
-    assert (count := results[0][3]).min() > 10 and (lengths - count).min() > 0  # skin pairs
-    assert not np.array_equal(results[0][4], nl.idx)  # the partition moved pairs
-    for other in results[1:]:
-        for a, b in zip(results[0], other):
-            assert np.array_equal(a, b)
+    def forms(own):
+        """L, B, F, count and the list from each form (own: the first parts)."""
+        results = []
+        for width in (None, 0, int(np.median(lengths))):
+            scratch = (gradient_scratch(nl.offsets) if width is None
+                       else np.zeros((GRADIENT_CHUNKS, GRADIENT_ROWS, width)))
+            idx = nl.idx.copy()
+            F = np.zeros(idx.size, np.float32)
+            L = np.zeros((n, 3, 3))
+            B = np.zeros((n, 3, 3))
+            count = np.zeros(n, np.int32)
+            velocity_gradient(c["x"], v, h, m, c["rho"], nl.offsets, idx, own, 0, c["sigma"], 3,
+                              1.0, correct, F, L, B, count, scratch)
+            results.append((L, B, F, count, idx))
+        count = results[0][3]
+        assert count.mean() > 3 and (own - count).min() >= 0 and (own - count).max() > 0
+        assert not np.array_equal(results[0][4], nl.idx)  # the partition moved pairs
+        for other in results[1:]:
+            for a, b in zip(results[0], other):
+                assert np.array_equal(a, b)
+        return results[0]
+
+    # rows of one part, then of two (the own pairs first, as the part runs it)
+    forms(lengths.astype(np.int32))
+    n_own = colour_pairs(c["x"], nl.offsets, nl.idx)[1]
+    assert 0 < n_own.mean() < lengths.mean()
+    idx = forms(n_own)[4]
+    for i in range(n):  # each part keeps its pairs
+        lo, mid, hi = nl.offsets[i], nl.offsets[i] + n_own[i], nl.offsets[i + 1]
+        assert sorted(idx[lo:mid]) == sorted(nl.idx[lo:mid])
+        assert sorted(idx[mid:hi]) == sorted(nl.idx[mid:hi])

@@ -41,7 +41,7 @@ from ...neighbours import build_neighbours, mean_neighbours, update_neighbours
 from ...state import BC_FIXED, Particles
 from ..base import register_part
 from .artificial_stress import artificial_stress_forces, artificial_stress_tensor
-from .colouring import pair_colouring
+from .colouring import colour_pairs
 from .passes import (forces, gradient_scratch, stress_terms, update_density_and_h,
                      velocity_gradient, xsph_velocity)
 from .swegle import FLAG_FRACTION, REL_STRESS_TOL, count_unstable, stress_scale, swegle_indicator
@@ -403,9 +403,10 @@ class SPHPart:
                 self._F_buf = np.empty(int(need * 1.1), dtype=np.float32)
             self.F = self._F_buf[:need]
         if self.has_ul:
-            velocity_gradient(p.x, p.v, p.h, p.m, p.rho, nl.offsets, nl.idx, k.kid, k.sigma,
-                              self.dim, k.support_scale, self.s.correction, self.F, p.L,
-                              p.B, p.n_support, self._gradient_scratch())
+            n_own = self._pair_colouring()[1]
+            velocity_gradient(p.x, p.v, p.h, p.m, p.rho, nl.offsets, nl.idx, n_own, k.kid,
+                              k.sigma, self.dim, k.support_scale, self.s.correction, self.F,
+                              p.L, p.B, p.n_support, self._gradient_scratch())
         if self.tl is not None:
             self.tl.velocity_gradient(p)
         for f in self.pair_filters:
@@ -421,10 +422,10 @@ class SPHPart:
         if self.has_ul:
             stress_terms(p.sig, p.rho, p.B, p.S)
             alpha, beta, signal = self._viscosity_arrays()
-            col = self._pair_colouring()
+            col = self._pair_colouring()[0]
             forces(p.x, p.v, p.m, p.rho, p.h, p.c, p.S, self.F, nl.offsets, p.n_support,
-                   nl.idx, col.rank, col.order, col.start, self.dim, k.support_scale, alpha,
-                   beta, p.a, p.dedt_av, signal)
+                   nl.idx, col.order, col.start, self.dim, k.support_scale, alpha, beta, p.a,
+                   p.dedt_av, signal)
         if self.as_on:
             artificial_stress_tensor(p.sig, p.rho, p.as_eps, p.R, p.Q)
             artificial_stress_forces(p.x, p.m, p.h, p.R, self.F, nl.offsets, nl.idx,
@@ -444,13 +445,14 @@ class SPHPart:
         return self._scratch
 
     def _pair_colouring(self):
-        """The slabs of :func:`.colouring.pair_colouring` for the current list,
-        at the positions it was built from; made again after a rebuild or a
-        restore."""
+        """``(colouring, n_own)`` of :func:`.colouring.colour_pairs` for the
+        current list, at the positions it was built from (the own pairs put
+        first in each row); made again after a rebuild or a restore, before
+        the gradient pass orders the rows (which keeps them first)."""
         nl = self.nl
         key = (id(nl), nl.n_builds)
         if self._colouring_list != key:
-            self._colouring = pair_colouring(nl.x_ref, nl.offsets, nl.idx, nl.active_ref)
+            self._colouring = colour_pairs(nl.x_ref, nl.offsets, nl.idx, nl.active_ref)
             self._colouring_list = key
         return self._colouring
 

@@ -3,9 +3,9 @@ r"""SPH passes of the updated-Lagrangian ("Eulerian kernel") solid scheme.
 Each pass but :func:`forces` loops over particles ``i`` in ``prange`` and over
 the neighbours ``j`` of ``i`` (CSR rows ``idx[offsets[i]:offsets[i+1]]``) and
 writes only row ``i`` (gather form), so the loops are race-free;
-:func:`forces` works each pair once and writes both rows, race-free by the
-slab colouring of :mod:`.colouring`. Pair quantities use the mean smoothing
-length
+:func:`forces` works each pair once (from the row that owns it) and writes
+both rows, race-free by the slab colouring of :mod:`.colouring`. Pair
+quantities use the mean smoothing length
 
 .. math:: h_{ij} = \kappa \, (h_i + h_j) / 2,
 
@@ -70,8 +70,8 @@ def stress_terms(sig, rho, B, P):
                 P[i, a, b] = s0 * B[i, 0, b] + s1 * B[i, 1, b] + s2 * B[i, 2, b]
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _gradient_row(i, x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_scale, correct,
-                  F, L, B, count):
+def _gradient_row(i, x, v, h, m, rho, offsets, idx, n_own, kid, sigma, dim, support_scale,
+                  correct, F, L, B, count):
     """Row ``i`` of :func:`velocity_gradient` (its docstring); inlined into
     each of the pass's compiled forms, where ``kid``, ``dim`` and ``correct``
     may be constants."""
@@ -88,64 +88,68 @@ def _gradient_row(i, x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sca
     three = dim == 3
     hi = h[i]
     irho = 1.0 / rho[i]
-    head = offsets[i]  # next slot of the row's head (pairs within the support)
-    for k in range(offsets[i], offsets[i + 1]):
-        j = idx[k]
-        d0 = xi0 - x[j, 0]
-        d1 = xi1 - x[j, 1]
-        d2 = xi2 - x[j, 2] if three else 0.0
-        r2 = d0 * d0 + d1 * d1 + d2 * d2
-        hij = support_scale * 0.5 * (hi + h[j])
-        if r2 >= (qmax * hij) ** 2:
-            F[k] = 0.0
-            continue
-        # grad_factor with one division: sigma / h^(d+2) * w'(q)/q
-        ih = 1.0 / hij
-        ih2 = ih * ih
-        if dim == 1:
-            scale = sigma * ih2 * ih
-        else:
-            scale = sigma * ih2 * ih2
+    o = offsets[i]
+    for part in range(2):  # the own pairs, then the others (own_pairs_first)
+        lo = o if part == 0 else o + n_own[i]
+        head = lo  # next slot of the part's head (pairs within the support)
+        for k in range(lo, o + n_own[i] if part == 0 else offsets[i + 1]):
+            j = idx[k]
+            d0 = xi0 - x[j, 0]
+            d1 = xi1 - x[j, 1]
+            d2 = xi2 - x[j, 2] if three else 0.0
+            r2 = d0 * d0 + d1 * d1 + d2 * d2
+            hij = support_scale * 0.5 * (hi + h[j])
+            if r2 >= (qmax * hij) ** 2:
+                F[k] = 0.0
+                continue
+            # grad_factor with one division: sigma / h^(d+2) * w'(q)/q
+            ih = 1.0 / hij
+            ih2 = ih * ih
+            if dim == 1:
+                scale = sigma * ih2 * ih
+            else:
+                scale = sigma * ih2 * ih2
+                if three:
+                    scale *= ih
+            # stored in single precision, and used as stored from here on
+            fk = np.float64(np.float32(scale * dwdq_over_q(kid, np.sqrt(r2) * ih)))
+            if k != head:  # swap with the part's first skin pair
+                idx[k] = idx[head]
+                F[k] = 0.0
+                idx[head] = j
+            F[head] = fk
+            head += 1
+            f = fk * (m[j] * irho)
+            if f == 0.0:
+                continue
+            g0 = f * d0
+            g1 = f * d1
+            u0 = v[j, 0] - vi0
+            u1 = v[j, 1] - vi1
+            # components unrolled: the in-plane terms here and the z terms
+            # below (3D only) have the same shape (a deliberate pair)
+            l00 += u0 * g0
+            l01 += u0 * g1
+            l10 += u1 * g0
+            l11 += u1 * g1
+            if correct:  # (x_j - x_i) = -d
+                m00 -= d0 * g0
+                m01 -= d0 * g1
+                m11 -= d1 * g1
             if three:
-                scale *= ih
-        # stored in single precision, and used as stored from here on
-        fk = np.float64(np.float32(scale * dwdq_over_q(kid, np.sqrt(r2) * ih)))
-        if k != head:  # swap with the first skin pair of the row
-            idx[k] = idx[head]
-            F[k] = 0.0
-            idx[head] = j
-        F[head] = fk
-        head += 1
-        f = fk * (m[j] * irho)
-        if f == 0.0:
-            continue
-        g0 = f * d0
-        g1 = f * d1
-        u0 = v[j, 0] - vi0
-        u1 = v[j, 1] - vi1
-        # components unrolled: the in-plane terms here and the z terms
-        # below (3D only) have the same shape (a deliberate pair)
-        l00 += u0 * g0
-        l01 += u0 * g1
-        l10 += u1 * g0
-        l11 += u1 * g1
-        if correct:  # (x_j - x_i) = -d
-            m00 -= d0 * g0
-            m01 -= d0 * g1
-            m11 -= d1 * g1
-        if three:
-            g2 = f * d2
-            u2 = v[j, 2] - vi2
-            l02 += u0 * g2
-            l12 += u1 * g2
-            l20 += u2 * g0
-            l21 += u2 * g1
-            l22 += u2 * g2
-            if correct:
-                m02 -= d0 * g2
-                m12 -= d1 * g2
-                m22 -= d2 * g2
-    count[i] = head - offsets[i]
+                g2 = f * d2
+                u2 = v[j, 2] - vi2
+                l02 += u0 * g2
+                l12 += u1 * g2
+                l20 += u2 * g0
+                l21 += u2 * g1
+                l22 += u2 * g2
+                if correct:
+                    m02 -= d0 * g2
+                    m12 -= d1 * g2
+                    m22 -= d2 * g2
+        if part == 0:
+            count[i] = head - o
     finish_row(i, dim, correct, l00, l01, l02, l10, l11, l12, l20, l21, l22,
                m00, m01, m02, m11, m12, m22, L, B)
 
@@ -199,9 +203,9 @@ def finish_row(i, dim, correct, l00, l01, l02, l10, l11, l12, l20, l21, l22,
 
 
 #: rows of a chunk's row buffer in :func:`_buffered_row` (pair ``t`` of the
-#: row within the support in column ``t``): r^2 and h_j
-_R2, _HJ = range(2)
-GRADIENT_ROWS = 2
+#: row within the support in column ``t``): r^2, h_j and the kernel factor
+_R2, _HJ, _FK = range(3)
+GRADIENT_ROWS = 3
 #: contiguous particle chunks of the buffered pass (each a row buffer)
 GRADIENT_CHUNKS = 64
 
@@ -218,18 +222,19 @@ def gradient_scratch(offsets, scratch=None):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _buffered_row(i, x, v, h, m, rho, offsets, idx, sigma, support_scale, correct, F, L, B,
-                  count, W):
+def _buffered_row(i, x, v, h, m, rho, offsets, idx, n_own, sigma, support_scale, correct, F, L,
+                  B, count, W):
     """Row ``i`` of :func:`velocity_gradient` for the 3D cubic spline, the same
     operations in the same order as :func:`_gradient_row` (the same bits),
-    in three loops: (1) the partition, keeping ``r^2`` and ``h_j`` of the
-    pairs within the support in the row buffer ``W`` (GRADIENT_ROWS, width),
-    (2) their kernel factors, pair by pair independent, which the compiler
-    turns into SIMD instructions, into ``F``, (3) the row's sums, in the
-    row's order, the neighbours' positions and velocities read again. Only
-    two numbers per pair go through the buffer: the first loop is bound by
-    its stores (BENCHMARKS.md, 2026-11-28 later), and reading a neighbour
-    again, just read, costs less than storing what the sums need."""
+    in three loops: (1) the partition of the row's two parts, keeping
+    ``r^2`` and ``h_j`` of the pairs within the support in the row buffer
+    ``W`` (GRADIENT_ROWS, width), (2) their kernel factors, pair by pair
+    independent, which the compiler turns into SIMD instructions, into the
+    buffer, (3) the row's sums, in the row's order, the factors stored in
+    ``F`` there and the neighbours' positions and velocities read again.
+    Three numbers per pair go through the buffer, not the sums' twelve: the
+    first loop was bound by its stores (BENCHMARKS.md, 2026-11-28 later),
+    and reading a neighbour again, just read, costs less."""
     xi0 = x[i, 0]
     xi1 = x[i, 1]
     xi2 = x[i, 2]
@@ -239,88 +244,106 @@ def _buffered_row(i, x, v, h, m, rho, offsets, idx, sigma, support_scale, correc
     hi = h[i]
     irho = 1.0 / rho[i]
     o = offsets[i]
-    head = o
-    for k in range(o, offsets[i + 1]):
-        j = idx[k]
-        d0 = xi0 - x[j, 0]
-        d1 = xi1 - x[j, 1]
-        d2 = xi2 - x[j, 2]
-        r2 = d0 * d0 + d1 * d1 + d2 * d2
-        hj = h[j]
-        if r2 >= (support_nb(0) * (support_scale * 0.5 * (hi + hj))) ** 2:
-            F[k] = 0.0
-            continue
-        if k != head:  # swap with the first skin pair of the row
-            idx[k] = idx[head]
-            F[k] = 0.0
-            idx[head] = j
-        W[_R2, head - o] = r2
-        W[_HJ, head - o] = hj
-        head += 1
-    c = head - o
-    count[i] = c
-    for t in range(c):
-        ih = 1.0 / (support_scale * 0.5 * (hi + W[_HJ, t]))
-        ih2 = ih * ih
-        scale = sigma * ih2 * ih2
-        scale *= ih
-        # the kernel's own w'(q)/q, inlined: both pieces formed, one selected
-        F[o + t] = np.float32(scale * dwdq_over_q(0, simd_sqrt(W[_R2, t]) * ih))
+    own = o + n_own[i]  # the second part's first slot
+    t = 0  # pairs within the support so far, both parts
+    for part in range(2):  # the own pairs, then the others (own_pairs_first)
+        head = o if part == 0 else own
+        for k in range(head, own if part == 0 else offsets[i + 1]):
+            j = idx[k]
+            d0 = xi0 - x[j, 0]
+            d1 = xi1 - x[j, 1]
+            d2 = xi2 - x[j, 2]
+            r2 = d0 * d0 + d1 * d1 + d2 * d2
+            hj = h[j]
+            if r2 >= (support_nb(0) * (support_scale * 0.5 * (hi + hj))) ** 2:
+                F[k] = 0.0
+                continue
+            if k != head:  # swap with the part's first skin pair
+                idx[k] = idx[head]
+                F[k] = 0.0
+                idx[head] = j
+            W[_R2, t] = r2
+            W[_HJ, t] = hj
+            head += 1
+            t += 1
+        if part == 0:
+            count[i] = t
+    c0 = count[i]
+    end = head  # the second part's pairs within the support: own to end
+    for t in range(c0 + end - own):  # the kernel factors, into the buffer
+        W[_FK, t] = _buffered_factor(W, t, hi, sigma, support_scale)
     l00 = l01 = l02 = l10 = l11 = l12 = l20 = l21 = l22 = 0.0
     m00 = m01 = m02 = m11 = m12 = m22 = 0.0
-    for k in range(o, head):
-        j = idx[k]
-        f = np.float64(F[k]) * (m[j] * irho)
-        if f == 0.0:
-            continue
-        d0 = xi0 - x[j, 0]
-        d1 = xi1 - x[j, 1]
-        d2 = xi2 - x[j, 2]
-        g0 = f * d0
-        g1 = f * d1
-        g2 = f * d2
-        u0 = v[j, 0] - vi0
-        u1 = v[j, 1] - vi1
-        u2 = v[j, 2] - vi2
-        l00 += u0 * g0
-        l01 += u0 * g1
-        l02 += u0 * g2
-        l10 += u1 * g0
-        l11 += u1 * g1
-        l12 += u1 * g2
-        l20 += u2 * g0
-        l21 += u2 * g1
-        l22 += u2 * g2
-        if correct:  # (x_j - x_i) = -d
-            m00 -= d0 * g0
-            m01 -= d0 * g1
-            m02 -= d0 * g2
-            m11 -= d1 * g1
-            m12 -= d1 * g2
-            m22 -= d2 * g2
+    t = 0
+    for part in range(2):
+        for k in range(o if part == 0 else own, o + c0 if part == 0 else end):
+            fk = W[_FK, t]
+            t += 1
+            F[k] = fk
+            j = idx[k]
+            f = fk * (m[j] * irho)
+            if f == 0.0:
+                continue
+            d0 = xi0 - x[j, 0]
+            d1 = xi1 - x[j, 1]
+            d2 = xi2 - x[j, 2]
+            g0 = f * d0
+            g1 = f * d1
+            g2 = f * d2
+            u0 = v[j, 0] - vi0
+            u1 = v[j, 1] - vi1
+            u2 = v[j, 2] - vi2
+            l00 += u0 * g0
+            l01 += u0 * g1
+            l02 += u0 * g2
+            l10 += u1 * g0
+            l11 += u1 * g1
+            l12 += u1 * g2
+            l20 += u2 * g0
+            l21 += u2 * g1
+            l22 += u2 * g2
+            if correct:  # (x_j - x_i) = -d
+                m00 -= d0 * g0
+                m01 -= d0 * g1
+                m02 -= d0 * g2
+                m11 -= d1 * g1
+                m12 -= d1 * g2
+                m22 -= d2 * g2
     finish_row(i, 3, correct, l00, l01, l02, l10, l11, l12, l20, l21, l22,
                m00, m01, m02, m11, m12, m22, L, B)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _buffered_chunk(t, x, v, h, m, rho, offsets, idx, sigma, support_scale, correct, F, L, B,
-                    count, work):
+def _buffered_factor(W, t, hi, sigma, support_scale):
+    """Kernel factor (rounded to float32) of pair ``t`` of the row buffer ``W`` of
+    :func:`_buffered_row` (3D cubic spline): ``sigma / h^5 * w'(q)/q``; the
+    kernel's own ``w'(q)/q``, inlined: both pieces formed, one selected."""
+    ih = 1.0 / (support_scale * 0.5 * (hi + W[_HJ, t]))
+    ih2 = ih * ih
+    scale = sigma * ih2 * ih2
+    scale *= ih
+    return np.float64(np.float32(scale * dwdq_over_q(0, simd_sqrt(W[_R2, t]) * ih)))
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _buffered_chunk(t, x, v, h, m, rho, offsets, idx, n_own, sigma, support_scale, correct, F,
+                    L, B, count, work):
     """Chunk ``t`` of :data:`GRADIENT_CHUNKS` (contiguous particles) of the
     buffered pass; a row longer than the buffer takes :func:`_gradient_row`."""
     n = x.shape[0]
     W = work[t]
     for i in range(t * n // GRADIENT_CHUNKS, (t + 1) * n // GRADIENT_CHUNKS):
         if offsets[i + 1] - offsets[i] <= W.shape[1]:
-            _buffered_row(i, x, v, h, m, rho, offsets, idx, sigma, support_scale, correct,
-                          F, L, B, count, W)
+            _buffered_row(i, x, v, h, m, rho, offsets, idx, n_own, sigma, support_scale,
+                          correct, F, L, B, count, W)
         else:
-            _gradient_row(i, x, v, h, m, rho, offsets, idx, 0, sigma, 3, support_scale,
+            _gradient_row(i, x, v, h, m, rho, offsets, idx, n_own, 0, sigma, 3, support_scale,
                           correct, F, L, B, count)
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_scale, correct,
-                      F, L, B, count, work):
+def velocity_gradient(x, v, h, m, rho, offsets, idx, n_own, kid, sigma, dim, support_scale,
+                      correct, F, L, B, count, work):
     r"""Velocity gradient with optional Randles-Libersky renormalisation.
 
     .. math::
@@ -361,12 +384,16 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
     kernel is evaluated once per pair and step. Pairs in the Verlet skin are
     rejected on ``r^2`` (no square root or kernel call) and get ``F = 0``.
 
-    The pass also orders each row: the pairs within the support first, in the
-    order they had, ``count[i]`` of them (a stable partition of the row in
-    place; the row still holds the same neighbours, so the Verlet list stays
-    valid). The passes after it visit only those, not the skin's pairs, and
-    the sums over a row keep their order while its pairs stay within the
-    support.
+    The pass also orders each row, in two parts: the row's first
+    ``n_own[i]`` pairs (its own pairs, :func:`~sphdyn.parts.sph.colouring.own_pairs_first`)
+    and the rest. In each part the pairs within the support come first, in
+    the order they had (a stable partition of the part in place; the row
+    still holds the same neighbours, so the Verlet list stays valid);
+    ``count[i]`` of them in the first part. :func:`forces` visits only those,
+    not the skin's pairs nor the pairs it works from the other row, and the
+    sums over a row keep their order while its pairs stay within the
+    support. With ``n_own`` the row lengths the rows are one part:
+    ``count`` is then every pair within the support.
 
     Parameters
     ----------
@@ -377,6 +404,7 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
         :func:`forces`, see the module docstring).
     offsets, idx : CSR neighbour list (``idx`` (nnz,) int32, each row
         reordered in place, see above).
+    n_own : (N,) int32, the length of each row's first part (see above).
     kid, sigma, dim, support_scale : kernel id, normalisation, dimension (2: z
         terms skipped; 1: y and z zero), support scale kappa.
     correct : bool, apply the renormalisation.
@@ -391,7 +419,8 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
     L : (N, 3, 3) out, velocity gradient [1/s].
     B : (N, 3, 3) out, correction matrix applied to kernel gradients
         (identity when ``correct`` is False).
-    count : (N,) int32 out, pairs within the support at the head of row i.
+    count : (N,) int32 out, pairs within the support at the head of row i
+        (of its first part).
     work : (GRADIENT_CHUNKS, GRADIENT_ROWS, width) scratch of the buffered forms
         (:func:`gradient_scratch`).
     """
@@ -401,27 +430,28 @@ def velocity_gradient(x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_sc
     if dim == 3 and kid == 0:
         if correct:
             for t in prange(GRADIENT_CHUNKS):
-                _buffered_chunk(t, x, v, h, m, rho, offsets, idx, sigma, support_scale, True,
-                                F, L, B, count, work)
+                _buffered_chunk(t, x, v, h, m, rho, offsets, idx, n_own, sigma, support_scale,
+                                True, F, L, B, count, work)
         else:
             for t in prange(GRADIENT_CHUNKS):
-                _buffered_chunk(t, x, v, h, m, rho, offsets, idx, sigma, support_scale, False,
-                                F, L, B, count, work)
+                _buffered_chunk(t, x, v, h, m, rho, offsets, idx, n_own, sigma, support_scale,
+                                False, F, L, B, count, work)
     elif correct:
         for i in prange(n):
-            _gradient_row(i, x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_scale,
-                          True, F, L, B, count)
+            _gradient_row(i, x, v, h, m, rho, offsets, idx, n_own, kid, sigma, dim,
+                          support_scale, True, F, L, B, count)
     else:
         for i in prange(n):
-            _gradient_row(i, x, v, h, m, rho, offsets, idx, kid, sigma, dim, support_scale,
-                          False, F, L, B, count)
+            _gradient_row(i, x, v, h, m, rho, offsets, idx, n_own, kid, sigma, dim,
+                          support_scale, False, F, L, B, count)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _force_row(i, x, v, m, rho, h, c, P, F, offsets, count, idx, rank, three, support_scale,
+def _force_row(i, x, v, m, rho, h, c, P, F, offsets, count, idx, three, support_scale,
                alpha, beta, a, dedt_av, signal):
-    """Row ``i`` of :func:`forces`: its own pairs (``rank[j] > rank[i]``), their
-    terms added to row ``i`` and written to row ``j``."""
+    """Row ``i`` of :func:`forces`: its own pairs within the support (the
+    row's first ``count[i]``), their terms added to row ``i`` and written to
+    row ``j``."""
     per_particle = alpha.shape[0] > 1
     want_signal = signal.shape[0] > 0
     p00 = P[i, 0, 0]
@@ -443,7 +473,6 @@ def _force_row(i, x, v, m, rho, h, c, P, F, offsets, count, idx, rank, three, su
     ci = c[i]
     rhoi = rho[i]
     mi = m[i]
-    ri = rank[i]
     alphai = alpha[i] if per_particle else alpha[0]
     betai = beta[i] if per_particle else beta[0]
     a0 = a1 = a2 = 0.0
@@ -451,8 +480,6 @@ def _force_row(i, x, v, m, rho, h, c, P, F, offsets, count, idx, rank, three, su
     sig_max = 0.0
     for k in range(offsets[i], offsets[i] + count[i]):
         j = idx[k]
-        if rank[j] < ri:  # worked by row j
-            continue
         f = F[k]
         mj = m[j]
         if f == 0.0 or (mj == 0.0 and mi == 0.0):  # taken out by a coupling; no mass
@@ -517,8 +544,8 @@ def _force_row(i, x, v, m, rho, h, c, P, F, offsets, count, idx, rank, three, su
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, rank, order, start, dim,
-           support_scale, alpha, beta, a, dedt_av, signal):
+def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, order, start, dim, support_scale,
+           alpha, beta, a, dedt_av, signal):
     r"""Acceleration from the stress divergence and Monaghan artificial viscosity.
 
     Symmetric (momentum-conserving) form of Gray, Monaghan & Swift (2001),
@@ -551,8 +578,9 @@ def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, rank, order, start, di
     contribute nothing; a zero-mass particle still gets an acceleration (it
     moves as an interpolation point).
 
-    Each pair is worked once, by the row of lower ``rank``, and its terms
-    written to both rows (:math:`\mathbf g_{ji} = -\mathbf g_{ij}`,
+    Each pair is worked once, by the row of lower rank (the row's own
+    pairs, at its head: :func:`~sphdyn.parts.sph.colouring.own_pairs_first`,
+    then :func:`velocity_gradient`), and its terms written to both rows (:math:`\mathbf g_{ji} = -\mathbf g_{ij}`,
     :math:`\Pi_{ji} = \Pi_{ij}`: the pair's acceleration terms are
     :math:`m_j \mathbf f_{ij}` on i and :math:`-m_i \mathbf f_{ij}` on j, its
     heating and signal speed the same on both), the slabs of
@@ -570,11 +598,12 @@ def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, rank, order, start, di
     P : (N, 3, 3) ``sigma B / rho^2`` from :func:`stress_terms` (Cauchy,
         tension +), so the pair term is :math:`(P_i + P_j)\,\mathbf g_{ij}`.
     F : (nnz,) pair gradient factors from :func:`velocity_gradient`.
-    offsets, count, idx : the neighbour list and the pairs within the support
-        at the head of each row (:func:`velocity_gradient`); only those are
-        visited.
-    rank, order, start : the list's slab colouring
-        (:class:`~sphdyn.parts.sph.colouring.PairColouring`).
+    offsets, count, idx : the neighbour list and the row's own pairs within
+        the support at the head of each row (:func:`velocity_gradient`); only
+        those are visited.
+    order, start : the list's slab colouring
+        (:class:`~sphdyn.parts.sph.colouring.PairColouring`), whose ranks
+        chose the own pairs.
     alpha, beta : (N,) artificial-viscosity coefficients of each particle
         [-], or (1,) the one value of all (no per-pair means to form).
     a : (N, 3) out, acceleration [m/s^2].
@@ -596,8 +625,8 @@ def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, rank, order, start, di
         for t in prange((slabs - colour + 1) // 2):
             s = colour + 2 * t
             for r in range(start[s], start[s + 1]):
-                _force_row(order[r], x, v, m, rho, h, c, P, F, offsets, count, idx, rank,
-                           three, support_scale, alpha, beta, a, dedt_av, signal)
+                _force_row(order[r], x, v, m, rho, h, c, P, F, offsets, count, idx, three,
+                           support_scale, alpha, beta, a, dedt_av, signal)
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
