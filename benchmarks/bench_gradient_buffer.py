@@ -47,7 +47,7 @@ def main() -> None:
     F = part.F.copy()
     L, B = np.zeros((n, 3, 3)), np.zeros((n, 3, 3))
     count = p.n_support.copy()
-    n_own = part._pair_colouring()[1]
+    n_own = part._pair_colouring().n_own
 
     def call(scratch) -> float:
         idx = nl.idx.copy()  # the pass partitions rows in place

@@ -40,16 +40,16 @@ def _cloud(dim, shape, dx=0.01, seed=0):
     v = rng.normal(scale=5.0, size=(n, 3))
     if dim == 2:
         v[:, 2] = 0.0
-    col, n_own = colour_pairs(x, nl.offsets, nl.idx)
+    col = colour_pairs(x, nl.offsets, nl.idx)
     F = np.zeros(nl.idx.size, np.float32)
     count = np.zeros(n, np.int32)
-    velocity_gradient(x, v, h, m, rho, nl.offsets, nl.idx, n_own, kid,
+    velocity_gradient(x, v, h, m, rho, nl.offsets, nl.idx, col.n_own, kid,
                       kernels.normalisation(kid, dim), dim, 1.0, False, F,
                       np.zeros((n, 3, 3)), np.zeros((n, 3, 3)), count,
                       gradient_scratch(nl.offsets))
     P = rng.normal(scale=1.0, size=(n, 3, 3))  # sigma B / rho^2 [Pa m^6/kg^2]
     return dict(x=x, v=v, m=m, rho=rho, h=h, c=rng.uniform(2000.0, 4000.0, n), P=P,
-                F=F, count=count, nl=nl, dim=dim, col=col, n_own=n_own)
+                F=F, count=count, nl=nl, dim=dim, col=col)
 
 
 def _gather(c, alpha, beta, support_scale=1.0):

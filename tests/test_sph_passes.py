@@ -191,8 +191,8 @@ def _forces(c, sig, v=None, correct=False, alpha=0.0, beta=0.0, cs=1000.0, full=
     n = c["x"].shape[0]
     v = np.zeros((n, 3)) if v is None else v
     nl = c["nl"]
-    col, n_own = colour_pairs(c["x"], nl.offsets, nl.idx)
-    L, B, F, count = _grad(c, v, correct, with_factors=True, n_own=n_own)
+    col = colour_pairs(c["x"], nl.offsets, nl.idx)
+    L, B, F, count = _grad(c, v, correct, with_factors=True, n_own=col.n_own)
     a = np.zeros((n, 3))
     dedt = np.zeros(n)
     P = np.zeros((n, 3, 3))
@@ -200,7 +200,7 @@ def _forces(c, sig, v=None, correct=False, alpha=0.0, beta=0.0, cs=1000.0, full=
     forces(c["x"], v, c["m"], c["rho"], c["h"], np.full(n, cs), P, F, nl.offsets, count,
            nl.idx, col.order, col.start, c["dim"], 1.0, np.full(n, alpha), np.full(n, beta),
            a, dedt, np.zeros(n))
-    return (a, dedt, (col, n_own, P, F)) if full else (a, dedt)
+    return (a, dedt, (col, P, F)) if full else (a, dedt)
 
 
 @pytest.mark.parametrize("dim", [2, 3])
@@ -247,10 +247,10 @@ def test_rows_hold_the_pairs_within_the_support_first(dim):
     assert np.allclose(L, L0, rtol=0.0, atol=1e-13 * np.abs(L0).max())
     sig = np.random.default_rng(5).normal(scale=1e6, size=(x.shape[0], 3, 3))
     sig = 0.5 * (sig + sig.transpose(0, 2, 1))
-    a_head, heat_head, (col, n_own, P, F) = _forces(c, sig, v=v, correct=True, alpha=1.0,
-                                                    beta=2.0, full=True)
+    a_head, heat_head, (col, P, F) = _forces(c, sig, v=v, correct=True, alpha=1.0, beta=2.0,
+                                             full=True)
     a_all, heat_all = np.zeros_like(a_head), np.zeros_like(heat_head)
-    forces(x, v, c["m"], c["rho"], h, np.full(x.shape[0], 1000.0), P, F, nl.offsets, n_own,
+    forces(x, v, c["m"], c["rho"], h, np.full(x.shape[0], 1000.0), P, F, nl.offsets, col.n_own,
            nl.idx, col.order, col.start, dim, 1.0, np.ones(x.shape[0]),
            np.full(x.shape[0], 2.0), a_all, heat_all, np.zeros(x.shape[0]))
     assert np.array_equal(a_head, a_all) and np.array_equal(heat_head, heat_all)
@@ -513,7 +513,8 @@ def test_pair_stress_and_viscosity_match_their_formulas(alpha, beta, approach):
     # each particle its own coefficients: the pair takes their means
     alphas, betas = alpha * np.array([0.5, 1.5]), beta * np.array([1.5, 0.5])
     signal = np.zeros(2)
-    col, count = colour_pairs(x, offsets, idx)  # the pair is row 0's own
+    col = colour_pairs(x, offsets, idx)
+    count = col.n_own  # the pair is row 0's own
     assert list(count) == [1, 0]
     forces(x, v, m, rho, h, c, P, F, offsets, count, idx, col.order, col.start, 3,
            support_scale, alphas, betas, a, dedt, signal)
@@ -615,7 +616,7 @@ def test_buffered_gradient_rows_give_the_pair_by_pair_bits(correct):
 
     # rows of one part, then of two (the own pairs first, as the part runs it)
     forms(lengths.astype(np.int32))
-    n_own = colour_pairs(c["x"], nl.offsets, nl.idx)[1]
+    n_own = colour_pairs(c["x"], nl.offsets, nl.idx).n_own
     assert 0 < n_own.mean() < lengths.mean()
     idx = forms(n_own)[4]
     for i in range(n):  # each part keeps its pairs

@@ -62,13 +62,25 @@ def longest_pair(y, offsets, idx):
     return best.max() if n else 0.0
 
 
+class ListColouring(NamedTuple):
+    """What the gradient and force passes take of a list's colouring
+    (:func:`colour_pairs`; the ranks are needed only to order the rows).
+
+    order, start : as in :class:`PairColouring`.
+    n_own : (N,) int32, the own pairs at the head of each row.
+    """
+
+    order: np.ndarray
+    start: np.ndarray
+    n_own: np.ndarray
+
+
 def colour_pairs(x: np.ndarray, offsets: np.ndarray, idx: np.ndarray,
-                 active: np.ndarray | None = None) -> tuple[PairColouring, np.ndarray]:
-    """The list's colouring (:func:`pair_colouring`) and its own pairs put at
-    the head of each row (:func:`own_pairs_first`, ``idx`` reordered in
-    place): ``(colouring, n_own)``, what the gradient and force passes take."""
+                 active: np.ndarray | None = None) -> ListColouring:
+    """The list's slabs (:func:`pair_colouring`) and its own pairs put at the
+    head of each row (:func:`own_pairs_first`, ``idx`` reordered in place)."""
     col = pair_colouring(x, offsets, idx, active)
-    return col, own_pairs_first(col.rank, offsets, idx)
+    return ListColouring(col.order, col.start, own_pairs_first(col.rank, offsets, idx))
 
 
 def pair_colouring(x: np.ndarray, offsets: np.ndarray, idx: np.ndarray,

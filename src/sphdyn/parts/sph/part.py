@@ -403,7 +403,7 @@ class SPHPart:
                 self._F_buf = np.empty(int(need * 1.1), dtype=np.float32)
             self.F = self._F_buf[:need]
         if self.has_ul:
-            n_own = self._pair_colouring()[1]
+            n_own = self._pair_colouring().n_own
             velocity_gradient(p.x, p.v, p.h, p.m, p.rho, nl.offsets, nl.idx, n_own, k.kid,
                               k.sigma, self.dim, k.support_scale, self.s.correction, self.F,
                               p.L, p.B, p.n_support, self._gradient_scratch())
@@ -422,7 +422,7 @@ class SPHPart:
         if self.has_ul:
             stress_terms(p.sig, p.rho, p.B, p.S)
             alpha, beta, signal = self._viscosity_arrays()
-            col = self._pair_colouring()[0]
+            col = self._pair_colouring()
             forces(p.x, p.v, p.m, p.rho, p.h, p.c, p.S, self.F, nl.offsets, p.n_support,
                    nl.idx, col.order, col.start, self.dim, k.support_scale, alpha, beta, p.a,
                    p.dedt_av, signal)
@@ -445,8 +445,8 @@ class SPHPart:
         return self._scratch
 
     def _pair_colouring(self):
-        """``(colouring, n_own)`` of :func:`.colouring.colour_pairs` for the
-        current list, at the positions it was built from (the own pairs put
+        """The :class:`.colouring.ListColouring` of :func:`.colouring.colour_pairs`
+        for the current list, at the positions it was built from (the own pairs put
         first in each row); made again after a rebuild or a restore, before
         the gradient pass orders the rows (which keeps them first)."""
         nl = self.nl

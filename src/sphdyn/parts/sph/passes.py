@@ -580,10 +580,11 @@ def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, order, start, dim, sup
 
     Each pair is worked once, by the row of lower rank (the row's own
     pairs, at its head: :func:`~sphdyn.parts.sph.colouring.own_pairs_first`,
-    then :func:`velocity_gradient`), and its terms written to both rows (:math:`\mathbf g_{ji} = -\mathbf g_{ij}`,
-    :math:`\Pi_{ji} = \Pi_{ij}`: the pair's acceleration terms are
-    :math:`m_j \mathbf f_{ij}` on i and :math:`-m_i \mathbf f_{ij}` on j, its
-    heating and signal speed the same on both), the slabs of
+    then :func:`velocity_gradient`), and its terms written to both rows
+    (:math:`\mathbf g_{ji} = -\mathbf g_{ij}`, :math:`\Pi_{ji} = \Pi_{ij}`:
+    the pair's acceleration terms are :math:`m_j \mathbf f_{ij}` on i and
+    :math:`-m_i \mathbf f_{ij}` on j, its heating and signal speed the same
+    on both), the slabs of
     :func:`~sphdyn.parts.sph.colouring.pair_colouring` taken in two colours
     so that no two threads write one row: half the arithmetic of a gather
     over both rows (BENCHMARKS.md, 2026-11-28). The order of each row's
@@ -602,7 +603,7 @@ def forces(x, v, m, rho, h, c, P, F, offsets, count, idx, order, start, dim, sup
         the support at the head of each row (:func:`velocity_gradient`); only
         those are visited.
     order, start : the list's slab colouring
-        (:class:`~sphdyn.parts.sph.colouring.PairColouring`), whose ranks
+        (:class:`~sphdyn.parts.sph.colouring.ListColouring`), whose ranks
         chose the own pairs.
     alpha, beta : (N,) artificial-viscosity coefficients of each particle
         [-], or (1,) the one value of all (no per-pair means to form).
