@@ -55,6 +55,21 @@ the stress within 1.8e-5, the damage within 1.3e-8, the positions within
 8e-11: round-off carried through the plastic return's choices in the
 blast's crushing zone) and the detonation fronts (gurney_1d 1.8e-7,
 sod_shock_tube 4.6e-9 of the largest acceleration).
+2026-11-28 (session 23, issue 17): the CSCM meridian's evaluation by
+reciprocals (0.5/w once instead of three divisions by 2w: round-off) and
+the return's Newton iteration stopping on its predicted next step (returned
+points within the 1e-11 tolerance, docs/cscm.md); the default Verlet skin
+0.25 -> 0.1 support radii, with the rebuild criterion taking out the common
+displacement (the lists hold fewer pairs: each row's sums in another
+order, round-off). The 25 decks with an updated-Lagrangian SPH body or a
+plastic CSCM point were rewritten: particle arrays within 2e-12 of their
+largest value, except those where the round-off reaches a discrete choice
+of the crushing zone (a plastic return's branch, an element's erosion
+step) within the few steps: the penetrations (CSCM FEM target struck at
+600 m/s: particle arrays within 6e-3 of their largest value, the time
+step within 5e-5), the blast slabs (CSCM cap kappa within 4.1e-4, stress
+2.7e-5), erosion_blocks_sph (1.1e-9) and the detonation front of
+gurney_1d (1.6e-7).
 """
 
 import subprocess

@@ -446,6 +446,48 @@ def test_rebuild_criterion_keeps_all_pairs():
     assert needs_rebuild(nl, x3, h)
 
 
+def test_a_body_moving_as_a_whole_needs_no_rebuild():
+    """Only displacements relative to a common one count: a cloud carried
+    by 50 skins (a flying body) keeps its list, whose pairs are then still
+    every pair within the radius (brute force); with random moves of up to
+    0.3 skin on top, max_displacement gives about 0.3 skin (the common
+    displacement taken out: the box's centre, off the moves' own centre by
+    their round-off asymmetry) and no rebuild; one particle moved against
+    the others changes its pairs' separations by as much, so needs one
+    from a skin on (the criterion before, 2 max |d| > skin, from half a
+    skin). The centre of the box is
+    not the best common displacement: random directions of one length
+    (a box centred near 0) give max |d| itself (c = 0 taken when smaller)."""
+    rng = np.random.default_rng(12)
+    n, dim = 2000, 3
+    x, h = random_cloud(rng, n, dim, h0=0.05)
+    skin = 0.01
+    nl = build_neighbours(x, h, RF, skin, dim)
+    old_pairs = pair_set(nl.offsets, nl.idx)
+    carry = np.array([50.0 * skin, -20.0 * skin, 7.0 * skin])
+    assert max_displacement(nl, x + carry, h)[0] <= 1e-12
+    assert not needs_rebuild(nl, x + carry, h)
+    d = rng.uniform(-1.0, 1.0, (n, 3))
+    d *= 0.3 * skin / np.linalg.norm(d, axis=1, keepdims=True).max()
+    x1 = x + carry + d
+    dmax = max_displacement(nl, x1, h)[0]
+    assert dmax <= 0.35 * skin and not needs_rebuild(nl, x1, h)
+    now = pair_set(*brute_force_neighbours(x1, h, RF, 0.0, dim))
+    assert len(now) > 5 * n and now <= old_pairs
+    nl = update_neighbours(nl, x1, h, dim)
+    assert nl.n_builds == 1
+    x2 = x + carry
+    x2[17] += [0.99 * skin, 0.0, 0.0]  # pairs of 17 change by < skin: none missed
+    assert not needs_rebuild(nl, x2, h)
+    x2[17] += [0.02 * skin, 0.0, 0.0]
+    assert needs_rebuild(nl, x2, h)
+    # a sphere of displacements of one length: the box's centre is not 0 but
+    # max |d| is the better bound and is the one returned
+    u = rng.normal(size=(n, 3))
+    u *= 0.4 * skin / np.linalg.norm(u, axis=1, keepdims=True)
+    assert max_displacement(nl, x + u, h)[0] == pytest.approx(0.4 * skin, rel=1e-12)
+
+
 def test_rebuild_criterion_is_needed():
     """A pair just outside radius + skin at build time moves inside the
     radius; the displacement then exceeds skin / 2 and the criterion fires
@@ -501,7 +543,7 @@ def test_update_rebuilds_and_matches_fresh_build():
     assert nl.n_builds == 5
     assert_same(nl, brute_force_neighbours(x2, h_big, RF, skin, dim))
     buf = nl.idx
-    x3 = x2 + [skin, 0.0, 0.0]
+    x3 = x2 + np.where(x2[:, :1] > np.median(x2[:, 0]), 1.2 * skin, 0.0) * [1.0, 0.0, 0.0]
     nl = update_neighbours(nl, x3, h, dim)
     assert nl.n_builds == 6 and np.shares_memory(nl.idx, buf)
     assert_same(nl, brute_force_neighbours(x3, h, RF, skin, dim))
@@ -520,7 +562,7 @@ def test_update_rebuilds_and_matches_fresh_build():
     ro = nl.idx.copy()
     ro.flags.writeable = False
     nl.idx = ro
-    x5 = x3 + [0.0, skin, 0.0]
+    x5 = x3 + np.where(x3[:, 1:2] > np.median(x3[:, 1]), 1.2 * skin, 0.0) * [0.0, 1.0, 0.0]
     nl = update_neighbours(nl, x5, h, dim)
     assert nl.n_builds == 7 and not np.shares_memory(nl.idx, ro)
     assert_same(nl, brute_force_neighbours(x5, h, RF, skin, dim))

@@ -8,7 +8,7 @@ import pytest
 from sphdyn.deck import load_deck
 from sphdyn.model import build_model
 from sphdyn.neighbours import max_neighbours
-from sphdyn.preflight import estimate_size, history_width, shape_volume
+from sphdyn.preflight import estimate_size, history_width, lattice_neighbours, shape_volume
 from sphdyn.simulation import Simulation
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -53,13 +53,24 @@ def test_particle_count_estimate_matches_the_lattice(deck):
 
 @pytest.mark.parametrize("deck", ["disc_impact", "rings_gray2001", "two_boxes"])
 def test_neighbour_estimate_is_an_interior_particles_list(tmp_path, deck):
-    # pairs per particle = lattice points in the Verlet ball = its volume in
-    # units of dx^dim; an interior particle's list (the longest) holds that
-    # many to within 3 % (113 vs 114 in 3D, 44 vs 44 and 28 vs 28 in 2D)
+    # pairs per particle = lattice points in the Verlet ball, counted: an
+    # interior particle's list (the longest) at the build holds exactly that
+    # many (80 in 3D, 36 and 20 in 2D with the default skin; the ball's
+    # volume is 77, 34.2 and 21.9: 4-10 % off at these radii)
     d = load_deck(EXAMPLES / f"{deck}.toml")
     sim = Simulation.from_deck(d, tmp_path / "o")
     longest = max_neighbours(sim.stepper.part("sph").nl)
-    assert estimate_size(d).pairs_per_particle == pytest.approx(longest, rel=0.03)
+    assert estimate_size(d).pairs_per_particle == longest
+
+
+@pytest.mark.parametrize("radius, dim, count", [(1.5, 1, 2), (1.0, 2, 0), (1.01, 2, 4),
+                                                (1.5, 2, 8), (1.01, 3, 6), (1.5, 3, 18),
+                                                (1.8, 3, 26)])
+def test_lattice_neighbours_counts_the_points_strictly_inside(radius, dim, count):
+    # by hand: 1D the two nearest; 2D the 4 edge neighbours (at 1, excluded
+    # at radius 1 exactly), then the 4 diagonals (sqrt 2); 3D 6 faces, 12
+    # edges (sqrt 2), 8 corners (sqrt 3 = 1.73)
+    assert lattice_neighbours(radius, dim) == count
 
 
 @pytest.mark.parametrize("deck", ["igirder_sph", "disc_impact", "rings_gray2001"])

@@ -2,7 +2,8 @@
 
 ``build_neighbours`` builds a :class:`NeighbourList` (CSR arrays plus the
 positions, smoothing lengths and active mask it was built from);
-``needs_rebuild`` tells from the largest displacement and growth of ``h``
+``needs_rebuild`` tells from the largest displacement (relative to the
+body's common one) and growth of ``h``
 since the build whether the skin still covers every pair;
 ``update_neighbours`` rebuilds in place when it does not or when the
 particle set changed.
@@ -84,34 +85,65 @@ class NeighbourList:
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def _max_disp_dh(x, x_ref, h, h_ref, active, use_active, dim):
-    """Max squared displacement and max increase of h over active particles.
+def _displacement_box(x, x_ref, h, h_ref, active, use_active, dim):
+    """Bounding box of the displacements ``x_i - x_ref_i`` and the largest
+    increase of h, over active particles.
 
-    Returns ``(max_i |x_i - x_ref_i|^2, max(0, max_i (h_i - h_ref_i)))``;
-    NaN contributions become +inf. ``max`` is exact and associative, so the
-    result does not depend on the thread count or the reduction order.
+    Returns ``(lo0, lo1, lo2, hi0, hi1, hi2, max(0, max_i (h_i - h_ref_i)))``
+    (z components 0 in 2D); non-finite displacements are left out of the
+    box (:func:`_max_disp_from` turns them into +inf), a NaN ``h`` gives
+    +inf. ``min`` and ``max`` are exact and associative: the result does
+    not depend on the thread count or the reduction order.
     """
     n = x.shape[0]
-    md2 = 0.0
+    lo0 = lo1 = lo2 = np.inf
+    hi0 = hi1 = hi2 = -np.inf
     mdh = 0.0
     for i in prange(n):
-        d2 = 0.0
+        d0 = d1 = d2 = 0.0
         dh = 0.0
-        if (not use_active) or active[i]:
+        take = (not use_active) or active[i]
+        if take:
             d0 = x[i, 0] - x_ref[i, 0]
             d1 = x[i, 1] - x_ref[i, 1]
-            d2 = d0 * d0 + d1 * d1
             if dim == 3:
-                dz = x[i, 2] - x_ref[i, 2]
-                d2 = d2 + dz * dz
-            if d2 != d2:
-                d2 = np.inf
+                d2 = x[i, 2] - x_ref[i, 2]
+            take = np.isfinite(d0) and np.isfinite(d1) and np.isfinite(d2)
             dh = h[i] - h_ref[i]
             if dh != dh:
                 dh = np.inf
-        md2 = max(md2, d2)
         mdh = max(mdh, dh)
-    return md2, mdh
+        lo0 = min(lo0, d0 if take else np.inf)
+        lo1 = min(lo1, d1 if take else np.inf)
+        lo2 = min(lo2, d2 if take else np.inf)
+        hi0 = max(hi0, d0 if take else -np.inf)
+        hi1 = max(hi1, d1 if take else -np.inf)
+        hi2 = max(hi2, d2 if take else -np.inf)
+    return lo0, lo1, lo2, hi0, hi1, hi2, mdh
+
+
+@njit(cache=True, error_model="numpy", parallel=True)
+def _max_disp_from(x, x_ref, c0, c1, c2, active, use_active, dim):
+    """``max_i |x_i - x_ref_i - c|^2`` and ``max_i |x_i - x_ref_i|^2`` over
+    active particles (z ignored in 2D); NaN contributions become +inf.
+    Deterministic (max reductions)."""
+    n = x.shape[0]
+    mc2 = 0.0
+    m02 = 0.0
+    for i in prange(n):
+        dc = 0.0
+        d0 = 0.0
+        if (not use_active) or active[i]:
+            e0 = x[i, 0] - x_ref[i, 0]
+            e1 = x[i, 1] - x_ref[i, 1]
+            e2 = x[i, 2] - x_ref[i, 2] if dim == 3 else 0.0
+            d0 = e0 * e0 + e1 * e1 + e2 * e2
+            dc = (e0 - c0) * (e0 - c0) + (e1 - c1) * (e1 - c1) + (e2 - c2) * (e2 - c2)
+            if d0 != d0 or dc != dc:
+                d0 = dc = np.inf
+        mc2 = max(mc2, dc)
+        m02 = max(m02, d0)
+    return mc2, m02
 
 
 @njit(cache=True, error_model="numpy")
@@ -166,7 +198,8 @@ def build_neighbours(x, h, radius_factor, skin, dim, active=None):
 
 
 def max_displacement(nl, x, h):
-    """Max displacement and max increase of h since the last build.
+    """Largest displacement since the last build, relative to the common
+    one, and the largest increase of h.
 
     Parameters
     ----------
@@ -177,33 +210,48 @@ def max_displacement(nl, x, h):
     Returns
     -------
     (float, float)
-        ``max_i |x_i - x_ref_i|`` [m] (x, y only in 2D) and
-        ``max(0, max_i (h_i - h_ref_i))`` [m], over the particles active at
-        the build. NaN gives +inf. Deterministic (max reduction).
+        ``max_i |x_i - x_ref_i - c|`` [m] (x, y only in 2D), with ``c`` the
+        centre of the bounding box of the displacements ``x_i - x_ref_i``
+        (a body moving as a whole gives 0) or ``c = 0`` if that gives less
+        (the box's centre is not the smallest enclosing ball's), and ``max(0, max_i (h_i -
+        h_ref_i))`` [m], over the particles active at the build. NaN gives
+        +inf. Deterministic (min and max reductions).
     """
     use_active = nl.active_ref is not None
     act = nl.active_ref if use_active else _NO_MASK
-    d2, dh = _max_disp_dh(x, nl.x_ref, h, nl.h_ref, act, use_active, nl.dim)
-    return math.sqrt(d2), dh
+    lo0, lo1, lo2, hi0, hi1, hi2, dh = _displacement_box(x, nl.x_ref, h, nl.h_ref, act,
+                                                         use_active, nl.dim)
+    if lo0 > hi0:  # no finite displacement (no active particle, or all NaN)
+        c0 = c1 = c2 = 0.0
+    else:
+        c0, c1, c2 = 0.5 * (lo0 + hi0), 0.5 * (lo1 + hi1), 0.5 * (lo2 + hi2)
+    dc2, d02 = _max_disp_from(x, nl.x_ref, c0, c1, c2, act, use_active, nl.dim)
+    return math.sqrt(min(dc2, d02)), dh
 
 
 def needs_rebuild(nl, x, h):
     """True when the list may miss a pair that is now within its radius.
 
-    The test is ``2 * max_i |x_i - x_ref_i| + radius_factor *
+    The test is ``2 * max_i |x_i - x_ref_i - c| + radius_factor *
     max(0, max_i (h_i - h_ref_i)) > skin`` over the particles active at the
-    build.
+    build, for a common displacement ``c`` (:func:`max_displacement`: the
+    centre of the displacements' bounding box, or 0).
 
-    Why it suffices: let ``d = max |x_i - x_ref_i|`` and ``e = max(0, max
-    (h_i - h_ref_i))``. If a pair is within its *current* radius without
-    skin, ``|x_i - x_j| < rf * 0.5 * (h_i + h_j)``, then by the triangle
-    inequality ``|x_ref_i - x_ref_j| <= |x_i - x_j| + 2 d`` and, since each
-    ``h`` grew by at most ``e``, ``rf * 0.5 * (h_i + h_j) <= rf * 0.5 *
-    (h_ref_i + h_ref_j) + rf * e``. Hence ``|x_ref_i - x_ref_j| < rf * 0.5 *
-    (h_ref_i + h_ref_j) + 2 d + rf * e <= ... + skin`` whenever ``2 d + rf e
-    <= skin``: the pair satisfied the build criterion and is in the list.
-    (Shrinking ``h`` only shrinks the current radius, so only the increase
-    counts.) The argument is exact in real arithmetic; floating-point
+    Why it suffices: a pair's separation does not change when both move by
+    the same ``c``, so only the displacements relative to it count. Let
+    ``d = max |x_i - x_ref_i - c|`` and ``e = max(0, max (h_i - h_ref_i))``.
+    Since ``(x_i - x_j) - (x_ref_i - x_ref_j) = (x_i - x_ref_i - c) -
+    (x_j - x_ref_j - c)``, the triangle inequality gives ``|x_ref_i -
+    x_ref_j| <= |x_i - x_j| + 2 d``. If a pair is within its *current*
+    radius without skin, ``|x_i - x_j| < rf * 0.5 * (h_i + h_j)``, and,
+    since each ``h`` grew by at most ``e``, ``rf * 0.5 * (h_i + h_j) <= rf *
+    0.5 * (h_ref_i + h_ref_j) + rf * e``. Hence ``|x_ref_i - x_ref_j| < rf *
+    0.5 * (h_ref_i + h_ref_j) + 2 d + rf * e <= ... + skin`` whenever ``2 d
+    + rf e <= skin``: the pair satisfied the build criterion and is in the
+    list. (Shrinking ``h`` only shrinks the current radius, so only the
+    increase counts.) A body flying as a whole (a projectile, the paper's
+    disc before its impact) thus needs no rebuild, however far it flies.
+    The argument is exact in real arithmetic; floating-point
     evaluation of the distances can only matter for pairs within a few ulps
     of the radius. The list may contain extra pairs beyond the current
     radius; kernels must still test the distance. Changes of the active set

@@ -44,9 +44,11 @@ class Neighbours(Section):
     """[sph.neighbours]: Verlet neighbour lists."""
 
     skin_factor: real("skin factor", lo=0) = Field(
-        0.25, description="Verlet skin as a fraction of the initial support "
-                          "radius; lists are rebuilt when a particle has "
-                          "moved half the skin.")
+        0.1, description="Verlet skin as a fraction of the initial support "
+                         "radius; a list is rebuilt when its particles have "
+                         "moved half the skin relative to their common "
+                         "displacement (a body flying as a whole keeps its "
+                         "list), or h has grown.")
 
 
 class ArtificialStress(Section):

@@ -14,7 +14,7 @@ from ..base import (P_G, P_K, ddot6, energy_increment, jaumann_rotate, load_sym6
                     p_wave_speed, rate_split, scale6, store_sym6, young_modulus)
 from ..elastic import elastic_increment
 from .damage import (DMAX, brittle_softening_c, ductile_softening_a, logistic_damage,
-                     max_principal, max_principal_bound, transition)
+                     max_principal, max_principal_bound, power, transition)
 from .layout import (H_DB, H_DD, H_EPS, H_ERODED, H_EV, H_KAPPA, H_R0C, H_R0T, H_RATE,
                      H_RF, H_RFMAX, H_SVP, H_TC, H_TT, P_ALPHA, P_BB, P_DD,
                      P_DMAX_POWER, P_ERODE, P_ERODE_STRAIN, P_ETA0C, P_ETA0T, P_GFC,
@@ -234,7 +234,7 @@ def cscm_point(h, deps, dt, p, size):
                     # maximum ductile damage vs confinement: choice [D] (formula
                     # not retrieved, notes sec. 1.9): DMAX (sqrt(3 J2')/J1)^power
                     ratio = math.sqrt(3.0) * rv / J1v if J1v > 0.0 else 1.0
-                    dmax = DMAX * (min(ratio, 1.0) ** p[P_DMAX_POWER])
+                    dmax = DMAX * power(min(ratio, 1.0), p[P_DMAX_POWER])
                     dd = logistic_damage(h[H_TC], r0, aa, p[P_BB], dmax)
                     if dd > h[H_DD]:
                         h[H_DD] = dd
@@ -272,7 +272,7 @@ def damage_scale(rf, irate, p):
     """Fracture-energy scale ``rf^REPOW`` of the rate effects (1 without them):
     the softening's ``GF`` grows with the dynamic-to-static strength ratio
     ``rf`` (notes sec. 1.10 [V name, R form])."""
-    return rf ** p[P_REPOW] if irate else 1.0
+    return power(rf, p[P_REPOW]) if irate else 1.0
 
 
 @njit(cache=True, error_model="numpy", parallel=True)

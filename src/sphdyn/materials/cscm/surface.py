@@ -87,13 +87,13 @@ def _rubin_cs(q1, q2, cb, sb):
     a0 = 2.0 * q1 * q1 * (q2 - 1.0)
     a1 = math.sqrt(3.0) * q2 + 2.0 * q1 * (q2 - 1.0)
     a2 = q2
-    a = (-a1 + math.sqrt(max(a1 * a1 - 4.0 * a2 * a0, 0.0))) / (2.0 * a2)
+    a = (-a1 + math.sqrt(max(a1 * a1 - 4.0 * a2 * a0, 0.0))) * (0.5 / a2)
     b = (2.0 * q1 + a) ** 2 - 3.0
     b0 = -(3.0 + b - a * a) / 4.0
     cs = cb - a * sb
     b1 = a * cs
     b2 = cs * cs + b * sb * sb
-    return (-b1 + math.sqrt(max(b1 * b1 - 4.0 * b2 * b0, 0.0))) / (2.0 * b2)
+    return (-b1 + math.sqrt(max(b1 * b1 - 4.0 * b2 * b0, 0.0))) * (0.5 / b2)
 
 
 @njit(cache=True, error_model="numpy")
@@ -279,7 +279,14 @@ def meridian_radius_curvature(J1, m, p):
         return 0.0, 0.0, 0.0
     dff = p[P_LAMDA] * p[P_BETA] * e + p[P_THETA]
     d2ff = -p[P_LAMDA] * p[P_BETA] * p[P_BETA] * e
-    x = J1 if J1 > 0.0 else 0.0
+    if J1 <= 0.0 and J1 <= L:
+        # tensile pressure, left of the cap: the Rubin ratios are held at
+        # their J1 = 0 values (rubin_q: a1 - l1 exp(0) + t1 0, the same
+        # bits), so the factor is a constant and F = Rub Ff: the chain
+        # below would give these values with its derivatives all zero
+        rub = _rubin_cs(p[P_A1] - p[P_L1], p[P_A2] - p[P_L2], cb, sb)
+        return rub * ff, rub * dff, rub * d2ff
+    x = J1 if J1 > 0.0 else 0.0  # (J1 <= 0 here only inside a cap with L < 0)
     e1 = math.exp(-p[P_B1] * x)
     e2 = math.exp(-p[P_B2] * x)
     q1 = p[P_A1] - p[P_L1] * e1 + p[P_T1] * x
@@ -328,8 +335,9 @@ def meridian_radius_curvature(J1, m, p):
     c = math.sqrt(max(1.0 - t * t, 0.0))
     if c <= 0.0:
         return 0.0, -1e300, -1e300
-    dc = -t * k / c
-    d2c = -k * k / (c * c * c)
+    ic = k / c
+    dc = -t * ic
+    d2c = -ic * ic / c
     return r * c, dr * c + r * dc, d2r * c + 2.0 * dr * dc + r * d2c
 
 
@@ -343,15 +351,17 @@ def _quadratic_root(w, dw, d2w, u, du, d2u, v, dv, d2v):
     (``s' = s'' = 0`` where ``D <= 0``)."""
     D = u * u - 4.0 * w * v
     s = math.sqrt(max(D, 0.0))
+    iw = 0.5 / w  # one division, off the sqrt's path (latency: see docstring)
     ds = d2s = 0.0
     if D > 0.0:
         dD = 2.0 * u * du - 4.0 * (dw * v + w * dv)
         d2D = 2.0 * (du * du + u * d2u) - 4.0 * (d2w * v + 2.0 * dw * dv + w * d2v)
-        ds = dD / (2.0 * s)
-        d2s = (d2D - 2.0 * ds * ds) / (2.0 * s)
-    y = (-u + s) / (2.0 * w)
-    dy = (-du + ds - 2.0 * dw * y) / (2.0 * w)
-    d2y = (-d2u + d2s - 2.0 * d2w * y - 4.0 * dw * dy) / (2.0 * w)
+        i_s = 0.5 / s
+        ds = dD * i_s
+        d2s = (d2D - 2.0 * ds * ds) * i_s
+    y = (-u + s) * iw
+    dy = (-du + ds - 2.0 * dw * y) * iw
+    d2y = (-d2u + d2s - 2.0 * d2w * y - 4.0 * dw * dy) * iw
     return y, dy, d2y
 
 
