@@ -745,6 +745,22 @@ def test_rate_enhanced_damage_thresholds():
     assert np.array_equal(a["stress"], b["stress"])
 
 
+def test_power_skips_pow_only_for_the_exponent_one():
+    # damage.power: x ** e, with e == 1 (the default pwrt and repow) returned
+    # as x (pow is within 0.52 ulp of the representable x: the same bits);
+    # any other exponent is pow's (the transition with pwrc = 5 and 0.7)
+    from sphdyn.materials.cscm.damage import power, transition
+    for x in (0.0, 0.3, 0.7071067811865476, 1.0, 2.5):
+        assert power(x, 1.0) == x ** 1.0 == x
+        assert power(x, 5.0) == x ** 5.0
+        assert power(x, 0.7) == x ** 0.7
+    r = 1e6
+    J1 = 0.6 * math.sqrt(3.0) * r
+    assert transition(J1, r, 1.0) == pytest.approx(0.6, rel=1e-15)
+    assert transition(J1, r, 5.0) == pytest.approx(0.6 ** 5, rel=1e-14)
+    assert transition(-J1, r, 0.7) == pytest.approx(0.6 ** 0.7, rel=1e-14)
+
+
 def test_fracture_energy_grows_with_rate_by_repow():
     # notes sec. 1.10 [V name, R form]: with rate effects the softening's GF
     # is multiplied by rf^REPOW (rf the dynamic-to-static strength ratio).

@@ -3,8 +3,8 @@
 ``build_neighbours`` builds a :class:`NeighbourList` (CSR arrays plus the
 positions, smoothing lengths and active mask it was built from);
 ``needs_rebuild`` tells from the largest displacement (relative to the
-body's common one) and growth of ``h``
-since the build whether the skin still covers every pair;
+common one) and growth of ``h`` since the build whether the skin still
+covers every pair;
 ``update_neighbours`` rebuilds in place when it does not or when the
 particle set changed.
 """
@@ -128,22 +128,22 @@ def _max_disp_from(x, x_ref, c0, c1, c2, active, use_active, dim):
     active particles (z ignored in 2D); NaN contributions become +inf.
     Deterministic (max reductions)."""
     n = x.shape[0]
-    mc2 = 0.0
-    m02 = 0.0
+    most_c = 0.0  # max |e - c|^2
+    most_0 = 0.0  # max |e|^2
     for i in prange(n):
-        dc = 0.0
-        d0 = 0.0
+        sq_c = 0.0
+        sq_0 = 0.0
         if (not use_active) or active[i]:
             e0 = x[i, 0] - x_ref[i, 0]
             e1 = x[i, 1] - x_ref[i, 1]
             e2 = x[i, 2] - x_ref[i, 2] if dim == 3 else 0.0
-            d0 = e0 * e0 + e1 * e1 + e2 * e2
-            dc = (e0 - c0) * (e0 - c0) + (e1 - c1) * (e1 - c1) + (e2 - c2) * (e2 - c2)
-            if d0 != d0 or dc != dc:
-                d0 = dc = np.inf
-        mc2 = max(mc2, dc)
-        m02 = max(m02, d0)
-    return mc2, m02
+            sq_0 = e0 * e0 + e1 * e1 + e2 * e2
+            sq_c = (e0 - c0) * (e0 - c0) + (e1 - c1) * (e1 - c1) + (e2 - c2) * (e2 - c2)
+            if sq_0 != sq_0 or sq_c != sq_c:
+                sq_0 = sq_c = np.inf
+        most_c = max(most_c, sq_c)
+        most_0 = max(most_0, sq_0)
+    return most_c, most_0
 
 
 @njit(cache=True, error_model="numpy")
@@ -213,9 +213,9 @@ def max_displacement(nl, x, h):
         ``max_i |x_i - x_ref_i - c|`` [m] (x, y only in 2D), with ``c`` the
         centre of the bounding box of the displacements ``x_i - x_ref_i``
         (a body moving as a whole gives 0) or ``c = 0`` if that gives less
-        (the box's centre is not the smallest enclosing ball's), and ``max(0, max_i (h_i -
-        h_ref_i))`` [m], over the particles active at the build. NaN gives
-        +inf. Deterministic (min and max reductions).
+        (the box's centre is not the smallest enclosing ball's), and
+        ``max(0, max_i (h_i - h_ref_i))`` [m], over the particles active at
+        the build. NaN gives +inf. Deterministic (min and max reductions).
     """
     use_active = nl.active_ref is not None
     act = nl.active_ref if use_active else _NO_MASK

@@ -351,7 +351,7 @@ def _quadratic_root(w, dw, d2w, u, du, d2u, v, dv, d2v):
     (``s' = s'' = 0`` where ``D <= 0``)."""
     D = u * u - 4.0 * w * v
     s = math.sqrt(max(D, 0.0))
-    iw = 0.5 / w  # one division, off the sqrt's path (latency: see docstring)
+    iw = 0.5 / w  # one division, not three, and not after the sqrt's
     ds = d2s = 0.0
     if D > 0.0:
         dD = 2.0 * u * du - 4.0 * (dw * v + w * dv)
