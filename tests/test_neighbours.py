@@ -455,9 +455,9 @@ def test_a_body_moving_as_a_whole_needs_no_rebuild():
     their round-off asymmetry) and no rebuild; one particle moved against
     the others changes its pairs' separations by as much, so needs one
     from a skin on (the criterion before, 2 max |d| > skin, from half a
-    skin). The centre of the box is
-    not the best common displacement: random directions of one length
-    (a box centred near 0) give max |d| itself (c = 0 taken when smaller)."""
+    skin). The centre of the box is not the best common displacement:
+    random directions of one length (a box centred near 0) give max |d|
+    itself (c = 0 taken when smaller)."""
     rng = np.random.default_rng(12)
     n, dim = 2000, 3
     x, h = random_cloud(rng, n, dim, h0=0.05)
