@@ -126,7 +126,9 @@ class SPHPart:
                            ("dt_viscous", ())):
             p.add(name, tail)
         p.add("tl", (), np.bool_, fill=False)
-        p.add("n_support", (), np.int32)  # pairs within the support (velocity_gradient)
+        # each row's own pairs within the support, at its head (velocity_gradient
+        # counts them, forces visits them)
+        p.add("n_support", (), np.int32)
         self.as_on = any(e > 0 for e, tl in zip(settings.epsilon, settings.total_lagrangian)
                          if not tl)
         if self.as_on:
