@@ -203,9 +203,9 @@ def final_step_rows(time: np.ndarray, dt: np.ndarray, t_end: float | None) -> np
     A row at time ``t`` reports the step ``dt`` taken from ``t`` (a row at
     ``t_end``, the run's last, the step that ended there), so the rows of
     the last step are those with ``t + dt`` at ``t_end`` (to the run loop's
-    1e-12 of ``t_end``). They are marked only if that step is shorter than
-    the one reported by the row before them (else it was not shortened).
-    None or an unfinished run: no row.
+    1e-12 of ``t_end``) whose step is shorter than the one reported by the
+    row before them (else it was not shortened). None or an unfinished run:
+    no row.
     """
     rows = np.zeros(dt.size, bool)
     if t_end is None or dt.size < 2:
@@ -215,9 +215,9 @@ def final_step_rows(time: np.ndarray, dt: np.ndarray, t_end: float | None) -> np
     if not at_end.size or not time[-1] >= end:
         return rows
     first = at_end[0]  # times increase: every later row is at the end too
-    if first == 0 or not dt[-1] < dt[first - 1]:
+    if first == 0:
         return rows
-    rows[first:] = True
+    rows[first:] = dt[first:] < dt[first - 1]
     return rows
 
 
@@ -279,8 +279,8 @@ def history_figures(data: dict[str, np.ndarray], title: str = "",
         if has_total:
             drift = relative_drift(data["E_total"], [data[c] for c in energy_cols])
             axes[1].plot(shown, drift, color="k", label="E_total drift")
-            axes[1].set_ylabel("(E_total - E_total(0)) / max|E| [-]")
-            _finish_axes(axes[1], "Relative energy drift")
+            axes[1].set_ylabel("drift [-]")  # short: the formula is in the title
+            _finish_axes(axes[1], "Relative energy drift (E_total - E_total(0)) / max|E|")
         axes[-1].set_xlabel(f"time [{tu}]")
         figures["energies"] = fig
 
@@ -331,7 +331,8 @@ def history_figures(data: dict[str, np.ndarray], title: str = "",
         if final.any():
             ax.plot([], [], " ", label=f"(not drawn: the last step, {dt[final][-1]:.3g} "
                     f"{du}, shortened to end at t_end)")
-        ax.set_ylim(bottom=0.0)
+        top = np.max(dt[~final], initial=0.0)
+        ax.set_ylim(0.0, 1.15 * top if np.isfinite(top) and top > 0 else None)
         ax.set_xlabel("step [-]" if xkey == "step" else f"time [{tu}]")
         ax.set_ylabel(f"time step dt [{du}]")
         _finish_axes(ax, f"Time step ({title})")
