@@ -108,7 +108,8 @@ def test_the_last_step_is_left_out_when_two_rows_report_it():
     row at t_end both report the shortened step (beam_fem: 7.34 us after
     16.4 us); the old check (last dt below the one before) missed it and
     drew the drop as a collapse. final_step_rows finds both rows; a step
-    that lands on t_end unshortened, and a run stopped early, have none."""
+    that lands on t_end unshortened, a run stopped early and a history
+    going past t_end have none."""
     from sphdyn.io.plots import final_step_rows
 
     time = np.array([0.0, 10.0, 20.0, 30.0, 32.0]) * 1e-6
@@ -121,6 +122,8 @@ def test_the_last_step_is_left_out_when_two_rows_report_it():
     assert np.array_equal(ax.get_lines()[0].get_ydata(), [1.0, 1.0, 1.0])  # in µs
     assert not final_step_rows(time, np.full(5, 1e-6), t_end).any()  # not shortened
     assert not final_step_rows(time, dt, 40e-6).any()  # stopped before t_end
+    # restarted past the deck's t_end (sphdyn restart --t-end): nothing hidden
+    assert not final_step_rows(np.append(time, 50e-6), np.append(dt, 1e-6), t_end).any()
     assert not final_step_rows(time, dt, None).any()
 
 

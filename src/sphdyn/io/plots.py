@@ -202,14 +202,25 @@ def final_step_rows(time: np.ndarray, dt: np.ndarray, t_end: float | None) -> np
 
     A row at time ``t`` reports the step ``dt`` taken from ``t`` (a row at
     ``t_end``, the run's last, the step that ended there), so the rows of
-    the last step are those with ``t + dt`` at ``t_end`` (to the run loop's
-    1e-12 of ``t_end``) whose step is shorter than the one reported by the
-    row before them (else it was not shortened). None or an unfinished run:
-    no row.
+    the last step are the trailing rows with ``t + dt`` or ``t`` at
+    ``t_end`` (to the run loop's 1e-12 of ``t_end``) whose step is shorter
+    than the one reported by the row before them (else it was not
+    shortened). None, or a history not ending at ``t_end`` (a run stopped
+    early, a restart to a later end): no row.
     """
     rows = np.zeros(dt.size, bool)
     if t_end is None or dt.size < 2:
         return rows
+    tol = 1e-12 * abs(t_end)
+    if not abs(time[-1] - t_end) <= tol:  # stopped early, or another end time
+        return rows
+    lands = (np.abs(time + dt - t_end) <= tol) | (np.abs(time - t_end) <= tol)
+    first = dt.size
+    while first > 0 and lands[first - 1]:  # the trailing rows of the last step
+        first -= 1
+    if first > 0:
+        rows[first:] = dt[first:] < dt[first - 1]
+    return rows
     end = t_end * (1 - 1e-12)
     at_end = np.flatnonzero(time + dt >= end)
     if not at_end.size or not time[-1] >= end:
