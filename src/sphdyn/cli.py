@@ -99,9 +99,8 @@ def _writable_dir(path, flag: str) -> Path:
 
 def cmd_run(args) -> int:
     from .deck import load_deck
-    from .simulation import Simulation
-
     from .monitors import compile_notice
+    from .simulation import Simulation
 
     deck = load_deck(args.deck, args.set)
     out = Path(args.out) if args.out else Path("out") / Path(args.deck).stem

@@ -230,8 +230,7 @@ class Progress:
     """A progress bar in simulated time (tqdm) with an ETA from the steady steps.
 
     While Numba compiles kernels (the first run's first steps, or a kernel
-    first needed later, e.g. at first contact) the bar says so instead of an
-    ETA; the ETA (:class:`RemainingTime`) appears once enough steps have been
+    first needed later in the run) the bar says so instead of an ETA; the ETA (:class:`RemainingTime`) appears once enough steps have been
     timed without compilation.
     """
 
