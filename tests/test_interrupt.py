@@ -128,6 +128,9 @@ def test_an_interrupted_run_in_process_writes_everything(tmp_path):
     # rows are taken at the kick's time t^n of the step after: the kick of
     # step 29 recorded step 28 (history_every = 2); all rows so far are on disk
     assert h["step"][-1] == 28
+    # the last state is the last frame (a stop frame, replaced on restart)
+    t, step, _, attrs = read_frame(_frames(tmp_path / "api")[-1])
+    assert (t, step) == (summary["time"], 30) and attrs.get("stop_frame")
 
 
 def test_a_full_disk_stops_the_run_and_keeps_what_was_written(tmp_path, monkeypatch):

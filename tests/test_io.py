@@ -290,7 +290,8 @@ class TestFields:
         p = _particles(5)
         names = [n for n, f in FIELDS.items() if f.shape != "history"] + p.hist_names
         f = particle_fields(p, names)
-        assert list(f) == names  # position first, then in the order asked
+        always = ["position", "mass"]  # first, then the others in the order asked
+        assert list(f) == always + [n for n in names if n not in always]
         np.testing.assert_array_equal(f["position"], p.x)
         np.testing.assert_array_equal(f["velocity"], p.v)
         np.testing.assert_array_equal(f["displacement"], p.x - p.x0)
@@ -309,10 +310,11 @@ class TestFields:
     def test_position_always_and_copies(self):
         p = _particles(3)
         f = particle_fields(p, ["velocity"])
-        assert list(f) == ["position", "velocity"]
+        assert list(f) == ["position", "mass", "velocity"]
         f["position"][:] = 0.0
         f["velocity"][:] = 0.0
-        assert np.all(p.x != 0.0) and np.all(p.v != 0.0)
+        f["mass"][:] = 0.0
+        assert np.all(p.x != 0.0) and np.all(p.v != 0.0) and np.all(p.m != 0.0)
 
     def test_unknown_name(self):
         p = _particles(2)

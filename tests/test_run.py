@@ -311,3 +311,153 @@ def test_run_examples_picks_the_runs_of_an_example_script(tmp_path, monkeypatch)
     calls.clear()
     sim.run_examples(tmp_path, runs, "full", include_full=True)
     assert calls == [("coarse", False), ("full", False)]
+
+
+# ------------------------------------------------- the first two minutes (issue 57)
+def test_remaining_time_leaves_out_compilation_and_waits_for_steady_steps():
+    """The ETA (RemainingTime) of a first run: a first step of 17 s (Numba
+    compiling) and then steps of 10 ms advancing 1 ns each. No estimate until
+    5 steady steps are timed; then 1e-4 s left takes 1e5 steps of 10 ms =
+    1000 s, not the 3:57:10 extrapolated from the first step. A later step
+    during which Numba compiled (5 s) is left out too. Sums of equal floats:
+    relative error of a few ulp (tolerance 1e-12)."""
+    from sphdyn.monitors import RemainingTime
+
+    eta = RemainingTime()
+    assert eta.seconds(1e-4) is None
+    eta.add(17.0, 1e-9)
+    for _ in range(4):
+        eta.add(0.01, 1e-9)
+        assert eta.seconds(1e-4) is None  # fewer than 5 steady steps
+    eta.add(0.01, 1e-9)
+    assert eta.seconds(1e-4) == pytest.approx(1000.0, rel=1e-12)
+    eta.add(5.0, 1e-9, compiled=True)
+    assert eta.seconds(1e-4) == pytest.approx(1000.0, rel=1e-12)
+    # the rate follows the run: 40 s of steps at 20 ms push the 10 ms ones out
+    for _ in range(2000):
+        eta.add(0.02, 1e-9)
+    assert eta.seconds(1e-4) == pytest.approx(2000.0, rel=1e-9)
+
+
+def test_the_progress_bar_says_compiling_and_shows_no_eta_before_steady_steps():
+    """While Numba compiles (a kernel not in its cache), the bar shows
+    'compiling kernels (first run only)' at once; after the step it shows no
+    ETA until 5 steady steps are timed, then the ETA of the steady rate (a
+    clock advancing 0.5 s per step of 1 us: at 6 us of 20 us, 14 steps left
+    = 7 s, '00:07'); and compile_notice writes its line once, and nothing
+    when told to be quiet."""
+    import types
+
+    import numba
+
+    from sphdyn.monitors import COMPILING, Progress, compile_notice
+
+    clock = iter(np.arange(0.0, 100.0, 0.5))
+    bar = Progress(0.0, 2e-5, clock=lambda: float(next(clock)))
+    s = types.SimpleNamespace(t=0.0)
+
+    @numba.njit(cache=False)
+    def fresh(x):  # never compiled before: a "numba:compile" event
+        return x + 1
+
+    shown = []
+    try:
+        fresh(1)
+        assert bar.bar.postfix == COMPILING
+        for k in range(1, 7):
+            s.t = k * 1e-6
+            bar.after_step(s)
+            shown.append(bar.bar.postfix)
+    finally:
+        bar.close()
+    assert shown == [""] * 5 + ["ETA 00:07"]
+    said = []
+    with compile_notice(said.append):
+        numba.njit(cache=False)(lambda x: x * 2)(1)
+        numba.njit(cache=False)(lambda x: x * 3)(1)
+    assert len(said) == 1 and COMPILING in said[0]
+    with compile_notice(None):
+        numba.njit(cache=False)(lambda x: x * 4)(1)  # says nothing, raises nothing
+
+
+def test_summary_text_says_how_the_run_ended_and_what_to_open(tmp_path):
+    """The end of a run for a person (summary_text), from a summary as
+    _summary makes it: status, time in us, steps, wall time, energy error in
+    per cent, the wall's peak force in kN (81,600 N; 3D), a reaction in MN,
+    and the files to open that exist; a stopped run says how to continue."""
+    from sphdyn.simulation import summary_text
+
+    (tmp_path / "plots").mkdir()
+    (tmp_path / "plots" / "forces.png").write_bytes(b"")
+    (tmp_path / "particles.pvd").write_text("")
+    summary = {"status": "stopped", "signal": None, "time": 1.25e-5, "steps": 120,
+               "steps_this_run": 120, "wall_seconds": 75.0, "dimension": 3,
+               "energy_error_max_rel": 0.0123, "peak_F_wall_base": 81600.0,
+               "peak_F_wall_base_mean": 69200.0, "force_window": 5e-6,
+               "peak_clamped_reaction": 1.04e7}
+    text = summary_text(summary, tmp_path)
+    assert text.splitlines()[0] == ("sphdyn: stopped by --max-steps at t = 12.5 µs, "
+                                    "step 120, in 1 min 15 s")
+    for words in ("energy error: 1.23 %", "peak force on wall base: 81.6 kN "
+                  "(5 µs mean 69.2 kN)", "peak reaction of clamped: 10.4 MN",
+                  "particles.pvd    open in ParaView (0 frames)", "plots/           forces.png",
+                  "summary.json", f"continue with: sphdyn restart {tmp_path}"):
+        assert words in text, words
+    summary.update(status="completed", dimension=2, peak_F_wall_base=812.0)
+    del summary["peak_F_wall_base_mean"]
+    text = summary_text(summary, tmp_path)
+    assert "peak force on wall base: 812 N/m\n" in text and "continue" not in text
+
+
+def test_the_cli_ends_a_run_with_a_summary_not_json_and_q_is_quiet(tmp_path, capsys):
+    """`sphdyn run` used to end with a raw JSON line; it prints the summary
+    for a person (no line of JSON), and summary.json keeps every value.
+    With -q it prints nothing on stdout (warnings and errors only)."""
+    deck = tmp_path / "small.toml"
+    deck.write_text(SMALL_DISC.format(t_end="1 ms", ck=0))
+    assert main(["run", str(deck), "--out", str(tmp_path / "a"), "--threads", "1",
+                 "--max-steps", "30"]) == 0
+    out = capsys.readouterr().out
+    assert not any(line.lstrip().startswith("{") for line in out.splitlines()), out
+    assert "stopped by --max-steps" in out and "particles.pvd" in out
+    assert "summary.json" in out and "energy error" in out
+    saved = json.loads((tmp_path / "a/summary.json").read_text())
+    assert saved["status"] == "stopped" and saved["steps"] == 30
+    assert "particle_steps_per_s" in saved
+    assert main(["run", str(deck), "--out", str(tmp_path / "b"), "--threads", "1",
+                 "--max-steps", "30", "-q"]) == 0
+    assert capsys.readouterr().out == ""
+
+
+def test_a_run_stopped_by_max_steps_ends_with_its_last_state_in_the_frames(tmp_path):
+    """A run stopped by --max-steps wrote no frame of its last state (ParaView
+    showed only t = 0). Now its last state is a frame, listed in the .pvd,
+    marked as a stop frame; the restart drops it, so the frames of the
+    stopped-and-restarted run are those of a run straight through (same
+    names, times and fields). A run ending at t_end writes no second frame at
+    t_end; one interrupted writes its last state too."""
+    from sphdyn.io import read_frame_header
+
+    part = _sim(tmp_path, "part", t_end="1 ms")
+    summary = part.run(max_steps=25)
+    assert summary["status"] == "stopped"
+    entries = read_pvd(tmp_path / "part/particles.pvd")
+    assert [t for t, _ in entries] == [0.0, summary["time"]]
+    t, step, fields, attrs = read_frame(tmp_path / "part/frames/frame_00001.h5")
+    assert (t, step) == (summary["time"], 25) and attrs.get("stop_frame")
+    assert np.array_equal(fields["position"], part.particles.x)
+
+    assert main(["restart", str(tmp_path / "part"), "-q"]) == 0
+    full = _sim(tmp_path, "full", t_end="1 ms")
+    full.run()
+    names = [f.name for f in sorted((tmp_path / "full/frames").glob("*.h5"))]
+    assert names == [f.name for f in sorted((tmp_path / "part/frames").glob("*.h5"))]
+    for name in names:
+        t_full, _, f_full, _ = read_frame(tmp_path / "full/frames" / name)
+        t_part, _, f_part, a_part = read_frame(tmp_path / "part/frames" / name)
+        assert t_full == t_part and not a_part.get("stop_frame")
+        assert np.array_equal(f_full["position"], f_part["position"]), name
+    times = [read_frame_header(tmp_path / "full/frames" / n)[0] for n in names]
+    assert times.count(times[-1]) == 1 and times[-1] == pytest.approx(1e-3, rel=1e-12)
+    assert read_pvd(tmp_path / "part/particles.pvd") == read_pvd(
+        tmp_path / "full/particles.pvd")

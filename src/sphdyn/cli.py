@@ -99,17 +99,25 @@ def _writable_dir(path, flag: str) -> Path:
 
 def cmd_run(args) -> int:
     from .deck import load_deck
+    from .monitors import compile_notice
     from .simulation import Simulation
 
     deck = load_deck(args.deck, args.set)
     out = Path(args.out) if args.out else Path("out") / Path(args.deck).stem
     _writable_dir(out, "--out")
-    sim = Simulation.from_deck(deck, out)
-    print(f"sphdyn: {sim.particles.n} particles{_mesh_counts(sim.model)}, "
-          f"{deck.run.dimension}D, "
-          f"t_end = {deck.run.t_end:g} s, initial dt = {sim.stepper.dt0:.3e} s -> {out}")
+    with compile_notice(None if args.quiet else _note):
+        sim = Simulation.from_deck(deck, out)
+    if not args.quiet:
+        print(f"sphdyn: {sim.particles.n} particles{_mesh_counts(sim.model)}, "
+              f"{deck.run.dimension}D, "
+              f"t_end = {deck.run.t_end:g} s, initial dt = {sim.stepper.dt0:.3e} s -> {out}")
     return _finish(sim.run(max_steps=args.max_steps, progress=not args.quiet and None,
-                           threads=args.threads), out)
+                           threads=args.threads), out, args.quiet)
+
+
+def _note(text: str) -> None:
+    """A line for the person waiting (stderr, at once)."""
+    print(text, file=sys.stderr, flush=True)
 
 
 def _mesh_counts(model) -> str:
@@ -123,28 +131,33 @@ def _mesh_counts(model) -> str:
 
 
 def cmd_restart(args) -> int:
+    from .monitors import compile_notice
     from .simulation import Simulation
 
     if Path(args.dir).is_dir():  # a missing one is reported by from_directory
         _writable_dir(args.dir, "DIR")
-    sim = Simulation.from_directory(args.dir)
+    with compile_notice(None if args.quiet else _note):
+        sim = Simulation.from_directory(args.dir)
     t = sim.stepper.t
     if args.t_end is not None and args.t_end <= t * (1 + 1e-12):
         raise ValueError(f"--t-end {args.t_end:g} s is not after the checkpoint's time "
                          f"t = {t:.6g} s in {args.dir}. Fix: give a --t-end later than "
                          f"{t:.6g} s")
-    print(f"sphdyn: restarting {args.dir} at t = {t:.6e} s "
-          f"(step {sim.stepper.step_count})")
+    if not args.quiet:
+        print(f"sphdyn: restarting {args.dir} at t = {t:.6e} s "
+              f"(step {sim.stepper.step_count})")
     return _finish(sim.run(t_end=args.t_end, max_steps=args.max_steps,
                            progress=not args.quiet and None,
-                           threads=args.threads), args.dir)
+                           threads=args.threads), args.dir, args.quiet)
 
 
-def _finish(summary: dict, out) -> int:
-    """Print the run's one-line summary; the exit code (128 + signal if interrupted)."""
-    keys = ("status", "particles", "steps", "time", "wall_seconds",
-            "particle_steps_per_s", "energy_error_max_rel")
-    print(json.dumps({k: summary.get(k) for k in keys}))
+def _finish(summary: dict, out, quiet: bool = False) -> int:
+    """Print the run's summary for a person (not with ``-q``; all of it is in
+    summary.json); the exit code (128 + signal if interrupted)."""
+    from .simulation import summary_text
+
+    if not quiet:
+        print(summary_text(summary, out))
     if summary.get("status") == "interrupted":
         import signal
 
@@ -452,6 +465,10 @@ def cmd_airblast(args) -> int:
     return 0
 
 
+#: what -q leaves out of a run
+QUIET = "print only warnings and errors: no progress bar, no summary (summary.json has it)"
+
+
 def build_parser() -> argparse.ArgumentParser:
     from . import __version__
 
@@ -467,7 +484,7 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--set", action="append", metavar="KEY=VALUE",
                    help="override a deck value, e.g. --set run.t_end=1e-4")
     r.add_argument("--max-steps", type=_whole(0), help="stop after this many steps")
-    r.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    r.add_argument("-q", "--quiet", action="store_true", help=QUIET)
     r.set_defaults(func=cmd_run)
 
     en = sub.add_parser("ensemble", help="run N random samples of a deck (and a grid "
@@ -507,7 +524,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--threads", type=_whole(1), default=None,
                    help="Numba threads (default: automatic)")
     s.add_argument("--max-steps", type=_whole(0), help="stop after this many steps")
-    s.add_argument("-q", "--quiet", action="store_true")
+    s.add_argument("-q", "--quiet", action="store_true", help=QUIET)
     s.set_defaults(func=cmd_restart)
 
     p = sub.add_parser("plot", help="plot DIR/history.csv (or particle snapshots) "

@@ -57,7 +57,9 @@ class OutputField:
     default : bool
         Written when the deck gives no ``output.fields``.
     always : bool
-        Written in every frame; not named in ``output.fields``.
+        Written in every frame (``position``; ``mass``, so that momentum
+        can be summed from a frame); naming it in ``output.fields`` changes
+        nothing.
     probe : bool
         A ``[[probe]]`` quantity (vector and tensor fields: each component,
         ``velocity_x``, ``stress_xy``).
@@ -85,8 +87,9 @@ def register_field(field: OutputField, *, replace: bool = False) -> OutputField:
 
 
 def allowed_fields() -> list[str]:
-    """Names that ``output.fields`` accepts, in registry order."""
-    return [f.name for f in FIELDS.values() if not f.always]
+    """Names that ``output.fields`` accepts (every registered field), in
+    registry order."""
+    return list(FIELDS)
 
 
 def default_fields() -> tuple[str, ...]:
@@ -179,8 +182,8 @@ _BUILT_IN = (
                 probe=True),
     OutputField("density", "scalar", "kg/m^3", "Current density rho.",
                 _array("rho"), default=True, probe=True),
-    OutputField("mass", "scalar", "kg", "Mass m (kg/m in 2D).",
-                _array("m"), default=True),
+    OutputField("mass", "scalar", "kg", "Mass m (kg/m in 2D, kg/m^2 in 1D).",
+                _array("m"), always=True),
     OutputField("smoothing_length", "scalar", "m", "Smoothing length h.",
                 _array("h"), default=True, probe=True),
     OutputField("damage", "scalar", "-", "Scalar damage in [0, 1].",

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import time
+from contextlib import contextmanager
 
 import numpy as np
 
@@ -120,18 +121,148 @@ class Checkpoints:
             self.write()
 
 
-class Progress:
-    """A progress bar with an ETA in simulated time (tqdm)."""
+#: the progress bar's word while Numba compiles (a cold cache: the first run)
+COMPILING = "compiling kernels (first run only)"
 
-    def __init__(self, t: float, t_end: float):
+
+class CompileWatch:
+    """Count Numba's compilations while entered (a context manager).
+
+    Numba announces each compilation of a kernel, one not found in its cache,
+    as a ``"numba:compile"`` event (``numba.core.event``); loading a cached
+    kernel raises none. ``on_start()`` is called when a compilation starts
+    (nested ones included), so a caller can say what the wait is for.
+    """
+
+    def __init__(self, on_start=None):
+        self.count = 0
+        self._on_start = on_start
+        self._listener = None
+
+    def __enter__(self) -> "CompileWatch":
+        from numba.core import event
+
+        watch = self
+
+        class Listener(event.Listener):
+            def on_start(self, ev) -> None:
+                watch.count += 1
+                if watch._on_start is not None:
+                    watch._on_start()
+
+            def on_end(self, ev) -> None:
+                pass
+
+        self._listener = Listener()
+        event.register("numba:compile", self._listener)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        from numba.core import event
+
+        event.unregister("numba:compile", self._listener)
+
+
+@contextmanager
+def compile_notice(write):
+    """Within: ``write(text)`` once, when Numba starts compiling a kernel, so a
+    first run's wait (building the model compiles kernels too) is explained;
+    ``write=None`` says nothing."""
+    said = []
+
+    def start() -> None:
+        if write is not None and not said:
+            said.append(True)
+            write(f"sphdyn: {COMPILING}: this may take minutes; later runs load them "
+                  "from Numba's cache")
+
+    with CompileWatch(start):
+        yield
+
+
+class RemainingTime:
+    """Wall time left in a run, from the rate of its recent steady steps.
+
+    A step's wall time and simulated time go in with :meth:`add`. The first
+    ``skip`` steps and every step during which Numba compiled are left out
+    (their seconds are compilation, not stepping), and so are steps older
+    than ``horizon`` seconds of counted wall time or than the last
+    ``max_steps`` (the rate follows the run: contact, rebuilds).
+    :meth:`seconds` is ``None`` until ``min_steps`` steps are counted: no
+    estimate rather than one extrapolated from compilation.
+    """
+
+    def __init__(self, skip: int = 1, min_steps: int = 5, horizon: float = 30.0,
+                 max_steps: int = 5000):
+        from collections import deque
+
+        self.skip, self.min_steps, self.horizon = skip, min_steps, horizon
+        self.max_steps = max_steps
+        self._seen = 0
+        self._steps = deque()
+        self._wall = self._sim = 0.0
+
+    def add(self, wall: float, sim: float, compiled: bool = False) -> None:
+        """One step: ``wall`` [s] it took, ``sim`` [s] it advanced the run;
+        ``compiled``: Numba compiled during it."""
+        self._seen += 1
+        if self._seen <= self.skip or compiled:
+            return
+        self._steps.append((wall, sim))
+        self._wall += wall
+        self._sim += sim
+        while len(self._steps) > self.max_steps or (
+                len(self._steps) > self.min_steps
+                and self._wall - self._steps[0][0] >= self.horizon):
+            w, t = self._steps.popleft()
+            self._wall -= w
+            self._sim -= t
+
+    def seconds(self, sim_left: float) -> float | None:
+        """Wall seconds to advance ``sim_left`` [s] more, or None (too few
+        steady steps timed yet)."""
+        if len(self._steps) < self.min_steps or not (self._sim > 0 and self._wall > 0):
+            return None
+        return max(sim_left, 0.0) * self._wall / self._sim
+
+
+class Progress:
+    """A progress bar in simulated time (tqdm) with an ETA from the steady steps.
+
+    While Numba compiles kernels (the first run's first steps, or a kernel
+    first needed later in the run) the bar says so instead of an ETA; the ETA (:class:`RemainingTime`) appears once enough steps have been
+    timed without compilation.
+    """
+
+    def __init__(self, t: float, t_end: float, clock=time.perf_counter):
         from tqdm import tqdm
 
+        self.t_end, self.clock = t_end, clock
         self.bar = tqdm(total=t_end, initial=t, unit="s(sim)", unit_scale=True,
                         bar_format="{l_bar}{bar}| t={n:.3e}/{total:.3e} s "
-                                   "[{elapsed}<{remaining}]", mininterval=0.5)
+                                   "[{elapsed}{postfix}]", mininterval=0.5)
+        self.eta = RemainingTime()
+        self.watch = CompileWatch(self._compiling).__enter__()
+        self._t, self._last, self._compiles = t, clock(), 0
+        self._shown = 0.0
+
+    def _compiling(self) -> None:
+        if self.bar.postfix != COMPILING:
+            self.bar.set_postfix_str(COMPILING)  # refreshes now: the step may take long
 
     def after_step(self, s) -> None:
+        now = self.clock()
+        compiled = self.watch.count != self._compiles
+        self.eta.add(now - self._last, s.t - self._t, compiled)
+        self._t, self._last, self._compiles = s.t, now, self.watch.count
+        if compiled or now - self._shown >= 0.5:  # tqdm redraws twice a second at most
+            left = self.eta.seconds(self.t_end - s.t)
+            self.bar.set_postfix_str("" if left is None else
+                                     f"ETA {self.bar.format_interval(left)}",
+                                     refresh=False)
+            self._shown = now
         self.bar.update(s.t - self.bar.n)
 
     def close(self) -> None:
+        self.watch.__exit__(None, None, None)
         self.bar.close()

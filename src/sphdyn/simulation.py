@@ -17,6 +17,7 @@ or failed run leaves only complete files behind.
 from __future__ import annotations
 
 import json
+import os
 import time
 from pathlib import Path
 
@@ -28,7 +29,9 @@ from .guards import SimulationFailed
 from .io import (FrameWriter, History, MeshFrame, atomic_write_text, particle_fields,
                  plot_history, read_checkpoint, write_checkpoint)
 from .analysis import window_mean_force
-from .io.plots import energy_columns, plot_gauges, relative_drift
+from .io.frames import STOP_FRAME, list_frames
+from .io.plots import (energy_columns, per_depth, plot_gauges, relative_drift, scaled_unit,
+                       time_unit)
 from .assembly import build_stepper
 from .gauges import GaugeRecorder, build_gauges
 from .model import Model, build_model
@@ -199,15 +202,19 @@ class Simulation:
     def _wind_up(self, t_end: float, failure) -> None:
         """The end of a run: the last frame, history row, checkpoint and plots.
 
-        Each write is tried on its own, so a full disk loses only what did
-        not fit (and a failed run still gets its history and summary).
+        However the run ends (at ``t_end``, by ``max_steps``, a signal or a
+        failure), its last state is a frame unless one was written at that
+        time; a run stopped early marks it as a stop frame, off the schedule,
+        which a restart replaces by the scheduled ones. Each write is tried
+        on its own, so a full disk loses only what did not fit (and a failed
+        run still gets its history and summary).
         """
         s = self.stepper
         done = failure is None and s.t >= t_end * (1 - 1e-12)
         writes = []
-        if failure is not None or (done and (not self.frames.frames_on_disk() or abs(
-                self.frames.last_time - s.t) > 1e-12 * t_end)):
-            writes.append(self._write_frame)
+        last = self.frames.last_time
+        if last is None or abs(last - s.t) > 1e-12 * t_end:
+            writes.append(self._write_frame if done else self._write_stop_frame)
         if done:
             self.history.append(self.recorder.row(s, kinetic=s.kinetic_now(),
                                                   dt=s.dt_prev))
@@ -229,15 +236,20 @@ class Simulation:
             print(f"warning: plotting failed: {exc}")
 
     # --------------------------------------------------------------- helpers
-    def _write_frame(self):
+    def _write_frame(self, attrs: dict | None = None):
         s = self.stepper
         computed = {}
         for part in s.parts:
             if part.kind == "sph":  # mesh parts' fields go to their own blocks
                 computed.update(part.fields())
         fields = particle_fields(self.particles, self.fields, computed)
-        self.frames.write(s.t, s.step_count, fields, meshes=mesh_frames(s.parts))
-        self.output.written(s.t)
+        self.frames.write(s.t, s.step_count, fields, meshes=mesh_frames(s.parts),
+                          attrs=attrs)
+        if attrs is None:  # a stop frame leaves the schedule as it was
+            self.output.written(s.t)
+
+    def _write_stop_frame(self):
+        self._write_frame({STOP_FRAME: True})
 
     def _checkpoint(self):
         scalars, groups = self.stepper.state()
@@ -296,7 +308,72 @@ class Simulation:
                         h["time"], impulse, window)))
         if self.model.walls:
             summary["force_window"] = window
+        for col in h:  # prescribed node sets: the largest magnitude of the reaction
+            if col.endswith("_reaction_x") and h[col].size:
+                name = col[:-len("_reaction_x")]
+                r = np.stack([h.get(f"{name}_reaction_{c}", np.zeros_like(h[col]))
+                              for c in "xyz"])
+                summary[f"peak_{name}_reaction"] = float(np.max(np.linalg.norm(r, axis=0)))
         return summary
+
+
+def _clock(seconds: float) -> str:
+    """Wall time as ``12.3 s``, ``4 min 05 s`` or ``2 h 07 min``."""
+    if seconds < 60:
+        return f"{seconds:.3g} s"
+    m = int(seconds // 60)
+    if m < 60:
+        return f"{m} min {int(seconds % 60):02d} s"
+    return f"{m // 60} h {m % 60:02d} min"
+
+
+def summary_text(summary: dict, outdir) -> str:
+    """A run's end for a person: how it ended, simulated time and steps, wall
+    time, energy error, peak wall forces and reactions, and what to open in
+    ``outdir`` (the ParaView series, the plots, ``summary.json``, which holds
+    all of ``summary`` and more)."""
+    outdir = Path(outdir)
+    tf, tu = time_unit(summary["time"])
+    dim = summary.get("dimension")
+    ended = {"completed": "completed", "stopped": "stopped by --max-steps",
+             "interrupted": f"interrupted by {summary.get('signal')}",
+             "failed": "failed"}.get(summary["status"], summary["status"])
+    steps = summary["steps"]
+    lines = [f"sphdyn: {ended} at t = {summary['time'] * tf:.4g} {tu}, step {steps}"
+             + (f" ({summary['steps_this_run']} in this run)"
+                if summary.get("steps_this_run", steps) != steps else "")
+             + f", in {_clock(summary['wall_seconds'])}"]
+    if summary.get("energy_error_max_rel") is not None:
+        lines.append(f"  energy error: {100 * summary['energy_error_max_rel']:.3g} % of the "
+                     "largest energy (plots/energies.png)")
+
+    def force(value: float) -> str:
+        f, unit = scaled_unit(value, "N")
+        return f"{value * f:.4g} {per_depth(unit, dim)}"
+
+    for key, value in summary.items():
+        if key.startswith("peak_F_wall_") and not key.endswith("_mean"):
+            mean = summary.get(f"{key}_mean")
+            window = summary.get("force_window")
+            lines.append(f"  peak force on wall {key[len('peak_F_wall_'):]}: {force(value)}"
+                         + (f" ({window * 1e6:g} µs mean {force(mean)})"
+                            if mean is not None and window else ""))
+        elif key.startswith("peak_") and key.endswith("_reaction"):
+            lines.append(f"  peak reaction of {key[5:-len('_reaction')]}: {force(value)}")
+    lines.append(f"  output in {outdir}{os.sep}:")
+    n = len(list_frames(outdir))
+    if (outdir / "particles.pvd").exists():
+        lines.append(f"    particles.pvd    open in ParaView ({n} frames)")
+    elif n:
+        lines.append(f"    frames/          {n} frames (sphdyn export {outdir} makes a "
+                     "ParaView series)")
+    plots = sorted(p.name for p in (outdir / "plots").glob("*.png"))
+    if plots:
+        lines.append(f"    plots/           {', '.join(plots)}")
+    lines.append("    summary.json     all of the above and more")
+    if summary["status"] == "stopped":
+        lines.append(f"  continue with: sphdyn restart {outdir}")
+    return "\n".join(lines)
 
 
 def _elements(part):
@@ -310,7 +387,8 @@ def _element_count(part) -> int:
 
 def mesh_frames(parts) -> dict[str, MeshFrame]:
     """One :class:`~sphdyn.io.MeshFrame` per mesh part: nodes at their current
-    positions with ``displacement`` and ``velocity`` [m, m/s], and every cell
+    positions with ``displacement``, ``velocity`` and ``mass`` [m, m/s, kg;
+    the lumped nodal mass, kg/m in 2D], and every cell
     field of the part (``stress``, ``von_mises``, ``damage``, plastic strain
     and the other history columns, ``hourglass_energy``; beams: forces);
     eroded elements are left out."""
@@ -323,7 +401,8 @@ def mesh_frames(parts) -> dict[str, MeshFrame]:
         live = el.active == 1  # eroded elements leave the picture
         out[part.name] = MeshFrame(
             points=q.x.copy(), cells=el.conn[live], kind=kind,
-            point_data={"displacement": q.x - q.x0, "velocity": q.v.copy()},
+            point_data={"displacement": q.x - q.x0, "velocity": q.v.copy(),
+                        "mass": q.m.copy()},
             cell_data={name: np.asarray(fn())[live] for name, fn in part.fields().items()})
     return out
 

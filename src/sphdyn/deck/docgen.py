@@ -252,10 +252,9 @@ def _field_rows() -> list[str]:
     rows = ["| name | values per particle | unit | default | description |",
             "|---|---|---|---|---|"]
     for f in FIELDS.values():
-        if not f.always:
-            rows.append("| " + " | ".join(_cell(c) for c in (
-                f"`{f.name}`", size[f.shape], f.unit, "yes" if f.default else "",
-                f.description)) + " |")
+        rows.append("| " + " | ".join(_cell(c) for c in (
+            f"`{f.name}`", size[f.shape], f.unit,
+            "always" if f.always else "yes" if f.default else "", f.description)) + " |")
     return rows
 
 

@@ -40,6 +40,9 @@ FRAMES_DIR = "frames"
 VTK_DIR = "vtk"
 PVD_NAME = "particles.pvd"
 _FRAME_RE = re.compile(r"^frame_(\d{5,})\.h5$")
+#: frame attribute of the last state of a run stopped before its end time
+#: (--max-steps, a signal, a failure), written off the frame schedule
+STOP_FRAME = "stop_frame"
 
 
 def _frame_name(index: int, suffix: str) -> str:
@@ -122,7 +125,9 @@ class FrameWriter:
         Restart time [s]. Frames with ``time <= start_after`` are kept and
         numbering continues after the last of them; frames with a later time
         belong to the abandoned part of the previous run and are deleted
-        (``.h5`` and every ``.vtu``) and dropped from the ``.pvd``.
+        (``.h5`` and every ``.vtu``) and dropped from the ``.pvd``, and so is
+        a stop frame (:data:`STOP_FRAME`: the last state of a run stopped
+        early, off the frame schedule, which the restart continues).
     overwrite : bool, optional
         Fresh run (``start_after=None``) over a directory that already holds
         frames: if True (default) they are deleted, as the new run replaces
@@ -155,8 +160,8 @@ class FrameWriter:
         kept: list[tuple[float, int]] = []  # (time, index)
         dropped: list[int] = []
         for f in existing:
-            t, _, _ = read_frame_header(f)
-            if start_after is not None and t <= start_after:
+            t, _, attrs = read_frame_header(f)
+            if start_after is not None and t <= start_after and not attrs.get(STOP_FRAME):
                 kept.append((t, _frame_index(f)))
             else:
                 dropped.append(_frame_index(f))
@@ -189,7 +194,8 @@ class FrameWriter:
         write_pvd(self.pvd_path, _pvd_entries(self.vtk_dir, frames))
 
     def write(self, t: float, step: int, fields: dict[str, np.ndarray],
-              meshes: dict[str, MeshFrame] | None = None) -> int:
+              meshes: dict[str, MeshFrame] | None = None,
+              attrs: dict | None = None) -> int:
         """Write one frame; returns its index.
 
         Parameters
@@ -208,6 +214,8 @@ class FrameWriter:
             in the ``.pvd`` beside the particles. ParaView fixes the blocks of
             the series at the first time step: give the same meshes in every
             frame.
+        attrs : dict, optional
+            Extra attributes of the ``.h5`` frame (e.g. ``{STOP_FRAME: True}``).
 
         Returns
         -------
@@ -222,7 +230,7 @@ class FrameWriter:
         meshes = dict(meshes or {})
         index = self.next_index
         write_frame(self.frames_dir / _frame_name(index, ".h5"), t, step, fields,
-                    meshes=meshes)
+                    attrs=attrs, meshes=meshes)
         if self.vtk:
             write_vtu(self.vtk_dir / _frame_name(index, ".vtu"), x, point_data)
             _write_mesh_vtus(self.vtk_dir, index, meshes)

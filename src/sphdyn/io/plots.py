@@ -16,7 +16,7 @@ from .atomic import atomic_path
 from .history import read_history_csv
 
 __all__ = ["plot_history", "history_figures", "save_figure", "time_unit", "per_depth",
-           "markdown_table",
+           "scaled_unit", "final_step_rows", "markdown_table",
            "run_dimension_and_end", "ENERGY_COLUMNS", "energy_columns", "relative_drift"]
 
 #: Energy columns plotted first, in this order, when present. Any other
@@ -51,17 +51,35 @@ def time_unit(duration: float) -> tuple[float, str]:
     return 1.0, "s"
 
 
+def scaled_unit(magnitude: float, unit: str) -> tuple[float, str]:
+    """Factor and prefixed unit for showing values up to ``magnitude`` [unit].
+
+    The prefix (k, M, G) keeps the largest shown number below 1000:
+    81,600 N is shown as 81.6 kN, 1.04e7 N as 10.4 MN; values below 1000
+    (and zero, NaN) keep ``unit``. ``value * factor`` is the shown number.
+    """
+    magnitude = abs(float(magnitude))
+    for factor, prefix in ((1e-9, "G"), (1e-6, "M"), (1e-3, "k")):
+        if magnitude * factor >= 1.0:  # False for NaN
+            return factor, prefix + unit
+    return 1.0, unit
+
+
 def per_depth(unit: str, dimension: int | None) -> str:
-    """``unit`` as stored for a run of ``dimension``: per metre of depth in 2D.
+    """``unit`` as stored for a run of ``dimension``: per metre of depth in
+    2D, per square metre of cross-section in 1D.
 
     2D runs are plane strain per unit depth, so an energy is in J/m and a
-    force in N/m; 3D runs keep ``unit``. Unknown dimension: both spelled out.
+    force in N/m; 1D runs are uniaxial strain per unit cross-section (J/m²,
+    N/m²); 3D runs keep ``unit``. Unknown dimension: all three spelled out.
     """
     if dimension == 3:
         return unit
     if dimension == 2:
         return f"{unit}/m"
-    return f"{unit} (3D) or {unit}/m (2D)"
+    if dimension == 1:
+        return f"{unit}/m²"
+    return f"{unit} (3D), {unit}/m (2D) or {unit}/m² (1D)"
 
 
 def run_dimension_and_end(outdir: str | os.PathLike) -> tuple[int | None, float | None]:
@@ -79,7 +97,7 @@ def run_dimension_and_end(outdir: str | os.PathLike) -> tuple[int | None, float 
         return None, None
     dim = run.get("dimension")
     t_end = run.get("t_end")
-    return (int(dim) if dim in (2, 3) else None,
+    return (int(dim) if dim in (1, 2, 3) else None,
             float(t_end) if isinstance(t_end, (int, float)) else None)
 
 
@@ -140,7 +158,8 @@ def plot_history(csv_path: str | os.PathLike,
         Averaging window of the wall forces [s]; default the deck's default
         ``[output] force_window``.
     dimension, t_end : optional
-        The run's dimension (2 or 3: units per depth or not) and end time [s]
+        The run's dimension (1, 2 or 3: units per area, per depth or not) and
+        end time [s]
         (marks a last step shortened to land on it); default read from
         ``deck.resolved.toml`` beside ``csv_path``.
 
@@ -169,6 +188,48 @@ def markdown_table(rows: list[dict]) -> str:
     lines = ["| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
     lines += ["| " + " | ".join(str(r[k]) for k in keys) + " |" for r in rows]
     return "\n".join(lines)
+
+
+def _largest(data: dict[str, np.ndarray], columns: list[str]) -> float:
+    """The largest finite magnitude in ``data``'s ``columns`` (0 if none)."""
+    return max((float(np.max(np.abs(v), initial=0.0)) for c in columns
+                if (v := data[c][np.isfinite(data[c])]).size), default=0.0)
+
+
+def final_step_rows(time: np.ndarray, dt: np.ndarray, t_end: float | None) -> np.ndarray:
+    """(n,) bool: the history rows that report the run's last step when it was
+    shortened to land exactly on ``t_end`` [s].
+
+    A row at time ``t`` reports the step ``dt`` taken from ``t`` (a row at
+    ``t_end``, the run's last, the step that ended there), so the rows of
+    the last step are the trailing rows with ``t + dt`` or ``t`` at
+    ``t_end`` (to the run loop's 1e-12 of ``t_end``) whose step is shorter
+    than the one reported by the row before them (else it was not
+    shortened). None, or a history not ending at ``t_end`` (a run stopped
+    early, a restart to a later end): no row.
+    """
+    rows = np.zeros(dt.size, bool)
+    if t_end is None or dt.size < 2:
+        return rows
+    tol = 1e-12 * abs(t_end)
+    if not abs(time[-1] - t_end) <= tol:  # stopped early, or another end time
+        return rows
+    lands = (np.abs(time + dt - t_end) <= tol) | (np.abs(time - t_end) <= tol)
+    first = dt.size
+    while first > 0 and lands[first - 1]:  # the trailing rows of the last step
+        first -= 1
+    if first > 0:
+        rows[first:] = dt[first:] < dt[first - 1]
+    return rows
+    end = t_end * (1 - 1e-12)
+    at_end = np.flatnonzero(time + dt >= end)
+    if not at_end.size or not time[-1] >= end:
+        return rows
+    first = at_end[0]  # times increase: every later row is at the end too
+    if first == 0:
+        return rows
+    rows[first:] = dt[first:] < dt[first - 1]
+    return rows
 
 
 #: curves above which a legend goes beside the axes in columns of this many
@@ -201,13 +262,15 @@ def history_figures(data: dict[str, np.ndarray], title: str = "",
       ``force_window`` (:func:`sphdyn.analysis.window_mean_force`, dashed);
     * ``reactions``: the reaction force components ``<set>_reaction_x|y|z``
       of prescribed motions (components that stay zero left out);
-    * ``dt``: ``dt`` against ``step`` (or time if there is no step). When
-      the last row lies at ``t_end``, its step was shortened to land exactly
-      there: it is drawn as a separate, labelled marker, not as part of the
-      line, so it does not look like a collapse of the time step.
+    * ``dt``: ``dt`` against ``step`` (or time if there is no step), from 0.
+      The last step, shortened to land exactly on ``t_end``
+      (:func:`final_step_rows`), is left out (a note says so), so it does not
+      look like a collapse of the time step.
 
     Times are shown in µs, ms or s from the run's duration (:func:`time_unit`);
-    energies and forces in J and N in 3D, J/m and N/m in 2D (``dimension``).
+    energies and forces in J and N in 3D, J/m and N/m in 2D, J/m² and N/m²
+    in 1D (``dimension``), with the prefix k, M or G where the values reach
+    thousands (:func:`scaled_unit`).
     """
     columns = list(data)
     figures: dict = {}
@@ -219,23 +282,25 @@ def history_figures(data: dict[str, np.ndarray], title: str = "",
     if time is not None and energy_cols:
         has_total = "E_total" in data
         fig, axes = _figure(2 if has_total else 1)
+        ef, eu = scaled_unit(_largest(data, energy_cols), "J")
         for c in energy_cols:
-            axes[0].plot(shown, data[c], label=c)
-        axes[0].set_ylabel(f"energy [{per_depth('J', dimension)}]")
+            axes[0].plot(shown, data[c] * ef, label=c)
+        axes[0].set_ylabel(f"energy [{per_depth(eu, dimension)}]")
         _finish_axes(axes[0], f"Energy balance ({title})")
         if has_total:
             drift = relative_drift(data["E_total"], [data[c] for c in energy_cols])
             axes[1].plot(shown, drift, color="k", label="E_total drift")
-            axes[1].set_ylabel("(E_total - E_total(0)) / max|E| [-]")
-            _finish_axes(axes[1], "Relative energy drift")
+            axes[1].set_ylabel("drift [-]")  # short: the formula is in the title
+            _finish_axes(axes[1], "Relative energy drift (E_total - E_total(0)) / max|E|")
         axes[-1].set_xlabel(f"time [{tu}]")
         figures["energies"] = fig
 
     force_cols = [c for c in columns if c.startswith("F_")]
     if time is not None and force_cols:
         fig, (ax,) = _figure()
+        ff, fu = scaled_unit(_largest(data, force_cols), "N")
         for c in force_cols:
-            ax.plot(shown, data[c], label=c)
+            ax.plot(shown, data[c] * ff, label=c)
         if force_window is None:
             from ..deck.schema import Output
 
@@ -244,24 +309,24 @@ def history_figures(data: dict[str, np.ndarray], title: str = "",
             if c.startswith("I_wall_") and f"F_wall_{c[7:]}" in data:
                 from ..analysis import window_mean_force
 
-                ax.plot(shown, window_mean_force(time, data[c], force_window), "--",
+                ax.plot(shown, ff * window_mean_force(time, data[c], force_window), "--",
                         label=f"F_wall_{c[7:]}, {force_window * 1e6:g} µs mean")
         ax.set_xlabel(f"time [{tu}]")
-        ax.set_ylabel(f"force [{per_depth('N', dimension)}]")
+        ax.set_ylabel(f"force [{per_depth(fu, dimension)}]")
         _finish_axes(ax, f"Forces ({title})")
         figures["forces"] = fig
 
     reaction_cols = [c for c in columns if c.rsplit("_", 1)[0].endswith("_reaction")]
-    largest = max((np.max(np.abs(data[c]), initial=0.0) for c in reaction_cols),
-                  default=0.0)
+    largest = _largest(data, reaction_cols)
     reaction_cols = [c for c in reaction_cols  # round-off of a free component left out
-                     if np.max(np.abs(data[c]), initial=0.0) > 1e-9 * largest]
+                     if _largest(data, [c]) > 1e-9 * largest]
     if time is not None and reaction_cols:
         fig, (ax,) = _figure()
+        rf, ru = scaled_unit(largest, "N")
         for c in reaction_cols:
-            ax.plot(shown, data[c], label=c)
+            ax.plot(shown, data[c] * rf, label=c)
         ax.set_xlabel(f"time [{tu}]")
-        ax.set_ylabel(f"reaction force [{per_depth('N', dimension)}]")
+        ax.set_ylabel(f"reaction force [{per_depth(ru, dimension)}]")
         _finish_axes(ax, f"Reactions of prescribed node sets ({title})")
         figures["reactions"] = fig
 
@@ -269,15 +334,16 @@ def history_figures(data: dict[str, np.ndarray], title: str = "",
     if "dt" in data and xkey is not None:
         fig, (ax,) = _figure()
         x = data["step"] if xkey == "step" else shown
-        df, du = time_unit(np.max(np.abs(data["dt"])) if data["dt"].size else 0.0)
+        final = (final_step_rows(time, data["dt"], t_end) if time is not None
+                 else np.zeros(data["dt"].size, bool))
+        df, du = time_unit(np.max(np.abs(data["dt"][~final]), initial=0.0))
         dt = data["dt"] * df
-        last_shortened = (t_end is not None and time is not None and dt.size > 1
-                          and time[-1] >= t_end * (1 - 1e-12) and dt[-1] < dt[-2])
-        n = dt.size - 1 if last_shortened else dt.size
-        ax.plot(x[:n], dt[:n], label="dt")
-        if last_shortened:
-            ax.plot(x[-1:], dt[-1:], "v", color="tab:red", linestyle="none",
-                    label=f"last step, shortened to end at t_end ({dt[-1]:.3g} {du})")
+        ax.plot(x[~final], dt[~final], label="dt")
+        if final.any():
+            ax.plot([], [], " ", label=f"(not drawn: the last step, {dt[final][-1]:.3g} "
+                    f"{du}, shortened to end at t_end)")
+        top = np.max(dt[~final], initial=0.0)
+        ax.set_ylim(0.0, 1.15 * top if np.isfinite(top) and top > 0 else None)
         ax.set_xlabel("step [-]" if xkey == "step" else f"time [{tu}]")
         ax.set_ylabel(f"time step dt [{du}]")
         _finish_axes(ax, f"Time step ({title})")
