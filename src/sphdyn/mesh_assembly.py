@@ -2,7 +2,8 @@
 
 Called by :func:`sphdyn.assembly.build_stepper` with the meshes of
 :mod:`sphdyn.mesh_model`. Names in the history: a boundary's reactions
-``<set>_reaction_x|y|z``, a load's ``<set>_force``, a mesh's damping
+``<set>_reaction_x|y|z``, a load's ``<set>_force`` (a pressure's
+``<set>_pressure`` and ``<set>_force_x|y|z``) and ``W_<set>``, a mesh's damping
 ``E_damping_<mesh>``, a wall on a mesh ``F_wall_<wall>_<mesh>``, a coupling
 ``F_<mesh>_coupling`` (penalty) or ``F_<mesh>_coupling_x|y|z`` (tied, hybrid),
 the sublayer of a bar ``F_<mesh>_sublayer_x|y|z`` (the bond force), the
@@ -23,6 +24,7 @@ from .events import ElementErosion, ErosionRules
 from .interactions import HybridCoupling, PenaltyCoupling, TiedCoupling, Wall
 from .interactions.nodal import MassDamping, NodalLoad, PrescribedMotion
 from .interactions.blast import BlastLoad
+from .interactions.pressure import PressureLoad
 from .interactions.embedded import EmbeddedNodes
 from .interactions.penalty_geometry import exterior_faces, on_nodes
 from .interactions.sublayer import SublayerCoupling
@@ -121,8 +123,15 @@ def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
             rot.v[idx] = 0.0
     for k, load in enumerate(deck.load):
         part, idx = _target(model, sph_part, meshes, load.set)
-        out.append(NodalLoad(_unique(load.set, taken), part, idx, load.force,
-                             ramp_time=load.ramp_time, shape=load.ramp))
+        name = _unique(load.set, taken)
+        if load.pressure is None:
+            out.append(NodalLoad(name, part, idx, load.force, ramp_time=load.ramp_time,
+                                 shape=load.ramp, curve=load.curve))
+            continue
+        faces, elements = _pressure_faces(model, part, idx, load.set, f"load[{k}].set")
+        out.append(PressureLoad(name, part, faces, elements, load.pressure,
+                                ramp_time=load.ramp_time, shape=load.ramp,
+                                curve=load.curve))
     out += blast_loads(deck, model, sph_part, meshes, taken)
     for b, body in enumerate(deck.body):
         if body.damping > 0.0:
@@ -187,6 +196,43 @@ def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
     return out
 
 
+def _set_faces(model, part, idx, set_name: str, where: str, fix: str):
+    """The exterior faces (F, nf) of a solid mesh whose nodes all lie in the mesh
+    set ``set_name`` (``idx`` (n,) of ``part``) and their elements (F,);
+    DeckError naming ``where`` (with ``fix``) if the set holds nodes of a line."""
+    mm = next(m for m in model.meshes if m.name == model.mesh_sets[set_name][0])
+    if mm.element != "solid":
+        raise DeckError([format_problem(
+            where, f"set '{set_name}' holds nodes of the {mm.element} line '{mm.name}', "
+                   "which has no faces", fix)])
+    faces, elements = exterior_faces(part.el.conn, with_elements=True)
+    keep = on_nodes(faces, idx)
+    return faces[keep], elements[keep]
+
+
+def _pressure_faces(model, part, idx, set_name: str, where: str):
+    """The faces a pressure on the set loads (:func:`_set_faces`); DeckError
+    naming ``where`` if the set holds particles, nodes of a line, or no whole face."""
+    if set_name not in model.mesh_sets:
+        raise DeckError([format_problem(
+            where, f"set '{set_name}' holds particles; a pressure acts on the faces of a "
+                   "solid mesh", "name a [[set]] with mesh = \"<name>\" whose nodes "
+                   "cover the loaded surface, or give force = [...] (shared by the "
+                   "particles)")])
+    faces, elements = _set_faces(model, part, idx, set_name, where,
+                                 "name a set of a solid mesh's nodes, or give force = "
+                                 "[...] (shared by the nodes)")
+    if faces.shape[0] == 0:
+        mesh = model.mesh_sets[set_name][0]
+        face = "edge" if part.el.conn.shape[1] == 4 else "face"
+        raise DeckError([format_problem(
+            where, f"set '{set_name}' holds {idx.size} node(s) of mesh '{mesh}' but no "
+                   f"exterior {face} of the mesh has all its nodes in the set",
+            f"select whole {face}s: a region around the loaded surface that contains "
+            f"every node of its {face}s (or a group of the mesh file that does)")])
+    return faces, elements
+
+
 def blast_loads(deck, model, sph_part, meshes: dict, taken: set) -> list:
     """The [[blast]] loads: the exposed faces of each set (particle faces, or
     the exterior faces of a solid mesh on the set's nodes)."""
@@ -196,15 +242,9 @@ def blast_loads(deck, model, sph_part, meshes: dict, taken: set) -> list:
         part, idx = _target(model, sph_part, meshes, bl.set)
         faces = elements = None
         if bl.set in model.mesh_sets:
-            mm = next(m for m in model.meshes if m.name == model.mesh_sets[bl.set][0])
-            if mm.element != "solid":
-                raise DeckError([format_problem(
-                    f"{where}.set", f"set '{bl.set}' holds nodes of the {mm.element} line "
-                    f"'{mm.name}', which has no faces", "name a set of particles or of "
-                    "a solid mesh's nodes")])
-            faces, elements = exterior_faces(part.el.conn, with_elements=True)
-            keep = on_nodes(faces, idx)
-            faces, elements = faces[keep], elements[keep]
+            faces, elements = _set_faces(model, part, idx, bl.set, f"{where}.set",
+                                         "name a set of particles or of a solid mesh's "
+                                         "nodes")
         try:
             out.append(BlastLoad(_unique(bl.name or "blast", taken), part, bl.charge,
                                  bl.point, burst=bl.burst, time=bl.time, idx=idx,
