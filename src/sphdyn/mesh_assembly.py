@@ -26,10 +26,9 @@ from .interactions.nodal import MassDamping, NodalLoad, PrescribedMotion
 from .interactions.blast import BlastLoad
 from .interactions.pressure import PressureLoad
 from .interactions.embedded import EmbeddedNodes
-from .interactions.penalty_geometry import exterior_faces, on_nodes
 from .interactions.sublayer import SublayerCoupling
 from .materials import get_model
-from .mesh_model import MeshModel
+from .mesh_model import MeshModel, pressure_faces, set_faces
 from .parts import SolidSettings
 from .parts.fem import BeamSection, LinePart, solid_part
 from .state import BC_FIXED
@@ -128,7 +127,8 @@ def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
             out.append(NodalLoad(name, part, idx, load.force, ramp_time=load.ramp_time,
                                  shape=load.ramp, curve=load.curve))
             continue
-        faces, elements = _pressure_faces(model, part, idx, load.set, f"load[{k}].set")
+        faces, elements = pressure_faces(model.meshes, model.mesh_sets, load.set,
+                                         f"load[{k}].set")
         out.append(PressureLoad(name, part, faces, elements, load.pressure,
                                 ramp_time=load.ramp_time, shape=load.ramp,
                                 curve=load.curve))
@@ -196,43 +196,6 @@ def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
     return out
 
 
-def _set_faces(model, part, idx, set_name: str, where: str, fix: str):
-    """The exterior faces (F, nf) of a solid mesh whose nodes all lie in the mesh
-    set ``set_name`` (``idx`` (n,) of ``part``) and their elements (F,);
-    DeckError naming ``where`` (with ``fix``) if the set holds nodes of a line."""
-    mm = next(m for m in model.meshes if m.name == model.mesh_sets[set_name][0])
-    if mm.element != "solid":
-        raise DeckError([format_problem(
-            where, f"set '{set_name}' holds nodes of the {mm.element} line '{mm.name}', "
-                   "which has no faces", fix)])
-    faces, elements = exterior_faces(part.el.conn, with_elements=True)
-    keep = on_nodes(faces, idx)
-    return faces[keep], elements[keep]
-
-
-def _pressure_faces(model, part, idx, set_name: str, where: str):
-    """The faces a pressure on the set loads (:func:`_set_faces`); DeckError
-    naming ``where`` if the set holds particles, nodes of a line, or no whole face."""
-    if set_name not in model.mesh_sets:
-        raise DeckError([format_problem(
-            where, f"set '{set_name}' holds particles; a pressure acts on the faces of a "
-                   "solid mesh", "name a [[set]] with mesh = \"<name>\" whose nodes "
-                   "cover the loaded surface, or give force = [...] (shared by the "
-                   "particles)")])
-    faces, elements = _set_faces(model, part, idx, set_name, where,
-                                 "name a set of a solid mesh's nodes, or give force = "
-                                 "[...] (shared by the nodes)")
-    if faces.shape[0] == 0:
-        mesh = model.mesh_sets[set_name][0]
-        face = "edge" if part.el.conn.shape[1] == 4 else "face"
-        raise DeckError([format_problem(
-            where, f"set '{set_name}' holds {idx.size} node(s) of mesh '{mesh}' but no "
-                   f"exterior {face} of the mesh has all its nodes in the set",
-            f"select whole {face}s: a region around the loaded surface that contains "
-            f"every node of its {face}s (or a group of the mesh file that does)")])
-    return faces, elements
-
-
 def blast_loads(deck, model, sph_part, meshes: dict, taken: set) -> list:
     """The [[blast]] loads: the exposed faces of each set (particle faces, or
     the exterior faces of a solid mesh on the set's nodes)."""
@@ -242,9 +205,9 @@ def blast_loads(deck, model, sph_part, meshes: dict, taken: set) -> list:
         part, idx = _target(model, sph_part, meshes, bl.set)
         faces = elements = None
         if bl.set in model.mesh_sets:
-            faces, elements = _set_faces(model, part, idx, bl.set, f"{where}.set",
-                                         "name a set of particles or of a solid mesh's "
-                                         "nodes")
+            faces, elements = set_faces(model.meshes, model.mesh_sets, bl.set,
+                                        f"{where}.set", "name a set of particles or of a "
+                                        "solid mesh's nodes")
         try:
             out.append(BlastLoad(_unique(bl.name or "blast", taken), part, bl.charge,
                                  bl.point, burst=bl.burst, time=bl.time, idx=idx,
