@@ -291,6 +291,7 @@ def test_an_even_split_of_the_total_force_is_not_a_pressure():
     consistent = build_stepper(block_deck(BLOCK_3D))
     run_to(even, 0.8e-3)
     row = run_to(consistent, 0.8e-3)
+    assert even.record()["top_force"] == pytest.approx(2.0e4, rel=1e-12)  # curve at 1
     dev = np.abs(even.part("block").element_stress()[:, 2, 2] + PRESSURE).max()
     assert dev > 0.5 * PRESSURE
     assert even.part("block").el.e_hg.sum() > 0.1 * even.record()["E_internal"]
@@ -391,7 +392,8 @@ def _bad(**over):
     ('pressure = "2 MPa"\ncurve = [[0, 1]]', r"load\[0\]\.curve.*at least two.*Fix:"),
     ('pressure = "2 MPa"\ncurve = [[0, 1, 2], [1, 1]]',
      r"load\[0\]\.curve: point 0.*\[time, factor\]"),
-    ('pressure = "2 MPa"\ncurve = [[0, 0], ["1 m", 1]]', r"load\[0\]\.curve\[1\]\[0\]: .1 m. is not a time"),
+    ('pressure = "2 MPa"\ncurve = [[0, 0], ["1 m", 1]]',
+     r"load\[0\]\.curve\[1\]\[0\]: .1 m. is not a time"),
     ('pressure = "2 MPa"\nramp_time = "1 ms"\ncurve = [[0, 0], [1, 1]]',
      r"load\[0\].*ramp.*or a curve, not both.*Fix: remove ramp_time"),
     ('pressure = "2 MPa"\nforce = [0, 0, 1]', r"load\[0\].*either a force or a pressure, "

@@ -150,7 +150,8 @@ class Load(Section):
         None, description="Time curve [[t, factor], ...] instead of a ramp: the load is "
                           "force or pressure times the factor, interpolated linearly "
                           "between the points (times strictly increasing) and held at "
-                          "the first and last factor outside them, e.g. [[0, 0], [\"1 ms\", 1], [\"3 ms\", 0]].")
+                          "the first and last factor outside them, e.g. [[0, 0], "
+                          "[\"1 ms\", 1], [\"3 ms\", 0]].")
 
     @model_validator(mode="after")
     def _one_load(self):
