@@ -363,6 +363,39 @@ def test_restart_with_a_pressure_load_is_bitwise():
     assert np.array_equal(st.part("block").kin.x, st2.part("block").kin.x)
 
 
+def test_a_pressure_on_a_gmsh_physical_surface(tmp_path):
+    """A Gmsh file's physical surface ("bottom", four quads under a 2 x 2 x 2
+    hex block 0.2 x 0.1 m in plan) becomes a node set; the pressure loads
+    the four hex faces on it: resultant +p A along z (the outward normal
+    is -z; 1e-12), and the middle node of the bottom takes a quarter of it."""
+    from test_mesh_geometry import gmsh_model, write_msh22
+
+    _, _, nodes, quads, hexes = gmsh_model()
+    write_msh22(tmp_path / "block.msh", nodes, quads, hexes)
+    text = BLOCK.split("[[mesh]]")[0].format(dim=3, t_end="1 ms") + """
+[[mesh]]
+name = "block"
+material = "steel"
+file = "block.msh"
+[[set]]
+name = "base"
+mesh = "block"
+group = "bottom"
+[[load]]
+set = "base"
+pressure = "1 MPa"
+"""
+    st = build_stepper(loads_deck(text, base_dir=tmp_path))
+    load = pressure_load(st, "base")
+    assert load.n_faces == 4
+    st.step()
+    total = load.force.sum(axis=0)
+    assert total[2] == pytest.approx(1e6 * 0.2 * 0.1, rel=1e-12)
+    assert np.abs(total[:2]).max() < 1e-12 * total[2]
+    middle = np.argmax(load.force[:, 2])
+    assert load.force[middle, 2] == pytest.approx(0.25 * total[2], rel=1e-12)
+
+
 def test_faces_of_eroded_elements_are_not_loaded():
     """An element marked eroded (inactive) loses its top face's load: the
     nodal forces are those of the other 15 faces at the current positions
