@@ -2,7 +2,8 @@
 
 Called by :func:`sphdyn.assembly.build_stepper` with the meshes of
 :mod:`sphdyn.mesh_model`. Names in the history: a boundary's reactions
-``<set>_reaction_x|y|z``, a load's ``<set>_force``, a mesh's damping
+``<set>_reaction_x|y|z``, a load's ``<set>_force`` (a pressure's
+``<set>_pressure`` and ``<set>_force_x|y|z``) and ``W_<set>``, a mesh's damping
 ``E_damping_<mesh>``, a wall on a mesh ``F_wall_<wall>_<mesh>``, a coupling
 ``F_<mesh>_coupling`` (penalty) or ``F_<mesh>_coupling_x|y|z`` (tied, hybrid),
 the sublayer of a bar ``F_<mesh>_sublayer_x|y|z`` (the bond force), the
@@ -23,11 +24,11 @@ from .events import ElementErosion, ErosionRules
 from .interactions import HybridCoupling, PenaltyCoupling, TiedCoupling, Wall
 from .interactions.nodal import MassDamping, NodalLoad, PrescribedMotion
 from .interactions.blast import BlastLoad
+from .interactions.pressure import PressureLoad
 from .interactions.embedded import EmbeddedNodes
-from .interactions.penalty_geometry import exterior_faces, on_nodes
 from .interactions.sublayer import SublayerCoupling
 from .materials import get_model
-from .mesh_model import MeshModel
+from .mesh_model import MeshModel, pressure_faces, set_faces
 from .parts import SolidSettings
 from .parts.fem import BeamSection, LinePart, solid_part
 from .state import BC_FIXED
@@ -121,8 +122,16 @@ def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
             rot.v[idx] = 0.0
     for k, load in enumerate(deck.load):
         part, idx = _target(model, sph_part, meshes, load.set)
-        out.append(NodalLoad(_unique(load.set, taken), part, idx, load.force,
-                             ramp_time=load.ramp_time, shape=load.ramp))
+        name = _unique(load.set, taken)
+        if load.pressure is None:
+            out.append(NodalLoad(name, part, idx, load.force, ramp_time=load.ramp_time,
+                                 shape=load.ramp, curve=load.curve))
+            continue
+        faces, elements = pressure_faces(model.meshes, model.mesh_sets, load.set,
+                                         f"load[{k}].set")
+        out.append(PressureLoad(name, part, faces, elements, load.pressure,
+                                ramp_time=load.ramp_time, shape=load.ramp,
+                                curve=load.curve))
     out += blast_loads(deck, model, sph_part, meshes, taken)
     for b, body in enumerate(deck.body):
         if body.damping > 0.0:
@@ -196,15 +205,9 @@ def blast_loads(deck, model, sph_part, meshes: dict, taken: set) -> list:
         part, idx = _target(model, sph_part, meshes, bl.set)
         faces = elements = None
         if bl.set in model.mesh_sets:
-            mm = next(m for m in model.meshes if m.name == model.mesh_sets[bl.set][0])
-            if mm.element != "solid":
-                raise DeckError([format_problem(
-                    f"{where}.set", f"set '{bl.set}' holds nodes of the {mm.element} line "
-                    f"'{mm.name}', which has no faces", "name a set of particles or of "
-                    "a solid mesh's nodes")])
-            faces, elements = exterior_faces(part.el.conn, with_elements=True)
-            keep = on_nodes(faces, idx)
-            faces, elements = faces[keep], elements[keep]
+            faces, elements = set_faces(model.meshes, model.mesh_sets, bl.set,
+                                        f"{where}.set", "name a set of particles or of a "
+                                        "solid mesh's nodes")
         try:
             out.append(BlastLoad(_unique(bl.name or "blast", taken), part, bl.charge,
                                  bl.point, burst=bl.burst, time=bl.time, idx=idx,

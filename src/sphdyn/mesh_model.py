@@ -6,7 +6,7 @@ found here, before a part is made or a file written, and reported as a
 :class:`~sphdyn.deck.DeckError` line ``mesh[k]...: <what>. Fix: <what>``
 (exit status 2 on the command line): an unreadable file, an unknown group,
 inverted or degenerate elements (named by element id), a conversion region
-without elements, an empty node set.
+without elements, an empty node set, a set with no face to carry a pressure.
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ from .geometry import select
 from .geometry.convert import element_centroids, elements_to_particles, hybrid_points
 from .geometry.mesh import (MeshData, block_mesh, check_elements, polyline_mesh, prism_mesh,
                             read_mesh)
+from .interactions.penalty_geometry import exterior_faces, on_nodes
 
 #: Element kind of a solid mesh by dimension.
 SOLID_KIND = {3: "hex8", 2: "quad4"}
@@ -216,3 +217,45 @@ def mesh_node_set(meshes: list[MeshModel], s, k: int, dim: int) -> tuple[MeshMod
             "enlarge the region (nodes are selected by their initial position; "
             "a box must contain them, edges included) or check the group")])
     return mm, idx.astype(np.int64)
+
+
+def set_faces(meshes: list[MeshModel], mesh_sets: dict, set_name: str, where: str,
+              fix: str) -> tuple[np.ndarray, np.ndarray]:
+    """The exterior faces (F, 4) or edges (F, 2) of a solid mesh whose nodes all
+    lie in the mesh node set ``set_name`` (``mesh_sets``: name -> (mesh, nodes)),
+    outward node order, and their elements (F,); F may be 0. DeckError naming
+    ``where`` (with ``fix``) if the set holds nodes of a line of beams or trusses."""
+    mesh, idx = mesh_sets[set_name]
+    mm = next(m for m in meshes if m.name == mesh)
+    if mm.element != "solid":
+        raise DeckError([format_problem(
+            where, f"set '{set_name}' holds nodes of the {mm.element} line '{mm.name}', "
+                   "which has no faces", fix)])
+    faces, elements = exterior_faces(mm.cells, with_elements=True)
+    keep = on_nodes(faces, idx)
+    return faces[keep], elements[keep]
+
+
+def pressure_faces(meshes: list[MeshModel], mesh_sets: dict, set_name: str,
+                   where: str) -> tuple[np.ndarray, np.ndarray]:
+    """The faces a pressure on the set ``set_name`` loads (:func:`set_faces`);
+    DeckError naming ``where`` if the set holds particles, nodes of a line, or no
+    whole exterior face."""
+    if set_name not in mesh_sets:
+        raise DeckError([format_problem(
+            where, f"set '{set_name}' holds particles; a pressure acts on the faces of a "
+                   "solid mesh", "name a [[set]] with mesh = \"<name>\" whose nodes "
+                   "cover the loaded surface, or give force = [...] (shared by the "
+                   "particles)")])
+    faces, elements = set_faces(meshes, mesh_sets, set_name, where,
+                                "name a set of a solid mesh's nodes, or give force = "
+                                "[...] (shared by the nodes)")
+    if faces.shape[0] == 0:
+        mesh, idx = mesh_sets[set_name]
+        face = "edge" if faces.shape[1] == 2 else "face"
+        raise DeckError([format_problem(
+            where, f"set '{set_name}' holds {idx.size} node(s) of mesh '{mesh}' but no "
+                   f"exterior {face} of the mesh has all its nodes in the set",
+            f"select whole {face}s: a region around the loaded surface that contains "
+            f"every node of its {face}s (or a group of the mesh file that does)")])
+    return faces, elements

@@ -26,7 +26,7 @@ from .detonation import light_explosives
 from .preflight import checked_lattices, history_models, support_radius
 from .materials import MaterialGroup, get_model, history_layout
 from .materials.uniaxial import UNIAXIAL, uniaxial_params
-from .mesh_model import MeshModel, build_meshes, mesh_node_set
+from .mesh_model import MeshModel, build_meshes, mesh_node_set, pressure_faces
 from .probes import Probe, quantity
 from .state import Particles
 
@@ -311,6 +311,9 @@ def build_model(deck) -> Model:
         region = None if s.region is None else s.region.model_dump()
         sel = select(particles.x[cand], region, dim)
         sets[s.name] = cand[sel].astype(np.int64)
+    for k, load in enumerate(deck.load):  # refused here, so that check refuses them
+        if load.pressure is not None:
+            pressure_faces(meshes, mesh_sets, load.set, f"load[{k}].set")
     probes = []
     for k, pr in enumerate(deck.probe):
         if pr.set in mesh_sets:

@@ -22,8 +22,8 @@ from .introspect import field_annotation, metadata, strip_optional, variants
 from .schema import deck_model
 from .sections.output import known_field
 from .units import DENSITY, LENGTH, PRESSURE, TIME, VELOCITY
-from .values import (Bounds, NonEmpty, Quantity, Reference, UniqueName, Vector,
-                     existing_file, unit_vector)
+from .values import (Bounds, CurvePoints, NonEmpty, Quantity, Reference, UniqueName,
+                     Vector, existing_file, unit_vector)
 
 #: A complete small deck shown in the reference (and tested to be valid):
 #: a 2D rubber disc thrown at a rigid floor.
@@ -166,7 +166,10 @@ def describe(annotation: Any) -> tuple[str, str, str]:
         elif f is existing_file:
             kind = "file path"
             allowed.append("existing file")
-    if any(isinstance(f, Vector) for f in funcs):
+    if any(isinstance(f, CurvePoints) for f in funcs):
+        kind, unit = "list of [time, factor]", TIME.si_unit
+        allowed.append("at least 2 points, times increasing")
+    elif any(isinstance(f, Vector) for f in funcs):
         elem_type, unit, _ = describe(get_args(core)[0])
         kind = f"vector of {elem_type}"
     elif get_origin(core) is Literal:

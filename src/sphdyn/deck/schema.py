@@ -85,7 +85,8 @@ class DeckSections(Section):
     set: tuple[ParticleSet, ...] = Field((), description="Particle sets.")
     boundary: tuple[Boundary, ...] = Field((), description="Boundary "
                                                            "conditions.")
-    load: tuple[Load, ...] = Field((), description="Forces on sets.")
+    load: tuple[Load, ...] = Field(
+        (), description="Forces on sets, pressures on mesh faces.")
     probe: tuple[Probe, ...] = Field((), description="Time histories of "
                                                      "particle sets.")
     gauge: tuple[Gauge, ...] = Field((), description="Strain, displacement and "

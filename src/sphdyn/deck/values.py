@@ -18,8 +18,8 @@ from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict,
 
 from .messages import problem, show, show_number, show_vector, suggest
 from .scope import SCOPE, dimension
-from .units import (ACCELERATION, LENGTH, PRESSURE, VELOCITY, Dimension, QuantityError,
-                    to_bytes, to_si)
+from .units import (ACCELERATION, LENGTH, PRESSURE, TIME, VELOCITY, Dimension,
+                    QuantityError, to_bytes, to_si)
 
 
 class Section(BaseModel):
@@ -287,3 +287,39 @@ def above_lo(hi, info: ValidationInfo):
 UpperPosition = Annotated[Position, AfterValidator(above_lo)]
 #: Likewise for a selection box (:data:`Corner`).
 UpperCorner = Annotated[Corner, AfterValidator(above_lo)]
+
+
+@dataclass(frozen=True)
+class CurvePoints:
+    """Before-validator of a time curve: a list of at least two ``[time, factor]``
+    pairs (the time a quantity, the factor a number)."""
+
+    def __call__(self, value: Any) -> Any:
+        example = "curve = [[0, 0], [\"1 ms\", 1]]"
+        if not isinstance(value, (list, tuple)) or len(value) < 2:
+            raise problem(f"{show(value)} is not a curve of at least two points",
+                          f"give [time, factor] pairs, e.g. {example} (for a "
+                          "constant load leave curve out)")
+        for k, point in enumerate(value):
+            if not isinstance(point, (list, tuple)) or len(point) != 2:
+                raise problem(f"point {k} ({show(point)}) is not a [time, factor] pair",
+                              f"write each point as [time, factor], e.g. {example}")
+        return value
+
+
+def increasing_times(points: tuple) -> tuple:
+    """After-validator of a time curve: the times strictly increase."""
+    for k in range(1, len(points)):
+        if points[k][0] <= points[k - 1][0]:
+            raise problem(
+                f"the curve's times are not increasing: point {k} at "
+                f"{show_number(points[k][0])} s follows {show_number(points[k - 1][0])} s",
+                "sort the points by time, each later than the one before (a step: "
+                "two points a short time apart)")
+    return points
+
+
+#: A time curve ``[[t, factor], ...]`` (times in s, strictly increasing),
+#: interpolated linearly and held at its end values.
+TimeCurve = Annotated[tuple[tuple[quantity(TIME), real("factor")], ...],
+                      BeforeValidator(CurvePoints()), AfterValidator(increasing_times)]

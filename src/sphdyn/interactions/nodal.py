@@ -5,7 +5,8 @@ These act on the items (mesh nodes or particles) of one part:
 * :class:`PrescribedMotion`: fixed items, or a velocity or displacement
   reached over a ramp (LS-DYNA's BOUNDARY_SPC and BOUNDARY_PRESCRIBED_MOTION);
   it reports the reaction force the constraint exerts;
-* :class:`NodalLoad`: a total force shared by the items, ramped;
+* :class:`NodalLoad`: a total force shared by the items, ramped or scaled by
+  a time curve (:class:`TimeFactor`);
 * :class:`MassDamping`: :math:`\\mathbf a \\mathrel{-}= c\\,\\mathbf v`
   (mass-proportional damping, LS-DYNA's DAMPING_GLOBAL), the usual way to
   reach a static state with an explicit code (dynamic relaxation).
@@ -13,7 +14,8 @@ These act on the items (mesh nodes or particles) of one part:
 Ramps (:func:`ramp`) take a value from 0 at t = 0 to 1 at t = T: ``linear``
 or ``smooth`` (:math:`s - \\sin(2\\pi s)/2\\pi`, :math:`s = t/T`, whose rate
 starts and ends at zero, so a prescribed displacement starts and stops
-without a jerk).
+without a jerk). A time curve (:func:`curve_value`) takes the factor from a
+table of ``(t, factor)`` points instead.
 """
 
 from __future__ import annotations
@@ -39,6 +41,35 @@ def ramp(t: float, T: float, shape: str = "linear") -> float:
     if shape == "smooth":
         return s - math.sin(2.0 * math.pi * s) / (2.0 * math.pi)
     return s
+
+
+def curve_value(t: float, times: np.ndarray, factors: np.ndarray) -> float:
+    """Factor of a time curve at ``t`` [s]: linear between the points ``times``
+    (k,) [s, increasing], ``factors`` (k,); the first or last factor outside them."""
+    return float(np.interp(t, times, factors))
+
+
+class TimeFactor:
+    """The factor a load is scaled by at time ``t``: :func:`ramp` (``ramp_time``,
+    ``shape``) or, given ``curve`` ((k, 2) ``(t, factor)`` points), :func:`curve_value`."""
+
+    def __init__(self, ramp_time: float = 0.0, shape: str = "linear", curve=None):
+        if shape not in RAMPS:
+            raise ValueError(f"ramp shape must be one of {RAMPS}")
+        self.ramp_time, self.shape = float(ramp_time), shape
+        self.curve = None
+        if curve is not None:
+            c = np.asarray(curve, dtype=float)
+            if (c.ndim != 2 or c.shape[1] != 2 or c.shape[0] < 1
+                    or np.any(np.diff(c[:, 0]) <= 0.0)):
+                raise ValueError("a time curve is (k, 2) (t, factor) points with "
+                                 "increasing times")
+            self.curve = (np.ascontiguousarray(c[:, 0]), np.ascontiguousarray(c[:, 1]))
+
+    def __call__(self, t: float) -> float:
+        if self.curve is None:
+            return ramp(t, self.ramp_time, self.shape)
+        return curve_value(t, *self.curve)
 
 
 @njit(cache=True, error_model="numpy")
@@ -194,7 +225,8 @@ class PrescribedMotion(_SetInteraction):
 
 
 class NodalLoad(_SetInteraction):
-    """A total force ``force`` (3,) [N] shared evenly by the items, times a ramp.
+    """A total force ``force`` (3,) [N] shared evenly by the items, times a ramp
+    (``ramp_time``, ``shape``) or a time curve (``curve``, :class:`TimeFactor`).
 
     Columns ``<name>_force``: the magnitude applied now [N]; ``W_<name>``:
     its work so far [J] (J/m in 2D), :math:`\\sum_n \\sum_k m_k \\mathbf a_k
@@ -205,10 +237,10 @@ class NodalLoad(_SetInteraction):
     external = True  # its work is external work (W_external)
 
     def __init__(self, name: str, part, idx, force, ramp_time: float = 0.0,
-                 shape: str = "linear"):
+                 shape: str = "linear", curve=None):
         super().__init__(name, part, idx)
         self.force = np.asarray(force, dtype=float)
-        self.ramp_time, self.shape = float(ramp_time), shape
+        self.factor = TimeFactor(ramp_time, shape, curve)
         m = part.kin.m[self.idx]
         if np.any(m <= 0.0):
             raise ValueError(f"{name}: a load on items without mass")
@@ -219,7 +251,7 @@ class NodalLoad(_SetInteraction):
         self._kick = 0.0  # over the last kick [J]
 
     def forces(self, t: float, dt: float, a_out: np.ndarray) -> None:
-        self._now = ramp(t, self.ramp_time, self.shape)
+        self._now = self.factor(t)
         add_load(self.idx, self._per_mass, self._now, self.force, self._a, a_out)
 
     def after_kick(self, dt_kick: float) -> None:

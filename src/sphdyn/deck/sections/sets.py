@@ -9,9 +9,9 @@ from typing import Literal, Optional
 from pydantic import Field, ValidationInfo, field_validator, model_validator
 
 from ..messages import problem
-from ..units import FORCE, TIME
-from ..values import (Section, VelocityVector, Position, name_of, quantity, reference_to,
-                      vector)
+from ..units import FORCE, PRESSURE, TIME
+from ..values import (Position, Section, TimeCurve, VelocityVector, name_of, quantity,
+                      reference_to, vector)
 from .shapes import Region
 
 #: A force vector [N] (N/m in 2D); z must be 0 in 2D decks.
@@ -122,14 +122,47 @@ class Boundary(Section):
 
 
 class Load(Section):
-    """[[load]]: a force on a set, shared evenly by its nodes or particles.
+    """[[load]]: a force on a set, shared evenly by its nodes or particles, or a
+    pressure on the faces of a solid mesh's node set.
 
-    The history reports the force applied now as ``<set>_force`` and its work
-    so far as ``W_<set>``, which is external work (part of ``W_external``)."""
+    A ``force`` is split evenly among the set's members; the history reports the
+    force applied now as ``<set>_force``. A ``pressure`` acts on every exterior
+    face of the mesh whose nodes all belong to the set (LS-DYNA's
+    LOAD_SEGMENT_SET): consistent nodal forces from the face's shape functions,
+    on the face as it deforms; positive pushes into the body (against the
+    outward normal). Its history columns are ``<set>_pressure`` and the
+    resultant ``<set>_force_x|y|z``. Either load's work so far is ``W_<set>``,
+    external work (part of ``W_external``)."""
 
-    set: reference_to("set") = Field(description="Name of a [[set]].")
-    force: ForceVector = Field(description="Total force on the set [N] (N/m in 2D), "
-                                           "split evenly among its members.")
+    set: reference_to("set") = Field(description="Name of a [[set]] (for a pressure: "
+                                                 "a set of a solid [[mesh]]'s nodes).")
+    force: Optional[ForceVector] = Field(
+        None, description="Total force on the set [N] (N/m in 2D), split evenly among "
+                          "its members. Give force or pressure.")
+    pressure: Optional[quantity(PRESSURE)] = Field(
+        None, description="Pressure on the exterior faces whose nodes all lie in the "
+                          "set (edges in 2D); positive pushes into the body. Give force "
+                          "or pressure.")
     ramp_time: quantity(TIME, "ramp time", lo=0) = Field(
-        0.0, description="The force grows from 0 over this time (0: at once).")
+        0.0, description="The load grows from 0 over this time (0: at once).")
     ramp: Literal["linear", "smooth"] = Field("linear", description="Ramp shape.")
+    curve: Optional[TimeCurve] = Field(
+        None, description="Time curve [[t, factor], ...] instead of a ramp: the load is "
+                          "force or pressure times the factor, interpolated linearly "
+                          "between the points (times strictly increasing) and held at "
+                          "the first and last factor outside them, e.g. [[0, 0], "
+                          "[\"1 ms\", 1], [\"3 ms\", 0]].")
+
+    @model_validator(mode="after")
+    def _one_load(self):
+        if (self.force is None) == (self.pressure is None):
+            raise problem("a load gives either a force or a pressure" + (
+                          ", not both" if self.force is not None else ""),
+                          "give force = [0, 0, \"-1 kN\"] (shared by the set) or "
+                          "pressure = \"2 MPa\" (on the set's faces)")
+        # (ramp = "linear", the default, is written out by the resolved deck)
+        if self.curve is not None and (self.ramp_time != 0.0 or self.ramp != "linear"):
+            raise problem("a load takes a ramp (ramp_time, ramp) or a curve, not both",
+                          "remove ramp_time and ramp (start the curve at [0, 0] for a "
+                          "ramp)")
+        return self
