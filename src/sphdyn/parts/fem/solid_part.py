@@ -222,6 +222,23 @@ class SolidPart:
         return (f"element {k} of mesh '{self.name}' at ({', '.join(f'{c:.4g}' for c in centre)})"
                 f", volume {el.vol[k] / el.vol0[k]:.3g} of its initial{inverted}")
 
+    def hotspot(self) -> str:
+        """The element of the largest specific internal energy (the energy
+        guard's diagnosis, :func:`sphdyn.guards.energy_diagnosis`) and the
+        fastest node."""
+        from ...guards import _fmt, fastest
+
+        el, p = self.el, self.pts
+        work = (p.m * p.e).reshape(el.n, self.ngp).sum(axis=1) + el.e_hg
+        spec = np.divide(work, el.m, out=np.zeros(el.n), where=(el.m > 0) & (el.active != 0))
+        k = int(np.argmax(spec))
+        centre = self.nodes.x[el.conn[k]].mean(axis=0)
+        hist = "".join(f", {name} {self.element_mean(p.hist[:, j])[k]:.3g}"
+                       for j, name in enumerate(p.hist_names) if name == "plastic_strain")
+        return (f"element {k} at {_fmt(centre)} has the largest specific internal energy, "
+                f"{spec[k]:.4g} J/kg (volume {el.vol[k] / el.vol0[k]:.3g} of its "
+                f"initial{hist}); {fastest(self.nodes, 'node')}")
+
     def start(self, dt: float) -> None:
         """Accelerations of the initial state (no material update)."""
         self._geometry(0.0)
