@@ -83,7 +83,8 @@ def energy_diagnosis(s, error: float, limit: float, scale: float, growth: float)
                      "between parts; the residuals include what they moved.")
     lines.append("  Likely causes: an element or particle crushed or inverted (see its "
                  "specific energy), a time step too large for a contact or material "
-                 "(lower time.cfl or the contact's alpha), or a model error in the named "
+                 "(lower time.cfl or the contact's alpha), an interaction changing "
+                 "velocities outside the work books, or a model error in the named "
                  "part. Raise [run] energy_error_limit or set energy_error_action = "
                  "\"warn\" only if the error is understood.")
     return "\n".join(lines)
