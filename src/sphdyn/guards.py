@@ -42,7 +42,7 @@ def energy_diagnosis(s, error: float, limit: float, scale: float, growth: float)
     :math:`R_p = \Delta(E_{kin,p} + E_{int,p}) - W_p` (``W_p`` the work of the
     interaction accelerations and boundary reactions on its items, the
     stepper's ``part_work``; minus its released chemical energy); the part
-    of the largest :math:`|R_p|` (of the sign of the error) is named, with
+    of the largest :math:`R_p` is named, with
     what its ``hotspot()`` says (the element or particle of the largest
     specific internal energy, the fastest item) and the interactions acting
     on it, with their own work when ``[output] interaction_work`` books it.
@@ -58,9 +58,8 @@ def energy_diagnosis(s, error: float, limit: float, scale: float, growth: float)
         if getattr(part, "has_sources", False):
             made -= part.supplied_energy()
         rows.append((made, gain, part))
-    sign = 1.0 if growth >= 0.0 else -1.0
-    made, gain, part = max(rows, key=lambda r: sign * r[0])
-    lines.append(f"  Part '{part.name}' {'gained' if sign > 0 else 'lost'} the most beyond "
+    made, gain, part = max(rows, key=lambda r: r[0])
+    lines.append(f"  Part '{part.name}' gained the most beyond "
                  f"the work done on it: {made:+.4g} J (its kinetic + internal energy "
                  f"{gain:+.4g} J, work on it {s.part_work[part.name]:+.4g} J).")
     others = [f"'{p.name}' {m:+.4g} J" for m, _, p in rows if p is not part]

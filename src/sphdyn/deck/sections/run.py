@@ -41,10 +41,11 @@ class Run(Section):
                           "prints them); a larger model is refused. Absent: half "
                           "of this machine's memory.")
     energy_error_limit: real("energy error limit", lo=0, hi=1, lo_open=True) = Field(
-        0.05, description="Largest energy error the run accepts: |E_total - E_total(0)| "
-                          "over the largest energy term so far (kinetic, internal, "
-                          "contact, external work; summary.json's "
-                          "energy_error_max_rel), checked at every history row. Past "
+        0.05, description="Largest energy the run may make from nothing: E_total - "
+                          "E_total(0) over the largest energy term so far (kinetic, "
+                          "internal, contact, external work; summary.json's "
+                          "energy_error_max_rel, for a gain), checked at every history "
+                          "row. Past "
                           "it the run does energy_error_action, naming the part that "
                           "gained the most energy beyond the work done on it, its "
                           "element or particle of the largest specific internal "
