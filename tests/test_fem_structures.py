@@ -232,13 +232,17 @@ def test_rigid_wall_acts_on_mesh_nodes():
     """A hex block (10 m/s) bounces off a rigid wall with the wall's mass
     stiffness (paper eq. 8): no node crosses the wall plane, the rebound
     speed is 80-101 % of the impact speed (the particles' test range) and the
-    total energy stays within 3 % of the impact energy (2.0 % measured: the
-    kick-to-middle offset of the spring power, see the load test)."""
+    total energy stays within 5 % of the impact energy while it touches (4.1 %
+    measured: the kick-to-middle offset of the spring power, see the load
+    test; 2.0 % before issue 57, when the face's edges and corners had thinner
+    contacts and met the wall out of phase with its middle) and within 1 %
+    once it has left (0.15 % measured)."""
     from sphdyn.interactions import Wall, WallSpec
     from sphdyn.interactions.wall_contact import STIFFNESS_MASS
 
     a = 0.1
-    x, cells = block([0, 0, 0.01], [a, a, a + 0.01], (4, 4, 4), 3)
+    # 1 mm above the nodes' contact thickness, half an element (12.5 mm)
+    x, cells = block([0, 0, 0.0135], [a, a, a + 0.0135], (4, 4, 4), 3)
     p = part(x, cells, 3, mat=material(density=2400.0, E=30e9, nu=0.2))
     p.nodes.v[:, 2] = -10.0
     wall = Wall(WallSpec("floor", np.zeros(3), np.array([0, 0, 1.0]), STIFFNESS_MASS,
@@ -253,7 +257,8 @@ def test_rigid_wall_acts_on_mesh_nodes():
     vz = float(np.sum(p.nodes.m * p.nodes.v[:, 2]) / p.nodes.m.sum())
     assert 8.0 < vz < 10.1
     assert lowest > 0.0
-    assert max(abs(r["E_total"] - e0) for r in rows) < 0.03 * e0
+    assert max(abs(r["E_total"] - e0) for r in rows) < 0.05 * e0
+    assert abs(rows[-1]["E_total"] - e0) < 0.01 * e0
 
 
 @pytest.mark.slow

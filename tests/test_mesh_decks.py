@@ -463,3 +463,75 @@ def test_deck_schema_refuses_inconsistent_meshes(tmp_path):
         loads_deck(_bar_text().replace('type = "fixed"', 'type = "fixed"\ncomponents = ["w"]'))
     with pytest.raises(DeckError, match="no \\[\\[body\\]\\] table"):
         loads_deck('[run]\ndimension = 3\nt_end = 1.0\n' + MATERIALS)
+
+
+#: a steel block of selective-reduced hexes at 200 m/s onto a rigid wall with
+#: the default contact thickness: the whole block, or its quarter x, y >= 0
+#: with rollers on the planes x = 0 and y = 0 (issue 57's set-up, elastic)
+QUARTER = """
+[run]
+dimension = 3
+t_end = "{t_end}"
+{materials}
+[[mesh]]
+name = "block"
+material = "steel"
+integration = "selective_reduced"
+block = {{lo = [{lo}, {lo}, "5.5 mm"], hi = ["20 mm", "20 mm", "25.5 mm"], divisions = [{n}, {n}, 2]}}
+velocity = [0, 0, "-200 m/s"]
+{rollers}
+[[wall]]
+name = "rigid"
+point = [0, 0, 0]
+normal = [0, 0, 1]
+[output]
+progress = false
+vtk = false
+"""
+
+ROLLERS = """
+[[set]]
+name = "x0"
+mesh = "block"
+region = {shape = "box", lo = [-1e-4, -1, -1], hi = [1e-4, 1, 1]}
+[[set]]
+name = "y0"
+mesh = "block"
+region = {shape = "box", lo = [-1, -1e-4, -1], hi = [1, 1e-4, 1]}
+[[boundary]]
+set = "x0"
+type = "fixed"
+components = ["x"]
+[[boundary]]
+set = "y0"
+type = "fixed"
+components = ["y"]
+"""
+
+
+def test_a_quarter_model_with_rollers_meets_a_wall_as_the_whole_model_does():
+    """Issue 57: the quarter of a block (rollers on its symmetry planes) and the
+    whole block strike a wall with the default contact thickness (half an
+    element, 5 mm); at 12 us, the contact under way since 2.5 us, every node
+    of the quarter is where its node of the whole block is, within 1e-9 of
+    the block's size (the two differ in summation order only). A node's
+    contact thickness was f_t times the cube root of its share of its
+    elements' volume, on the symmetry planes a half (their edge of the struck
+    face) or a quarter (the corner, the centre of the struck face) of the
+    whole model's share: the quarter's nodes there met the wall later, and
+    at 12 us were 0.18 mm off (the dent that crushed the centre element)."""
+    runs = []
+    for lo, n, rollers in (("\"-20 mm\"", 4, ""), (0, 2, ROLLERS)):
+        deck = loads_deck(QUARTER.format(materials=MATERIALS, t_end="12 us", lo=lo, n=n,
+                                         rollers=rollers))
+        s = build_stepper(deck)
+        while s.t < deck.run.t_end * (1 - 1e-12):
+            s.step(t_stop=deck.run.t_end)
+        q = s.part("block").kin
+        assert s.record()["contacts_rigid_block"] > 0
+        runs.append((q.x0, q.x))
+    (x0_all, x_all), (x0_q, x_q) = runs
+    key = lambda x0: np.round(x0 * 1e6).astype(np.int64)  # noqa: E731 (um grid)
+    where = {tuple(k): i for i, k in enumerate(key(x0_all))}
+    match = np.array([where[tuple(k)] for k in key(x0_q)])
+    assert np.abs(x_q - x_all[match]).max() < 1e-9 * 0.04

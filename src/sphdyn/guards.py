@@ -1,4 +1,5 @@
-"""Run guards: non-finite values, particles leaving the domain, time-step collapse.
+"""Run guards: non-finite values, particles leaving the domain, time-step collapse,
+energy made from nothing.
 
 A failed check raises :class:`SimulationFailed` with a diagnosis naming the
 particles, where they are and which quantity went wrong; the runner then
@@ -16,11 +17,76 @@ OUTSIDE = 2
 
 
 class SimulationFailed(RuntimeError):
-    """The run stopped on a guard; ``diagnosis`` is a human-readable report."""
+    """The run stopped on a guard; ``diagnosis`` is a human-readable report,
+    ``status`` the summary's status."""
+
+    status = "failed"
 
     def __init__(self, diagnosis: str):
         super().__init__(diagnosis)
         self.diagnosis = diagnosis
+
+
+class EnergyError(SimulationFailed):
+    """The energy balance broke its limit (:func:`energy_diagnosis`)."""
+
+    status = "energy_error"
+
+
+def energy_diagnosis(s, error: float, limit: float, scale: float, growth: float) -> str:
+    r"""What made the energy of stepper ``s``: a report for the energy guard.
+
+    ``error`` the relative energy error (``growth`` [J] over ``scale`` [J],
+    the largest energy term so far) past ``limit``. Each part's residual is
+    its gain beyond the work done on it since the first kick,
+    :math:`R_p = \Delta(E_{kin,p} + E_{int,p}) - W_p` (``W_p`` the work of the
+    interaction accelerations and boundary reactions on its items, the
+    stepper's ``part_work``; minus its released chemical energy); the part
+    of the largest :math:`R_p` is named, with
+    what its ``hotspot()`` says (the element or particle of the largest
+    specific internal energy, the fastest item) and the interactions acting
+    on it, with their own work when ``[output] interaction_work`` books it.
+    """
+    lines = [f"run stopped at t = {s.t:.6e} s, step {s.step_count}: the energy balance "
+             f"is off by {growth:+.4g} J, {100 * error:.3g} % of the largest energy "
+             f"term ({scale:.4g} J), past energy_error_limit = {limit:g}."]
+    rows = []
+    for part in s.parts:
+        now = s.part_kinetic[part.name] + part.energies()[0]
+        gain = now - s.part_start.get(part.name, now)
+        made = gain - s.part_work[part.name]
+        if getattr(part, "has_sources", False):
+            made -= part.supplied_energy()
+        rows.append((made, gain, part))
+    made, gain, part = max(rows, key=lambda r: r[0])
+    lines.append(f"  Part '{part.name}' gained the most beyond "
+                 f"the work done on it: {made:+.4g} J (its kinetic + internal energy "
+                 f"{gain:+.4g} J, work on it {s.part_work[part.name]:+.4g} J).")
+    others = [f"'{p.name}' {m:+.4g} J" for m, _, p in rows if p is not part]
+    if others:
+        lines.append("  The other parts: " + ", ".join(others) + ".")
+    hotspot = getattr(part, "hotspot", None)
+    lines.append("  In it: " + (hotspot() if hotspot is not None else fastest(part.kin))
+                 + ".")
+    acting = [i for i in s.interactions  # on the part, or coupling it to another
+              if any(v is part for v in vars(i).values())]
+    if acting:
+        books = s.books.work if s.books is not None else {}
+        named = [f"'{i.name}'" + (f" (work {books[i.name]:+.4g} J)" if i.name in books
+                                  else "") for i in acting]
+        lines.append("  Interactions acting on it: " + ", ".join(named) + "."
+                     + ("" if s.books is not None else
+                        " ([output] interaction_work = true books each one's work.)"))
+    if s.events:
+        lines.append("  Events (" + ", ".join(e.name for e in s.events) + ") move energy "
+                     "between parts; the residuals include what they moved.")
+    lines.append("  Likely causes: an element or particle crushed or inverted (see its "
+                 "specific energy), a time step too large for a contact or material "
+                 "(lower time.cfl or the contact's alpha), an interaction changing "
+                 "velocities outside the work books, or a model error in the named "
+                 "part. Raise [run] energy_error_limit or set energy_error_action = "
+                 "\"warn\" only if the error is understood.")
+    return "\n".join(lines)
 
 
 #: stand-ins for the stress and density of items that have none (mesh nodes)
@@ -132,3 +198,12 @@ def _describe(p, idx) -> str:
     body = getattr(p, "body", None)
     return "; ".join(f"#{i}" + ("" if body is None else f" (body {body[i]})")
                      + f" at {_fmt(p.x[i])}" for i in idx)
+
+
+def fastest(q, what: str = "item") -> str:
+    """The fastest active item of kinematics ``q`` (a diagnosis' phrase)."""
+    speed = np.where(q.active != 0, np.sqrt(np.sum(q.v * q.v, axis=1)), 0.0)
+    if speed.size == 0:
+        return f"no {what}s"
+    k = int(np.argmax(speed))
+    return f"the fastest {what} #{k} at {_fmt(q.x[k])}, {speed[k]:.4g} m/s"

@@ -6,7 +6,8 @@ A monitor has any of the hooks the :class:`~sphdyn.stepper.Stepper` calls:
 ``after_step(stepper)`` at :math:`t^{n+1}`. They are attached in this order
 by :class:`~sphdyn.simulation.Simulation`: the thread tuner
 (:mod:`sphdyn.threads`, when the thread count is automatic), guards, history
-(with probes), frames, checkpoints, progress, the history flush.
+(with probes), the energy guard (after the history, so that the row that
+broke the limit is kept), frames, checkpoints, progress, the history flush.
 """
 
 from __future__ import annotations
@@ -17,7 +18,8 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from .guards import check_particles, check_time_step
+from .guards import EnergyError, check_particles, check_time_step, energy_diagnosis
+from .io.plots import energy_columns
 from .probes import record as probe_record
 
 
@@ -62,6 +64,63 @@ class HistoryRecorder:
         if self._row is not None:
             self.history.append(self._row)
             self._row = None
+
+
+class EnergyGuard:
+    r"""Stop (or warn) when the run has made more than ``limit`` of its energy.
+
+    At every history row of ``recorder`` the relative energy error
+    :math:`(E_{total} - E_{total}^0) / E_{max}` is taken, :math:`E_{max}` the
+    largest magnitude of any energy column (``E_*``, ``W_*``) of the rows so
+    far: the measure of summary.json's ``energy_error_max_rel``
+    (:func:`sphdyn.io.plots.relative_drift`), as the run goes, for a gain
+    only. Energy made from nothing is the signature of an instability or a
+    wrong formula; a loss beyond the books is dissipation not booked (a
+    quasi-static ramp's first steps, with all energies still tiny, lose 19 %
+    of them to the leapfrog's booking of the prescribed motion's work, a
+    transient), reported by ``energy_error_max_rel`` alone. Past ``limit``,
+    ``action`` ``"stop"`` raises :class:`~sphdyn.guards.EnergyError` with
+    :func:`~sphdyn.guards.energy_diagnosis` (after the row is kept),
+    ``"warn"`` prints that diagnosis once and keeps it in ``warning``.
+    ``history`` (the rows of a restarted run) gives the first row and the
+    largest term so far.
+    """
+
+    def __init__(self, recorder, history, limit: float, action: str = "stop"):
+        self.recorder, self.limit, self.action = recorder, float(limit), action
+        self.e0 = None
+        self.scale = 0.0
+        self.warning: str | None = None
+        self._row = None
+        h = history.as_arrays() if len(history) else {}
+        if "E_total" in h and h["E_total"].size:
+            self.e0 = float(h["E_total"][0])
+            for c in energy_columns(list(h)):
+                self.scale = max(self.scale, float(np.nanmax(np.abs(h[c]))))
+
+    def after_kick(self, s) -> None:
+        self._row = self.recorder._row
+
+    def after_step(self, s) -> None:
+        row, self._row = self._row, None
+        if row is None or "E_total" not in row:
+            return
+        if self.e0 is None:
+            self.e0 = row["E_total"]
+        for c in energy_columns(list(row)):
+            if math.isfinite(row[c]):
+                self.scale = max(self.scale, abs(row[c]))
+        growth = row["E_total"] - self.e0
+        if self.scale <= 0.0 or not math.isfinite(growth):
+            return  # (a non-finite state is the other guards' to report)
+        error = growth / self.scale  # a gain: a loss is dissipation left unbooked
+        if error <= self.limit or (self.action == "warn" and self.warning is not None):
+            return
+        diagnosis = energy_diagnosis(s, error, self.limit, self.scale, growth)
+        if self.action == "stop":
+            raise EnergyError(diagnosis)
+        self.warning = diagnosis.replace("run stopped at", "warning: at", 1)
+        print("sphdyn: " + self.warning, flush=True)
 
 
 class HistoryFlush:

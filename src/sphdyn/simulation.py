@@ -36,8 +36,8 @@ from .assembly import build_stepper
 from .gauges import GaugeRecorder, build_gauges
 from .model import Model, build_model
 from .interrupt import StopRequests
-from .monitors import (Checkpoints, FrameOutput, Guards, HistoryFlush, HistoryRecorder,
-                       Progress)
+from .monitors import (Checkpoints, EnergyGuard, FrameOutput, Guards, HistoryFlush,
+                       HistoryRecorder, Progress)
 from .threads import ThreadTuner
 from .neighbours import max_neighbours, mean_neighbours
 from .stepper import Stepper
@@ -72,11 +72,15 @@ class Simulation:
         self.recorder = HistoryRecorder(history, out.history_every, self.model.probes)
         self.gauges = GaugeRecorder(build_gauges(deck, stepper.parts) if gauges is None
                                     else gauges)
+        run = deck.run
+        self.energy_guard = (None if run.energy_error_action == "off" else EnergyGuard(
+            self.recorder, history, run.energy_error_limit, run.energy_error_action))
         for monitor in (Guards(self.model.domain_lo, self.model.domain_hi,
                                deck.time.collapse_ratio, stepper.parts),
-                        self.recorder, self.gauges, self.output,
+                        self.recorder, self.energy_guard, self.gauges, self.output,
                         Checkpoints(self._checkpoint, out.checkpoint_every)):
-            stepper.add_monitor(monitor)
+            if monitor is not None:
+                stepper.add_monitor(monitor)
 
     @property
     def particles(self):
@@ -269,7 +273,7 @@ class Simulation:
         sph = next((p for p in s.parts if p.kind == "sph"), None)
         h = self.history.as_arrays() if len(self.history.columns) else {}
         if failure is not None:
-            status = "failed"
+            status = failure.status  # "failed", or "energy_error" (the energy guard)
         elif s.t >= t_end * (1 - 1e-12):  # the deck's end or a restart's --t-end
             status = "completed"
         else:
@@ -292,6 +296,8 @@ class Simulation:
             if part.kind != "sph":
                 summary.setdefault("meshes", {})[part.name] = {
                     "nodes": part.kin.n, "elements": _element_count(part)}
+        if self.energy_guard is not None and self.energy_guard.warning is not None:
+            summary["energy_warning"] = self.energy_guard.warning
         if "E_total" in h and h["E_total"].size:
             # the drift drawn in plots/energies.png: relative to the largest
             # energy term, not to E_kinetic (tiny in a quasi-static test)

@@ -93,6 +93,13 @@ class Stepper:
         self.work_contact = 0.0  # work of the interaction forces [J]
         self.work_external = 0.0  # work of the boundary-condition reactions [J]
         self._kick_sums: dict[str, np.ndarray] = {}  # per part, grown with it
+        # per part (the energy guard's diagnosis, sphdyn.monitors.EnergyGuard):
+        # kinetic energy at the last kick [J], the work done on its items by
+        # interaction accelerations and boundary reactions so far [J], and its
+        # kinetic plus internal energy at the first kick [J]
+        self.part_kinetic = {p.name: 0.0 for p in self.parts}
+        self.part_work = {p.name: 0.0 for p in self.parts}
+        self.part_start: dict[str, float] = {}
         self.books = (InteractionWork(self.parts, self.interactions, self.events, dofs)
                       if interaction_work else None)
         for part in self.parts:
@@ -174,10 +181,17 @@ class Stepper:
             inter.prescribe(self.t, dt)
         ke = wc = we = None
         for part in self.parts:
+            kp = wp = 0.0
             for j, q in enumerate(dofs(part)):
                 k_, c_, e_ = kick(q.v, q.a, q.a_ext, q.m, q.bc, q.bc_v, dt_kick, q.v_mid,
                                   self._sums(f"{part.name}.{j}", q.n))
                 ke, wc, we = _add(ke, k_), _add(wc, c_), _add(we, e_)
+                kp += k_
+                wp += c_ + e_
+            self.part_kinetic[part.name] = kp
+            self.part_work[part.name] += wp
+            if self.step_count == 0:
+                self.part_start[part.name] = kp + part.energies()[0]
         self.work_contact += wc
         self.work_external += we
         self.kinetic, self.dt_step = ke, dt
@@ -281,6 +295,10 @@ class Stepper:
         for ev in self.events:
             scalars.update({f"event.{ev.name}.{k}": v for k, v in ev.state().items()})
         for part in self.parts:
+            scalars[f"energy.part.{part.name}.work"] = self.part_work[part.name]
+            scalars[f"energy.part.{part.name}.kinetic"] = self.part_kinetic[part.name]
+            if part.name in self.part_start:
+                scalars[f"energy.part.{part.name}.start"] = self.part_start[part.name]
             groups[f"kin.{part.name}"] = part.kin.arrays()
             if len(dofs(part)) > 1:
                 groups[f"rot.{part.name}"] = part.kin.rot.arrays()
@@ -323,6 +341,12 @@ class Stepper:
         self.dt_step = float(scalars["dt_step"])
         self.work_contact = float(scalars["work_contact"])
         self.work_external = float(scalars["work_external"])
+        for part in self.parts:  # (absent in checkpoints before issue 57: zero)
+            pre = f"energy.part.{part.name}."
+            self.part_work[part.name] = float(scalars.get(pre + "work", 0.0))
+            self.part_kinetic[part.name] = float(scalars.get(pre + "kinetic", 0.0))
+            if pre + "start" in scalars:
+                self.part_start[part.name] = float(scalars[pre + "start"])
         for kind, items in (("part", self.parts), ("interaction", self.interactions)):
             for item in items:
                 item.restore(*_own_state(scalars, groups, f"{kind}.{item.name}"))

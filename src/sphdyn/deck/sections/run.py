@@ -40,6 +40,22 @@ class Run(Section):
                           "geometry before any particle is made (`sphdyn check` "
                           "prints them); a larger model is refused. Absent: half "
                           "of this machine's memory.")
+    energy_error_limit: real("energy error limit", lo=0, hi=1, lo_open=True) = Field(
+        0.05, description="Largest energy the run may make from nothing: E_total - "
+                          "E_total(0) over the largest energy term so far (kinetic, "
+                          "internal, contact, external work; summary.json's "
+                          "energy_error_max_rel, for a gain), checked at every history "
+                          "row. Past "
+                          "it the run does energy_error_action, naming the part that "
+                          "gained the most energy beyond the work done on it, its "
+                          "element or particle of the largest specific internal "
+                          "energy, and the interactions acting on it.")
+    energy_error_action: Literal["stop", "warn", "off"] = Field(
+        "stop", description="Past energy_error_limit: stop (the run ends with status "
+                            "\"energy_error\", the diagnosis in summary.json, exit "
+                            "status 1, the output so far kept), warn (print the "
+                            "diagnosis once, keep running; summary.json's "
+                            "energy_warning) or off.")
 
 
 class Time(Section):

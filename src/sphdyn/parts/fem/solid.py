@@ -63,6 +63,16 @@ virtual work of the same :math:`\bar B`:
 :math:`f_{iI} = -\sum_g w_g J_g [\sigma_{ij} B_{jI} + \tfrac1d
 \sigma_{kk} (\bar b_{iI} - B_{iI})]` (d = 3; in plane strain d = 2 for the
 in-plane trace).
+Each point's work is booked with the volume its Gauss point stands for,
+:math:`\Delta(m_g e_g) = \Delta t\, \bar\sigma_g:\bar{\mathbf D}_g\,
+J_g` (:math:`J_g` on the mid-step geometry, :func:`weigh_point_work`), the
+weight of the same point in the forces: the material books
+:math:`\Delta t\,\bar\sigma:\bar{\mathbf D}/\rho` per unit mass with the
+element's density :math:`\rho = m_e/V`, which is the point's share
+:math:`V/2^d` and so its work only in an element whose points have equal
+volumes (a parallelepiped); in a distorted one the forces' work and the
+booked energy differ by :math:`\sum_g (J_g - V/2^d)\,\bar\sigma_g:
+\bar{\mathbf D}_g`, energy made from nothing (docs/theory.md).
 
 **Stable step** (Flanagan & Belytschko 1981, eq. 64): the largest
 eigenvalue of the uniform-strain element with lumped mass is bounded by
@@ -440,8 +450,8 @@ def uniform_forces(x, v, conn, active, sig, L, rho, c, e_spec, e_av, dim, tab, g
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def reduced_strain_rate(x, v, conn, active, m_el, dt, dim, tab, dN, xl, g, Bg, wg, L, rho,
-                        vol):
+def reduced_strain_rate(x, v, conn, active, m_el, dt, dim, tab, dN, xl, g, Bg, wg, wm, L,
+                        rho, vol):
     r"""Selective-reduced elements: per Gauss point B-bar velocity gradient.
 
     ``dN`` (ngp, nen, dim) shape derivatives in the parent element. For each
@@ -450,7 +460,8 @@ def reduced_strain_rate(x, v, conn, active, m_el, dt, dim, tab, dN, xl, g, Bg, w
     by that of the uniform gradient (in-plane trace in 2D). Then at
     :math:`\mathbf x^{n+1}`: ``g`` (E, nen, 3) volume derivatives, ``vol`` (E,),
     ``Bg`` (P, nen, 3) the Gauss points' :math:`\nabla N_I`, ``wg`` (P,) their
-    :math:`\det J` (weight 1); ``rho`` (P,) the element density and ``L``
+    :math:`\det J` (weight 1); ``wm`` (P,) the same on the mid-step geometry
+    (:func:`weigh_point_work`); ``rho`` (P,) the element density and ``L``
     (P, 3, 3) on the mid-step geometry.
     Point p of element e is ``e * ngp + k``.
     """
@@ -514,6 +525,7 @@ def reduced_strain_rate(x, v, conn, active, m_el, dt, dim, tab, dN, xl, g, Bg, w
                 if stage == 1:
                     wg[p] = det
                     continue
+                wm[p] = det
                 rho[p] = m_el[e] / ve if ve > 0.0 else 0.0  # mid-step, as above
                 tr = 0.0
                 for i in range(3):
@@ -535,7 +547,11 @@ def reduced_forces(conn, active, sig, L, rho, c, e_spec, e_av, g, vol, Bg, wg, q
 
     Bulk viscosity from the element's mean volumetric rate (the points share
     it), heat shared evenly by the points; ``dt_el`` (E,) out, the element
-    steps (:func:`element_step` with the element's largest wave speed).
+    steps (:func:`element_step` with the element's largest wave speed), 0
+    for an element with an inverted Gauss point (:math:`\det J \le 0`; its
+    mean volume may still be positive): the point's negative weight turns its
+    stiffness into a source of energy, so the run stops there on the
+    time-step guard, naming the element (LS-DYNA's negative-volume error).
     """
     ngp = wg.shape[0] // conn.shape[0]
     nen = conn.shape[1]
@@ -554,6 +570,9 @@ def reduced_forces(conn, active, sig, L, rho, c, e_spec, e_av, g, vol, Bg, wg, q
         for k in range(ngp):
             cmax = max(cmax, c[p0 + k])
         dt_el[e] = element_step(ell, cmax, dkk, q1, q2)
+        for k in range(ngp):
+            if wg[p0 + k] <= 0.0:
+                dt_el[e] = 0.0
         q = bulk_viscosity(rho[p0], cmax, ell, dkk, q1, q2)
         if q > 0.0 and rho[p0] > 0.0:
             heat = -dt * q * dkk / rho[p0]
@@ -577,6 +596,28 @@ def reduced_forces(conn, active, sig, L, rho, c, e_spec, e_av, g, vol, Bg, wg, q
         for I in range(nen):
             for i in range(dim):
                 fe[e, I, i] += q * g[e, I, i]
+
+
+@njit(cache=True, error_model="numpy", parallel=True)
+def weigh_point_work(e, e_old, rho, wm, m):
+    r"""Book each point's material work with its own volume (selective-reduced).
+
+    A material adds :math:`\Delta e = \Delta t\,\bar\sigma:\mathbf D/\rho`
+    to the specific energy ``e`` (P,) [J/kg] of a point of mass ``m`` (P,)
+    [kg] with the density ``rho`` (P,) [kg/m^3] it was given (the element's,
+    :math:`m_e/V`); the point's work is that stress power over its own
+    volume, the mid-step Gauss volume ``wm`` (P,) [m^3] (:math:`\det J`, the
+    point's weight in the forces, Hughes 1980; module docstring), so the
+    increment is scaled by :math:`\rho\,J_g/m_g`:
+
+    .. math:: e \leftarrow e_{old} + (e - e_{old})\,\rho\, J_g / m_g
+
+    (``e_old`` (P,) before the update). Points without mass (eroded) are left
+    as they are.
+    """
+    for p in prange(e.shape[0]):
+        if m[p] > 0.0:
+            e[p] = e_old[p] + (e[p] - e_old[p]) * (rho[p] * wm[p] / m[p])
 
 
 #: blocks of the parallel minimum in :func:`min_time_step`

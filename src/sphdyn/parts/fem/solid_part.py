@@ -32,7 +32,7 @@ from .gather import gather_loads, node_element_list
 from .hex_lanes import hex_forces, hex_strain_rate, lane_scratch
 from .solid import (DT_BLOCKS, HG_STIFFNESS, HG_VISCOUS, block_scratch, element_volumes,
                     min_time_step, reduced_forces, reduced_strain_rate, uniform_forces,
-                    uniform_strain_rate)
+                    uniform_strain_rate, weigh_point_work)
 
 INTEGRATIONS = ("one_point", "selective_reduced")
 HOURGLASS_FORMS = {"viscous": HG_VISCOUS, "stiffness": HG_STIFFNESS}
@@ -119,6 +119,8 @@ class SolidPart:
         if self.reduced:
             pts.add("Bg", (nen, 3))
             pts.add("wg", ())
+            pts.add("wm", ())  # the points' mid-step volumes (their work's weights)
+            pts.add("e_old", ())  # the specific energies before the material update
         self.groups = []
         for k, (model, params) in sorted(materials.items()):
             idx = np.flatnonzero(pts.mat == k).astype(np.int64)
@@ -151,18 +153,16 @@ class SolidPart:
         share = lambda w: np.bincount(elements.conn.ravel(),  # noqa: E731
                                       weights=np.repeat(w / nen, nen), minlength=nodes.n)
         nodes.m = share(elements.m)
-        # what walls need of an item (as particles have): volume, density, bulk modulus
+        # what walls need of an item (as particles have): volume, density, bulk
+        # modulus (node_contact_items)
         self.p = nodes
         for name_ in ("vol0", "rho0", "bulk_modulus"):
             nodes.add(name_, ())
-        nodes.vol0 = share(elements.vol0)
-        nodes.rho0 = np.divide(nodes.m, nodes.vol0, out=np.zeros(nodes.n),
-                               where=nodes.vol0 > 0)
         k_el = np.zeros(ne)
         for g in self.groups:
             k_el[pts.elem[g.idx]] = g.model.bulk_modulus(g.params)
-        nodes.bulk_modulus = np.where(nodes.vol0 > 0, share(k_el * elements.vol0) /
-                                      np.where(nodes.vol0 > 0, nodes.vol0, 1.0), 0.0)
+        nodes.vol0, nodes.rho0, nodes.bulk_modulus = node_contact_items(
+            elements.conn, elements.vol0, elements.m, k_el, nodes.n, self.dim)
         self._geometry(0.0)  # densities from the masses
         self._element_geometry()  # element steps with the wave speeds
 
@@ -172,7 +172,7 @@ class SolidPart:
         q, el, p = self.nodes, self.el, self.pts
         if self.reduced:
             reduced_strain_rate(q.x, q.v, el.conn, el.active, el.m, dt, self.dim, self.tab,
-                                self.dN, el.xl, el.g, p.Bg, p.wg, p.L, p.rho, el.vol)
+                                self.dN, el.xl, el.g, p.Bg, p.wg, p.wm, p.L, p.rho, el.vol)
         elif self.lanes is not None:
             hex_strain_rate(q.x, q.v, el.conn, el.active, el.m, dt, p.L, p.rho, self.lanes)
         else:
@@ -213,8 +213,31 @@ class SolidPart:
         """What element ``k`` of :meth:`stable_dt` is, for a diagnosis."""
         el = self.el
         centre = self.nodes.x[el.conn[k]].mean(axis=0)
+        inverted = ""
+        if self.reduced:
+            w = self.pts.wg[k * self.ngp:(k + 1) * self.ngp]
+            if np.any(w <= 0.0):
+                inverted = (f", {int(np.sum(w <= 0.0))} of its {self.ngp} integration "
+                            "points inverted (det J <= 0)")
         return (f"element {k} of mesh '{self.name}' at ({', '.join(f'{c:.4g}' for c in centre)})"
-                f", volume {el.vol[k] / el.vol0[k]:.3g} of its initial")
+                f", volume {el.vol[k] / el.vol0[k]:.3g} of its initial{inverted}")
+
+    def hotspot(self) -> str:
+        """The element of the largest specific internal energy (the energy
+        guard's diagnosis, :func:`sphdyn.guards.energy_diagnosis`) and the
+        fastest node."""
+        from ...guards import _fmt, fastest
+
+        el, p = self.el, self.pts
+        work = (p.m * p.e).reshape(el.n, self.ngp).sum(axis=1) + el.e_hg
+        spec = np.divide(work, el.m, out=np.zeros(el.n), where=(el.m > 0) & (el.active != 0))
+        k = int(np.argmax(spec))
+        centre = self.nodes.x[el.conn[k]].mean(axis=0)
+        hist = "".join(f", {name} {self.element_mean(p.hist[:, j])[k]:.3g}"
+                       for j, name in enumerate(p.hist_names) if name == "plastic_strain")
+        return (f"element {k} at {_fmt(centre)} has the largest specific internal energy, "
+                f"{spec[k]:.4g} J/kg (volume {el.vol[k] / el.vol0[k]:.3g} of its "
+                f"initial{hist}); {fastest(self.nodes, 'node')}")
 
     def start(self, dt: float) -> None:
         """Accelerations of the initial state (no material update)."""
@@ -230,9 +253,13 @@ class SolidPart:
     def internal_forces(self, t: float, dt: float) -> None:
         p = self.pts
         self._geometry(dt)
+        if self.reduced:
+            p.e_old[:] = p.e
         for g in self.groups:
             g.model.update(g.idx, p.L, dt, p.rho, p.sig, p.e, p.c, p.damage,
                            g.history(p.hist), g.params, p.size)
+        if self.reduced:  # each point's work over its own volume
+            weigh_point_work(p.e, p.e_old, p.rho, p.wm, p.m)
         self._forces(dt)
 
     def energies(self) -> tuple[float, float]:
@@ -385,6 +412,46 @@ class SolidPart:
             store, name = (self.el, k[3:]) if k.startswith("el.") else (self.pts, k[3:])
             setattr(store, name, v)
         self._element_geometry()  # volumes and element steps of the restored state
+
+
+def node_contact_items(conn: np.ndarray, vol0: np.ndarray, m: np.ndarray, k: np.ndarray,
+                       n: int, dim: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    r"""What a wall sees of each node: the particle of the node's spacing.
+
+    A wall (:mod:`sphdyn.interactions.wall_contact`) takes an item's size
+    :math:`V^{1/d}` for its contact thickness :math:`f_t V^{1/d}` and its bulk
+    spring :math:`a = \alpha K\delta/(\rho_0 V^{2/d})`. A node's size is
+    the mean size of its elements, :math:`h_I = \frac1{n_I}\sum_{e\ni I}
+    V_e^{1/d}`, so ``vol0`` is :math:`h_I^d`; ``rho0`` and ``bulk_modulus``
+    are the density :math:`\sum m_e / \sum V_e` and the volume-weighted
+    bulk modulus of its elements. The size is not the node's share of its
+    elements' volume, :math:`(\sum_e V_e/n_{en})^{1/d}`: that is smaller on
+    an edge (a quarter) and a corner (an eighth) than on a face (a half), so
+    a face of equal elements met the wall in a dent at its edges, and the
+    nodes on a symmetry plane met it later than the same nodes of the whole
+    model (issue 57; a quarter model with rollers is now the quarter of the
+    whole, pinned by a test). Both laws then act alike on every node of a
+    uniform face: the mass spring's acceleration :math:`\alpha\delta/\Delta
+    t^2` does not depend on the node, the bulk spring's on its size and
+    density only, so the force is proportional to the node's mass.
+
+    ``conn`` (E, nen), element volumes ``vol0`` (E,) [m^dim], masses ``m``
+    (E,) [kg], bulk moduli ``k`` (E,) [Pa]; ``n`` nodes. Returns ``vol0``,
+    ``rho0``, ``bulk_modulus`` (n,) [m^dim, kg/m^3, Pa]; a node of no element
+    gets zeros.
+    """
+    nen = conn.shape[1]
+    flat = conn.ravel()
+    count = np.bincount(flat, minlength=n).astype(float)
+    size = np.bincount(flat, weights=np.repeat(vol0 ** (1.0 / dim), nen), minlength=n)
+    vol = np.bincount(flat, weights=np.repeat(vol0, nen), minlength=n)
+    used = count > 0
+    h = np.divide(size, count, out=np.zeros(n), where=used)
+    rho = np.divide(np.bincount(flat, weights=np.repeat(m, nen), minlength=n), vol,
+                    out=np.zeros(n), where=used)
+    kb = np.divide(np.bincount(flat, weights=np.repeat(k * vol0, nen), minlength=n), vol,
+                   out=np.zeros(n), where=used)
+    return h ** dim, rho, kb
 
 
 def solid_part(name: str, points: np.ndarray, cells: np.ndarray, dim: int, materials,

@@ -315,6 +315,20 @@ class SPHPart:
         """Internal energy and its artificial-viscosity part [J] (J/m in 2D)."""
         return internal_energies(self.p.m, self.p.e, self.p.e_av)
 
+    def hotspot(self) -> str:
+        """The particle of the largest specific internal energy (the energy
+        guard's diagnosis, :func:`sphdyn.guards.energy_diagnosis`) and the
+        fastest particle."""
+        from ...guards import _fmt, fastest
+
+        p = self.p
+        e = np.where(p.active != 0, p.e, -np.inf)
+        if e.size == 0:
+            return "no particles"
+        k = int(np.argmax(e))
+        return (f"particle {k} at {_fmt(p.x[k])} has the largest specific internal "
+                f"energy, {p.e[k]:.4g} J/kg; {fastest(p, 'particle')}")
+
     @property
     def has_sources(self) -> bool:
         """Whether a material of the part releases energy (an explosive)."""
