@@ -221,15 +221,6 @@ def final_step_rows(time: np.ndarray, dt: np.ndarray, t_end: float | None) -> np
     if first > 0:
         rows[first:] = dt[first:] < dt[first - 1]
     return rows
-    end = t_end * (1 - 1e-12)
-    at_end = np.flatnonzero(time + dt >= end)
-    if not at_end.size or not time[-1] >= end:
-        return rows
-    first = at_end[0]  # times increase: every later row is at the end too
-    if first == 0:
-        return rows
-    rows[first:] = dt[first:] < dt[first - 1]
-    return rows
 
 
 #: curves above which a legend goes beside the axes in columns of this many
