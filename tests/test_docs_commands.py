@@ -296,3 +296,27 @@ def test_package_summary_and_docstring_do_not_call_existing_parts_planned():
         assert "planned" not in text.lower()
         for part in ("FEM" if text is summary else "finite elements", "rebar", "blast"):
             assert part in text, (part, text)
+
+
+#: a repository path to a script, deck or page: ``examples/gurney.py``
+_REPO_PATH = re.compile(
+    r"\b((?:examples|tools|benchmarks|studies|tests|docs)/[\w./-]*\.(?:py|toml|md))\b")
+
+
+def referenced_paths() -> list[tuple[str, str]]:
+    """(file, path) of every script, deck or page path named in the example
+    decks, README.md and docs/*.md (placeholders such as ``NAME`` left out)."""
+    sources = [*sorted((ROOT / "examples").glob("*.toml")), *DOCS]
+    return [(src.name, m.group(1)) for src in sources
+            for m in _REPO_PATH.finditer(src.read_text(encoding="utf-8"))
+            if not re.search(r"[A-Z]{2,}", m.group(1))]
+
+
+def test_every_script_and_deck_named_in_the_decks_and_docs_exists():
+    """The decks' comments and the docs point at files that exist (two decks
+    once named examples/shock_tube.py and examples/gurney.py, which never
+    did; both cases are run by examples/explosives_1d.py)."""
+    found = referenced_paths()
+    assert len({p for _, p in found if p.endswith(".py")}) >= 10
+    missing = sorted({f"{src}: {path}" for src, path in found if not (ROOT / path).exists()})
+    assert not missing, "\n".join(missing)
