@@ -320,3 +320,20 @@ def test_every_script_and_deck_named_in_the_decks_and_docs_exists():
     assert len({p for _, p in found if p.endswith(".py")}) >= 10
     missing = sorted({f"{src}: {path}" for src, path in found if not (ROOT / path).exists()})
     assert not missing, "\n".join(missing)
+
+
+def test_readme_says_how_long_the_suite_takes_and_how_to_shorten_it():
+    """README: the suite's duration and the quick options, each of which works
+    with the test extras (the "slow" marker is registered, pytest-xdist is in
+    the extras); the two setup commands stay as they are."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert "about 15 minutes on 2 cores" in text
+    assert '`pytest -m "not slow"`' in text and "`pytest -n 2`" in text
+    with open(ROOT / "pyproject.toml", "rb") as f:
+        project = tomllib.load(f)
+    assert any(m.startswith("slow:") for m in project["tool"]["pytest"]["ini_options"]["markers"])
+    assert any(d.startswith("pytest-xdist") for d in project["project"]["optional-dependencies"]["test"])
+    blocks = [b for lang, _, b in [(m.group(1), 0, m.group(2)) for m in _FENCE.finditer(text)]
+              if lang == "bash"]
+    assert blocks[:2] == ["pip install . && sphdyn run examples/disc_impact.toml\n",
+                          "pip install '.[test]' && pytest\n"]
