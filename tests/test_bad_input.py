@@ -93,6 +93,20 @@ def test_export_of_a_frame_out_of_range_is_refused(run_dir, capsys):
     assert main(["export", str(run_dir), "--format", "csv", "--frame", "0"]) == 0
 
 
+@pytest.mark.parametrize("fmt", ["vtk", "csv"])
+def test_export_of_a_folder_without_frames_is_refused(tmp_path, capsys, fmt):
+    """`sphdyn export DIR` of a folder with no frames (empty, or a missing
+    folder) exits 2 saying so and what to do; the VTK export once wrote an
+    empty particles.pvd and exited 0."""
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    rc, err = _exit_and_message(capsys, ["export", str(empty), "--format", fmt])
+    assert rc == 2 and "there are no frames" in err and "Fix:" in err
+    assert list(empty.iterdir()) == []
+    rc, err = _exit_and_message(capsys, ["export", str(tmp_path / "nope"), "--format", fmt])
+    assert rc == 2 and "no such directory" in err and "Fix:" in err
+
+
 # ---------------------------------------------------------------- arguments
 
 @pytest.mark.parametrize("argv, flag", [

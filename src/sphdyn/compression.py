@@ -32,7 +32,8 @@ import numpy as np
 
 from .io.atomic import atomic_path
 from .io.plots import save_figure
-from .io import list_frames, read_frame
+from .io import read_frame
+from .io.frames import frames_of_run
 from .io.history import read_history_csv
 
 __all__ = ["compression_curve", "ensemble_report"]
@@ -67,9 +68,7 @@ def _specimen(run_dir: Path, wall: str, moves: bool = True
     if any(float(b["dx"]) != dx for b in bodies):
         raise ValueError(f"{run_dir}: bodies with different dx; the specimen must be "
                          "one lattice")
-    frames = list_frames(run_dir)
-    if not frames:
-        raise FileNotFoundError(f"no frames in {run_dir / 'frames'}")
+    frames = frames_of_run(run_dir)
     x = np.asarray(read_frame(frames[0])[2]["position"], float)
     s = x @ normal
     height = float(s.max() - s.min()) + dx

@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from .plots import save_figure, time_unit
-from .frames import list_frames
+from .frames import frames_of_run
 from .hdf5 import read_frame, read_frame_header
 
 __all__ = ["plot_snapshots", "select_frames", "slab_mask", "particle_spacing",
@@ -330,9 +330,7 @@ def _run_panels(outdir: Path, field: str, times, n: int, k_slice: int,
     Returns ``(panels, unit, spacing, title, plane, slab)`` with ``panels`` a
     list of ``(time [s], xy [m] (n, 2), values [SI] (n,))``.
     """
-    frame_files = list_frames(outdir)
-    if not frame_files:
-        raise FileNotFoundError(f"no frames in {outdir / 'frames'}")
+    frame_files = frames_of_run(outdir)
     frame_times = [read_frame_header(f)[0] for f in frame_files]
     chosen = select_frames(frame_times, times=times, n=n)
 
