@@ -112,8 +112,18 @@ class TestSelectFrames:
 
     def test_times_pick_nearest(self):
         assert select_frames(self.times, times=[0.9e-4, 3.4e-4, 5.6e-4]) == [1, 3, 6]
-        # Outside the run: the first/last frame; duplicates dropped; sorted.
-        assert select_frames(self.times, times=[1.0, -1.0, 2.1e-4, 1.9e-4]) == [0, 2, 6]
+        # Within half a frame interval of the ends: the first/last frame;
+        # duplicates dropped; sorted.
+        assert select_frames(self.times, times=[6.4e-4, -0.4e-4, 2.1e-4, 1.9e-4]) == [
+            0, 2, 6]
+
+    @pytest.mark.parametrize("t", [6.6e-4, -0.6e-4, 1.0])
+    def test_times_outside_the_run_are_refused(self, t):
+        """A time more than half a frame interval (0.05 ms here) past either
+        end is refused naming the run's range (it once showed the last
+        frame without a word)."""
+        with pytest.raises(ValueError, match=r"outside the run.*span 0 to 0\.0006 s"):
+            select_frames(self.times, times=[2e-4, t])
 
     def test_bad_input(self):
         with pytest.raises(ValueError):
@@ -229,6 +239,16 @@ def test_bad_limits_and_empty_slab(run2d, run3d, tmp_path):
     path = plot_snapshots(run3d, "von_mises", n=1, slice_axis="x",
                           slice_width=1e-4, out=tmp_path / "empty.png")
     assert path.is_file()
+
+
+def test_cli_times_outside_the_run_exit_2_naming_the_range(run2d, capsys):
+    """`sphdyn plot --times` beyond the run's frames exits 2 with the run's
+    time range and writes nothing."""
+    target = run2d / "plots" / "snapshots_density.png"
+    assert main(["plot", str(run2d), "--snapshots", "density", "--times", "0.1 ms,5 ms"]) == 2
+    err = capsys.readouterr().err
+    assert "0.005 s is outside the run" in err and "0 to 0.0006 s" in err and "Fix:" in err
+    assert not target.exists()
 
 
 def test_no_frames(tmp_path):

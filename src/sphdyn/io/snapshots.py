@@ -69,7 +69,9 @@ def select_frames(frame_times, times=None, n: int = 4) -> list[int]:
         Times [s] of the frames, in frame order (non-decreasing).
     times : sequence of float, optional
         Wanted times [s]: the frame nearest to each is taken (the earlier one
-        on a tie). Duplicates are dropped.
+        on a tie). Duplicates are dropped. A time more than half the largest
+        frame interval before the first frame or after the last is refused
+        (ValueError naming the run's time range): no frame shows it.
     n : int, optional
         Without ``times``: the number of frames, evenly spaced in time from
         the first frame to the last, both included (``n = 1``: the last
@@ -94,6 +96,18 @@ def select_frames(frame_times, times=None, n: int = 4) -> list[int]:
             raise ValueError("times is empty")
         if not np.all(np.isfinite(targets)):
             raise ValueError(f"times must be finite, got {list(targets)}")
+        gaps = np.diff(ft)
+        slack = max(0.5 * float(gaps.max()) if gaps.size else 0.0,
+                    1e-9 * max(abs(ft[0]), abs(ft[-1])))
+        outside = targets[(targets < ft[0] - slack) | (targets > ft[-1] + slack)]
+        if outside.size:
+            factor, unit = time_unit(ft[-1] - ft[0] or ft[-1])
+            show = ", ".join(f"{t:g} s" for t in outside)
+            raise ValueError(
+                f"time {show} is outside the run: its {ft.size} frame(s) span "
+                f"{ft[0]:g} to {ft[-1]:g} s ({ft[0] * factor:.4g} to "
+                f"{ft[-1] * factor:.4g} {unit}). Fix: give times from {ft[0]:g} to "
+                f"{ft[-1]:g} s (a run stopped early has no later frames)")
     picked = {int(np.argmin(np.abs(ft - t))) for t in targets}
     return sorted(picked)
 
@@ -332,7 +346,10 @@ def _run_panels(outdir: Path, field: str, times, n: int, k_slice: int,
     """
     frame_files = frames_of_run(outdir)
     frame_times = [read_frame_header(f)[0] for f in frame_files]
-    chosen = select_frames(frame_times, times=times, n=n)
+    try:
+        chosen = select_frames(frame_times, times=times, n=n)
+    except ValueError as exc:
+        raise ValueError(f"{outdir}: {exc}") from None
 
     # Spacing and slab from the first frame of the run.
     _, _, first, _ = read_frame(frame_files[0])
