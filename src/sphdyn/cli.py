@@ -517,8 +517,9 @@ def build_parser() -> argparse.ArgumentParser:
                    "(e.g. a case with and without a remedy)")
     p.add_argument("--snapshots", action="append", metavar="FIELD",
                    help="instead of the history plots, panels of the particles coloured "
-                   "by FIELD (von_mises, damage, speed, stress_yy, ...) into "
-                   "DIR/plots/snapshots_FIELD.png; repeatable or a comma list")
+                   "by FIELD (von_mises, damage, speed, stress_yy, ...; 1D runs: FIELD "
+                   "along x, one line per time) into DIR/plots/snapshots_FIELD.png; "
+                   "repeatable or a comma list")
     p.add_argument("--out", metavar="PNG",
                    help="snapshots: the PNG to write (one field only)")
     p.add_argument("--times", metavar="T1,T2,...",

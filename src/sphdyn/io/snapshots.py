@@ -235,6 +235,52 @@ def field_values(fields: dict[str, np.ndarray], name: str) -> tuple[np.ndarray, 
 
 # --------------------------------------------------------------------- drawing
 
+def _length_scale(extent: float) -> tuple[float, str]:
+    """Factor and unit of coordinates spanning ``extent`` [m]: mm below 1 m."""
+    return (1e3, "mm") if extent < 1.0 else (1.0, "m")
+
+
+def _line_figure(loaded, field: str, row_labels, out, runs, vmin, vmax, dpi) -> Path:
+    """The 1D snapshots: for each run (one axes per run, stacked) the field
+    against x, one line per selected frame coloured by its time."""
+    from matplotlib import colormaps
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    panels = [pan for run in loaded for pan in run[0]]
+    unit, title = loaded[0][1], loaded[0][3]
+    values = np.concatenate([v[np.isfinite(v)] for _, _, v in panels])
+    magnitude = float(np.abs(values).max()) if values.size else 1.0
+    factor, shown_unit = _display_scale(unit, magnitude)
+    xs = np.concatenate([xy[:, 0] for _, xy, _ in panels])
+    x_factor, x_unit = _length_scale(float(np.ptp(xs)) if xs.size else 0.0)
+    t_max = max(t for t, _, _ in panels)
+    fig = Figure(figsize=(8.0, 1.0 + 2.8 * len(loaded)), layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(len(loaded), 1, sharex=True, squeeze=False)[:, 0]
+    cmap = colormaps["viridis"]
+    for ax, run, label in zip(axes, loaded, row_labels):
+        frames = run[0]
+        for k, (t, xy, v) in enumerate(frames):
+            order = np.argsort(xy[:, 0], kind="stable")
+            colour = cmap(k / max(len(frames) - 1, 1))
+            ax.plot(xy[order, 0] * x_factor, v[order] * factor, color=colour, lw=1.2,
+                    marker="." if len(order) <= 200 else None, ms=3,
+                    label=_time_label(t, t_max))
+        name = field if not shown_unit else f"{field} [{shown_unit}]"
+        ax.set_ylabel(f"{label}\n{name}" if len(runs) > 1 else name,
+                      fontsize=10 if len(runs) == 1 else 8)
+        if vmin is not None or vmax is not None:
+            ax.set_ylim(None if vmin is None else vmin * factor,
+                        None if vmax is None else vmax * factor)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8, loc="best")
+    axes[-1].set_xlabel(f"x [{x_unit}]")
+    fig.suptitle(f"{field}: {title}" if len(runs) == 1 else field, fontsize=11)
+    dest = Path(out) if out is not None else runs[0] / "plots" / f"snapshots_{field}.png"
+    return save_figure(fig, dest, dpi)
+
+
 def _display_scale(unit: str, magnitude: float) -> tuple[float, str]:
     """Factor and unit in which values of ``unit`` are shown."""
     if unit == "Pa":
@@ -313,7 +359,7 @@ def _run_info(outdir: Path) -> tuple[int | None, str]:
     except (OSError, tomllib.TOMLDecodeError):
         return None, ""
     dim = run.get("dimension")
-    return (int(dim) if dim in (2, 3) else None), str(run.get("title", "") or "")
+    return (int(dim) if dim in (1, 2, 3) else None), str(run.get("title", "") or "")
 
 
 def _grid(n_panels: int, box_w: float, box_h: float) -> tuple[int, int]:
@@ -342,7 +388,8 @@ def _run_panels(outdir: Path, field: str, times, n: int, k_slice: int,
     """Frames of one run for :func:`plot_snapshots`.
 
     Returns ``(panels, unit, spacing, title, plane, slab)`` with ``panels`` a
-    list of ``(time [s], xy [m] (n, 2), values [SI] (n,))``.
+    list of ``(time [s], xy [m] (n, 2), values [SI] (n,))``; in 1D ``plane``
+    is ``(0,)`` and ``xy`` is ``(n, 1)``, the x coordinates.
     """
     frame_files = frames_of_run(outdir)
     frame_times = [read_frame_header(f)[0] for f in frame_files]
@@ -356,9 +403,13 @@ def _run_panels(outdir: Path, field: str, times, n: int, k_slice: int,
     x0 = np.asarray(first["position"], dtype=float)
     dimension, title = _run_info(outdir)
     if dimension is None:
-        dimension = 2 if np.ptp(x0[:, 2]) == 0.0 else 3
+        flat = [np.ptp(x0[:, k]) == 0.0 for k in (1, 2)] if x0.size else [True, True]
+        dimension = 1 if all(flat) else 2 if flat[1] else 3
     spacing = particle_spacing(x0, dimension)
-    if dimension == 2:
+    if dimension == 1:  # the field along x: no plane, no slab
+        plane = (0,)
+        slab = None
+    elif dimension == 2:
         plane = (0, 1)
         slab = None
     else:
@@ -385,7 +436,8 @@ def plot_snapshots(outdir, field: str = "von_mises",
                    slice_axis: str = "z", slice_width: float | None = None,
                    cmap=None, vmin: float | None = None, vmax: float | None = None,
                    marker_size: float | None = None, dpi: int = 110) -> Path:
-    """Panel figure of the particles of selected frames coloured by a field.
+    """Panel figure of the particles of selected frames coloured by a field
+    (1D runs: the field along x, one line per frame).
 
     Parameters
     ----------
@@ -453,6 +505,10 @@ def plot_snapshots(outdir, field: str = "von_mises",
     plane, slab = loaded[0][4], loaded[0][5]
     title = loaded[0][3]
     row_labels = run_labels(runs) if len(runs) > 1 else [""]
+    if vmin is not None and vmax is not None and not float(vmax) > float(vmin):
+        raise ValueError(f"vmax ({vmax}) must be greater than vmin ({vmin})")
+    if len(plane) == 1:
+        return _line_figure(loaded, field, row_labels, out, runs, vmin, vmax, dpi)
     side = float(marker_size) if marker_size is not None else spacing
 
     # Shared colour scale.
@@ -468,8 +524,6 @@ def plot_snapshots(outdir, field: str = "von_mises",
         dlo = -dhi
     else:
         dlo, dhi = lo, hi
-    if vmin is not None and vmax is not None and not float(vmax) > float(vmin):
-        raise ValueError(f"vmax ({vmax}) must be greater than vmin ({vmin})")
     vlo = dlo if vmin is None else float(vmin)
     vhi = dhi if vmax is None else float(vmax)
     if not vhi > vlo:
@@ -544,7 +598,7 @@ def plot_snapshots(outdir, field: str = "von_mises",
             ax.set_xlabel(f"{names[plane[0]]} [mm]")
             ax.xaxis.set_tick_params(labelbottom=True)
         if col == 0:
-            run_label = row_labels[row] + "\n" if row_labels[row] else ""
+            run_label = row_labels[row] + "\n" if len(runs) > 1 else ""
             ax.set_ylabel(f"{run_label}{names[plane[1]]} [mm]",
                           fontsize=10 if len(runs) == 1 else 8)
     label = field if not shown_unit else f"{field} [{shown_unit}]"
