@@ -430,3 +430,42 @@ def test_deck_schema_refuses_inconsistent_meshes(tmp_path):
         loads_deck(_bar_text().replace('type = "fixed"', 'type = "fixed"\ncomponents = ["w"]'))
     with pytest.raises(DeckError, match="no \\[\\[body\\]\\] table"):
         loads_deck('[run]\ndimension = 3\nt_end = 1.0\n' + MATERIALS)
+
+
+def test_sets_and_gauges_name_the_particles_of_a_converted_mesh_by_the_mesh_name(capsys):
+    """The particles of a [mesh.convert] form a body named as the mesh (the
+    docs say so), and a [[set]] or [[gauge]] may name it: `body = "bar"` was
+    refused with "there is no body named 'bar'". The set holds exactly the
+    converted particles (all of them, or those in its region); the gauge
+    sits on the converted particle nearest its point."""
+    source = BLOCK + ('\nconvert = {region = {shape = "box", lo = [0.3, -1, -1], '
+                      'hi = [0.7, 1, 1]}}')
+    extra = """
+[[set]]
+name = "converted"
+body = "bar"
+[[set]]
+name = "right_half"
+body = "bar"
+region = {shape = "box", lo = [0.5, -1, -1], hi = [1, 1, 1]}
+[[gauge]]
+name = "mid"
+type = "point"
+body = "bar"
+point = [0.45, 0.05, 0.05]
+"""
+    deck = bar_deck(source=source, extra=extra)
+    model = build_model(deck)
+    assert model.body_names == ["bar"]
+    assert np.array_equal(model.sets["converted"], np.arange(4))
+    assert np.allclose(model.particles.x[model.sets["right_half"], 0], [0.55, 0.65])
+    from sphdyn.gauges import build_gauges
+
+    parts = build_stepper(deck, model).parts
+    (gauge,) = build_gauges(deck, parts)
+    ((pk, i),) = gauge.items  # the converted particle at x = 0.45 (0.5 m from a node)
+    assert parts[pk].kind == "sph" and np.allclose(parts[pk].kin.x0[i], [0.45, 0.05, 0.05])
+    with pytest.raises(DeckError, match="there is no body named 'rod'.*bar"):
+        bar_deck(source=source, extra=extra.replace('body = "bar"', 'body = "rod"', 1))
+    with pytest.raises(DeckError, match="there is no body named 'bar'"):
+        bar_deck(extra=extra)  # without [mesh.convert] the mesh makes no particles

@@ -163,7 +163,8 @@ def describe(annotation: Any) -> tuple[str, str, str]:
         elif isinstance(f, Bounds):
             allowed.append(f.interval())
         elif isinstance(f, Reference):
-            allowed.append(f"name of a [[{f.section}]]")
+            allowed.append(f"name of a [[{f.section}]]" + (
+                " or of a mesh's particles" if f.mesh_bodies else ""))
         elif isinstance(f, UniqueName):
             allowed.append("unique name")
         elif isinstance(f, NonEmpty):
