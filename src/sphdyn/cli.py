@@ -181,7 +181,7 @@ def cmd_check(args) -> int:
 
     deck = load_deck(args.deck, args.set)
     model = build_model(deck)  # refuses a model over the memory limit before building
-    estimate = estimate_size(deck)
+    estimate = estimate_size(deck, model)
     p = model.particles
     limit, source = memory_limit(deck)
     if deck.gauge:  # placed on the stepper's parts, as a run places them
