@@ -228,6 +228,19 @@ def test_memory_limit_is_a_deck_key(tmp_path, capsys):
     (SECOND_BODY.format(name="grain", dx=0.05, lo=0.02, hi=0.03), ["'grain'", "dx"]),
     ('\n[[wall]]\nname = "roof"\npoint = [0, 0.01]\nnormal = [0, 1]\n',
      ["'disc'", "'roof'", "through"]),
+    # the [domain] box: a body partly or wholly outside it, a mesh partly
+    # outside (they passed check and stopped the run at its first step with
+    # "enlarge [domain] if this motion is physical")
+    ('\n[domain]\nlo = [-0.01, 0]\nhi = [0.01, 0.01]\n',
+     ["body[0].geometry", "'disc' lies partly outside the domain box",
+      "[-0.01, 0] .. [0.01, 0.01] m", "12 of its 112 particles"]),
+    ('\n[domain]\nlo = [0.1, 0.1]\nhi = [0.2, 0.2]\n',
+     ["body[0].geometry", "'disc' lies wholly outside", "[domain] lo/hi"]),
+    ('\n[[mesh]]\nname = "pad"\nmaterial = "rubber"\n'
+     'block = { lo = [0.02, 0], hi = [0.03, 0.01], divisions = [2, 2] }\n'
+     '\n[domain]\nlo = [-0.01, -0.01]\nhi = [0.025, 0.02]\n',
+     ["mesh[0] 'pad'", "mesh 'pad' lies partly outside", "3 of its 9 nodes",
+      "up to 0.005 m outside"]),
 ])
 def test_placement_that_would_die_mid_run_is_refused(extra, words, tmp_path, capsys):
     deck = _deck(tmp_path, _small() + extra)

@@ -23,7 +23,8 @@ from .interactions.wall import STIFFNESS, WallSpec
 from .deck import DeckError
 from .deck.errors import format_problem
 from .detonation import light_explosives
-from .preflight import checked_lattices, history_models, support_radius
+from .preflight import (check_meshes_in_domain, checked_lattices, history_models,
+                        support_radius)
 from .materials import MaterialGroup, get_model, history_layout
 from .materials.uniaxial import UNIAXIAL, uniaxial_params
 from .mesh_model import MeshModel, build_meshes, mesh_node_set
@@ -194,12 +195,14 @@ def build_model(deck) -> Model:
 
     Raises :class:`~sphdyn.deck.DeckError` before making any particle if the
     model would exceed ``run.memory_limit``, and before anything else if
-    bodies overlap, start through a wall or are smaller than their dx
-    (:mod:`sphdyn.preflight`).
+    bodies overlap, start through a wall or outside the [domain] box or are
+    smaller than their dx, and before making parts if a mesh lies outside
+    the box (:mod:`sphdyn.preflight`).
     """
     dim = deck.run.dimension
     _, lattices = checked_lattices(deck)
     meshes = build_meshes(deck)
+    check_meshes_in_domain(deck, meshes)
     mats = {m.name: m for m in deck.material}
     mat_index = {m.name: k for k, m in enumerate(deck.material)}
     models = {m.name: get_model(m.model) for m in deck.material}

@@ -495,7 +495,8 @@ def placement_problems(deck, positions: list[np.ndarray]) -> list[str]:
 
     A body of fewer than two particles (smaller than dx); a body whose
     particles lie inside another body's geometry (overlap); a body with
-    particles behind a wall's plane (starting through the wall).
+    particles outside the [domain] box; a body with particles behind a
+    wall's plane (starting through the wall).
     """
     dim = deck.run.dimension
     problems = []
@@ -525,6 +526,10 @@ def placement_problems(deck, positions: list[np.ndarray]) -> list[str]:
                     "deep)",
                     f"move '{body_b.name}' or '{body_a.name}' apart so that their "
                     "geometries at most touch"))
+    for b, (body, x) in enumerate(zip(deck.body, positions)):
+        line = outside_problem(deck, f"body[{b}].geometry", f"body '{body.name}'", x)
+        if line:
+            problems.append(line)
     for w, wall in enumerate(deck.wall):
         normal = np.asarray(wall.normal) / np.linalg.norm(wall.normal)
         for body, x in zip(deck.body, positions):
@@ -539,6 +544,62 @@ def placement_problems(deck, positions: list[np.ndarray]) -> list[str]:
                     f"move the body to the side wall '{wall.name}''s normal points "
                     "to, or move the wall's point (or flip its normal)"))
     return problems
+
+
+def domain_box(deck) -> tuple[np.ndarray, np.ndarray] | None:
+    """The deck's [domain] box ``(lo, hi)`` (3,) each, -inf/inf for an absent
+    corner and for the axes beyond the dimension; None without lo and hi."""
+    d, dim = deck.domain, deck.run.dimension
+    if d.lo is None and d.hi is None:
+        return None
+    lo = np.full(3, -np.inf) if d.lo is None else np.asarray(d.lo, float).copy()
+    hi = np.full(3, np.inf) if d.hi is None else np.asarray(d.hi, float).copy()
+    lo[dim:], hi[dim:] = -np.inf, np.inf
+    return lo, hi
+
+
+def _box_text(lo: np.ndarray, hi: np.ndarray, dim: int) -> str:
+    return (f"[{', '.join(f'{v:g}' for v in lo[:dim])}] .. "
+            f"[{', '.join(f'{v:g}' for v in hi[:dim])}] m")
+
+
+def outside_problem(deck, where: str, what: str, x: np.ndarray,
+                    items: str = "particles") -> str | None:
+    """The problem line of items ``x`` (n, 3) [m] outside the [domain] box
+    (outside as the run's guard sees it: below lo or above hi on an axis),
+    or None. ``where`` is the deck path named, ``what`` the thing
+    (``"body 'disc'"``), ``items`` what its points are."""
+    box = domain_box(deck)
+    if box is None or not x.size:
+        return None
+    lo, hi = box
+    depth = np.max(np.maximum(lo - x, x - hi), axis=1)  # > 0 outside
+    out = depth > 0.0
+    if not out.any():
+        return None
+    dim = deck.run.dimension
+    how = "wholly" if out.all() else "partly"
+    return format_problem(
+        where, f"{what} lies {how} outside the domain box {_box_text(lo, hi, dim)} "
+        f"([domain] lo, hi): {int(out.sum())} of its {x.shape[0]} {items}, up to "
+        f"{float(depth.max()):.3g} m outside, would stop the run at its first step",
+        "move it into the box, or enlarge [domain] lo/hi (or remove them: the box then "
+        "follows the model, widened by [domain] margin)")
+
+
+def check_meshes_in_domain(deck, meshes) -> None:
+    """DeckError for meshes (:class:`~sphdyn.mesh_model.MeshModel`) whose
+    nodes or converted particles lie outside the [domain] box."""
+    problems = []
+    for mm in meshes:
+        x = mm.points if mm.converted is None else np.concatenate(
+            [mm.points, mm.converted.x])
+        line = outside_problem(deck, f"mesh[{mm.index}] '{mm.name}'", f"mesh '{mm.name}'", x,
+                               "nodes" if mm.converted is None else "nodes and particles")
+        if line:
+            problems.append(line)
+    if problems:
+        raise DeckError(problems)
 
 
 def check_placement(deck, positions: list[np.ndarray]) -> None:
