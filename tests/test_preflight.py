@@ -106,6 +106,7 @@ def _mutated(tmp_path, deck: str, path: tuple, value) -> str:
     ("disc_impact", ("sph", "support_scale"), 1e6, "sph.support_scale"),
     ("sod_shock_tube", ("sph", "neighbours"), {"skin_factor": 1e9}, "sph.neighbours.skin_factor"),
     ("elastic_disc_bounce", ("sph", "h_factor"), 1e300, "sph.h_factor"),
+    ("disc_impact", ("sph", "support_scale"), 1e-9, "sph.support_scale"),
     ("beam_fem", ("mesh", 0, "block", "divisions"), [1_000_000_000, 8, 8],
      "mesh[0].block.divisions"),
     ("beam_hybrid", ("mesh", 0, "block", "divisions"), [1_000_000, 80, 80],
@@ -122,7 +123,8 @@ def test_absurd_sizes_are_refused_before_anything_large_is_allocated(
     naming the key and a fix, allocating little on the way: a smoothing-length
     factor of 1e6 made the neighbour count allocate 141 TiB
     (numpy ArrayMemoryError); a mesh's element count had no bound before its
-    particles were counted. The peak of Python allocations (tracemalloc,
+    particles were counted; a support_scale of 1e-9 (no neighbour at all)
+    passed. The peak of Python allocations (tracemalloc,
     which sees NumPy's buffers) stays below 100 MB, far below any of these
     models and above the examples' own meshes (beam: 10,240 hexes)."""
     import tracemalloc

@@ -495,7 +495,14 @@ def _sublayer_groups(deck, meshes, particles: Particles, body_names: list[str],
                     f"\"{stiffness}\" scales the bar material's stresses, which model "
                     f"'{model.name}' does not allow", "use a bar material of model "
                     f"{' or '.join(SPLIT_MODELS)}, or stiffness = \"material\" or \"none\"")])
-            values = mat.stress_scaled(float(particles.rho0[rows[0]]) / mat.density)
+            ratio = float(particles.rho0[rows[0]]) / mat.density
+            values = mat.stress_scaled(ratio)
+            if not all(np.isfinite(v) for v in values.values() if isinstance(v, float)):
+                raise DeckError([format_problem(
+                    f"material[{k}] '{mat.name}'.density",
+                    f"\"{stiffness}\" scales the bar's stresses by the concrete's "
+                    f"density over the bar's, {ratio:.3g}, and they overflow",
+                    "give the bar material its density (steel: 7850 kg/m^3)")])
             packed = model.pack(values)
             if stiffness == "axial":
                 model, packed = UNIAXIAL, uniaxial_params(model.name, packed)

@@ -388,9 +388,17 @@ TOO_MANY_NEIGHBOURS = 1000.0
 MAX_NEIGHBOURS = 1e4
 
 
-def _radius_field(sph) -> tuple[str, float]:
+def has_particles(deck) -> bool:
+    """Whether the model has SPH particles now or later: bodies, or meshes
+    converted, with a sublayer or eroding into particles."""
+    return bool(deck.body) or any(
+        m.convert is not None or m.sublayer is not None
+        or (m.erosion is not None and m.erosion.to == "particles") for m in deck.mesh)
+
+
+def _radius_field(sph, smallest: bool = False) -> tuple[str, float]:
     """The [sph] key that stretches the Verlet radius most over its
-    default, and its value."""
+    default (``smallest``: shrinks it most), and its value."""
     from .deck.sections.sph import Sph
 
     default = Sph()
@@ -398,7 +406,7 @@ def _radius_field(sph) -> tuple[str, float]:
               "sph.support_scale": sph.support_scale / default.support_scale,
               "sph.neighbours.skin_factor": (1.0 + sph.neighbours.skin_factor)
               / (1.0 + default.neighbours.skin_factor)}
-    key = max(ratios, key=lambda k: ratios[k])
+    key = (min if smallest else max)(ratios, key=lambda k: ratios[k])
     return key, {"sph.h_factor": sph.h_factor, "sph.support_scale": sph.support_scale,
                  "sph.neighbours.skin_factor": sph.neighbours.skin_factor}[key]
 
@@ -409,7 +417,14 @@ def check_size(deck) -> SizeEstimate:
     dim = deck.run.dimension
     radius = verlet_radius(deck.sph)
     per = lattice_neighbours(radius, dim)
-    if not per <= MAX_NEIGHBOURS:
+    if has_particles(deck) and per == 0:
+        key, value = _radius_field(deck.sph, smallest=True)
+        raise DeckError([format_problem(
+            key, f"{key} = {value:g} gives a Verlet radius of {radius:.3g} particle "
+            "spacings: a particle has no neighbour on its lattice, so the particles "
+            "would not interact", "use h_factor 1.2-2 (h = h_factor dx) and "
+            "support_scale about 1 (a support of 2-3 spacings)")])
+    if has_particles(deck) and not per <= MAX_NEIGHBOURS:
         key, value = _radius_field(deck.sph)
         raise DeckError([format_problem(
             key, f"{key} = {value:g} gives a Verlet radius of {radius:.3g} particle "
