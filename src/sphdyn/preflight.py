@@ -1,13 +1,18 @@
 """Checks of a deck's model before it is built or run: its size and its placement.
 
 * :func:`estimate_size` counts the particles of every body from the closed-form
-  volume of its geometry over ``dx**dim`` and the neighbour-list pairs from the
+  volume of its geometry over ``dx**dim`` (and those a mesh's elements make),
+  the elements of generated meshes and the neighbour-list pairs from the
   kernel support, before a single particle is made; :func:`check_size` refuses
-  a model over ``run.memory_limit`` (default: half of this machine's memory),
-  so a mistyped ``dx`` cannot hang ``sphdyn check`` and end in a MemoryError.
+  a support holding no neighbour or more than :data:`MAX_NEIGHBOURS`, and a
+  model over ``run.memory_limit`` (default: half of this machine's memory),
+  naming the key behind it, so a mistyped ``dx``, ``divisions`` or
+  ``h_factor`` cannot hang ``sphdyn check`` and end in a MemoryError. Nothing
+  here allocates more than the limit to find that out.
 * :func:`placement_problems` finds, on the built lattices, bodies that
-  overlap, bodies that start through a wall and bodies of a single particle:
-  decks that validate but would die mid-run.
+  overlap, bodies that start through a wall or outside the [domain] box and
+  bodies of a single particle (:func:`check_meshes_in_domain`: meshes outside
+  the box): decks that validate but would die mid-run.
 
 Both raise :class:`~sphdyn.deck.DeckError` (exit status 2 on the command line),
 one ``<path>: <what>. Fix: <what to write>`` line per problem.

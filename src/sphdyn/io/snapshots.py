@@ -4,6 +4,7 @@
 (``outdir/frames/frame_*.h5``), all on one colour scale with one colour bar,
 like the ring and disc figures of the thesis and the paper:
 
+* 1D runs: the field along x, one line per frame (one axes per run);
 * 2D runs: the particles at their x-y positions;
 * 3D runs: the particles of a slab around the mid-plane of ``slice_axis``,
   in the other two coordinates.
