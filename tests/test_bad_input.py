@@ -93,6 +93,20 @@ def test_export_of_a_frame_out_of_range_is_refused(run_dir, capsys):
     assert main(["export", str(run_dir), "--format", "csv", "--frame", "0"]) == 0
 
 
+@pytest.mark.parametrize("fmt", ["vtk", "csv"])
+def test_export_of_a_folder_without_frames_is_refused(tmp_path, capsys, fmt):
+    """`sphdyn export DIR` of a folder with no frames (empty, or a missing
+    folder) exits 2 saying so and what to do; the VTK export once wrote an
+    empty particles.pvd and exited 0."""
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    rc, err = _exit_and_message(capsys, ["export", str(empty), "--format", fmt])
+    assert rc == 2 and "there are no frames" in err and "Fix:" in err
+    assert list(empty.iterdir()) == []
+    rc, err = _exit_and_message(capsys, ["export", str(tmp_path / "nope"), "--format", fmt])
+    assert rc == 2 and "no such directory" in err and "Fix:" in err
+
+
 # ---------------------------------------------------------------- arguments
 
 @pytest.mark.parametrize("argv, flag", [
@@ -201,7 +215,9 @@ def test_memory_limit_is_a_deck_key(tmp_path, capsys):
     assert rc == 2 and "run.memory_limit" in err and "GiB" in err
     assert main(["check", deck, "--set", "run.memory_limit=1 GiB"]) == 0
     out = capsys.readouterr().out
-    assert "estimate: about 113 particles" in out and "1.07 GB" in out
+    # after the build, check reports the model's own count (the closed-form
+    # estimate that the limit was checked against says 113)
+    assert "estimate: about 112 particles" in out and "1.07 GB" in out
 
 
 # ---------------------------------------------------------------- placement
@@ -212,6 +228,19 @@ def test_memory_limit_is_a_deck_key(tmp_path, capsys):
     (SECOND_BODY.format(name="grain", dx=0.05, lo=0.02, hi=0.03), ["'grain'", "dx"]),
     ('\n[[wall]]\nname = "roof"\npoint = [0, 0.01]\nnormal = [0, 1]\n',
      ["'disc'", "'roof'", "through"]),
+    # the [domain] box: a body partly or wholly outside it, a mesh partly
+    # outside (they passed check and stopped the run at its first step with
+    # "enlarge [domain] if this motion is physical")
+    ('\n[domain]\nlo = [-0.01, 0]\nhi = [0.01, 0.01]\n',
+     ["body[0].geometry", "'disc' lies partly outside the domain box",
+      "[-0.01, 0] .. [0.01, 0.01] m", "12 of its 112 particles"]),
+    ('\n[domain]\nlo = [0.1, 0.1]\nhi = [0.2, 0.2]\n',
+     ["body[0].geometry", "'disc' lies wholly outside", "[domain] lo/hi"]),
+    ('\n[[mesh]]\nname = "pad"\nmaterial = "rubber"\n'
+     'block = { lo = [0.02, 0], hi = [0.03, 0.01], divisions = [2, 2] }\n'
+     '\n[domain]\nlo = [-0.01, -0.01]\nhi = [0.025, 0.02]\n',
+     ["mesh[0] 'pad'", "mesh 'pad' lies partly outside", "3 of its 9 nodes",
+      "up to 0.005 m outside"]),
 ])
 def test_placement_that_would_die_mid_run_is_refused(extra, words, tmp_path, capsys):
     deck = _deck(tmp_path, _small() + extra)

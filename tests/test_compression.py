@@ -174,3 +174,31 @@ def test_itz_strength_varied_per_sample_scatters_the_peak_in_its_order(tmp_path)
     peaks = np.array([_ucs(tmp_path, f"v{k}", seed=k, variation=var) for k in (1, 2, 3)])
     assert np.ptp(peaks) > 0.03 * peaks.mean()
     assert np.array_equal(np.argsort(peaks), np.argsort(factors))
+
+
+def _fake_run(path: Path) -> Path:
+    """A run directory with only what the wall checks read: the resolved deck
+    (walls 'base' and 'platen') and a history with the platen's columns."""
+    path.mkdir()
+    (path / "deck.resolved.toml").write_text(
+        '[run]\ndimension = 2\n[[body]]\nname = "col"\ndx = 0.001\n'
+        '[[wall]]\nname = "base"\nnormal = [0, 1, 0]\n'
+        '[[wall]]\nname = "platen"\nnormal = [0, -1, 0]\n')
+    (path / "history.csv").write_text("time,F_wall_platen,d_wall_platen\n0,0,0\n1e-5,1,1e-6\n")
+    return path
+
+
+def test_ucs_refuses_a_wall_the_runs_do_not_have(tmp_path, capsys):
+    """`sphdyn ucs --wall NAME` with a name that is no wall of the runs exits 2
+    naming the walls that exist, and writes nothing (it printed "nan MPa" and
+    exited 0); a wall that does not move in every run is refused too."""
+    run = _fake_run(tmp_path / "r")
+    out = tmp_path / "rep"
+    assert main(["ucs", str(run), "--wall", "lid", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "no [[wall]] named 'lid'" in err and "base, platen" in err and "Fix:" in err
+    assert not out.exists()
+    assert main(["ucs", str(run), "--wall", "base", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "none of the 1 directories" in err and "does not move" in err
+    assert "nan" not in err and not out.exists()

@@ -659,3 +659,16 @@ def test_probe_quantity_is_checked_and_names_the_field():
     assert "probe[0].quantities" in str(err.value) and "Fix:" in str(err.value)
     ok = loads_deck(MINIMAL + '[[set]]\nname = "s"\n[[probe]]\nset = "s"\n')
     assert ok.probe[0].reduce == "mean" and "velocity_x" in ok.probe[0].quantities
+
+
+@pytest.mark.parametrize("kind, plural", [
+    ("quantity", "quantities"), ("number", "numbers"),
+    ("list of quantities", "lists of quantities"),
+    ("vector of quantity", "vectors of quantity")])
+def test_type_names_in_the_reference_are_plural_english(kind, plural):
+    """The reference's type column: a list's element type is pluralised on its
+    head noun (it once printed "list of list of quantityss")."""
+    assert docgen.plural(kind) == plural
+    text = docgen.generate()
+    assert "list of lists of quantities" in text
+    assert not re.search(r"(ss|ys) \|", text)

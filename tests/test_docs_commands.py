@@ -4,6 +4,7 @@
   for a few steps; a fragment is merged into the example deck named for it in
   :data:`FRAGMENT_HOSTS` (tables by name, as a user would paste it) and the
   result checked and run the same way.
+* Fenced ```python blocks run as they stand, in a scratch directory.
 * Shell commands: the lines of fenced ```bash blocks and of indented code
   blocks, and inline code spans, that start with ``sphdyn``. They run in
   document order in one scratch directory (``examples/`` linked in), through
@@ -15,6 +16,9 @@
     ensemble is replaced by a loop over its samples in this process (the
     cluster itself is tested in tests/test_ensemble.py);
   - ``material-test`` takes 20 load steps;
+  - ``plot --times T1,...`` drops ``--times``: the shortened runs end long
+    before the documented times, which ``plot`` refuses (tests/test_snapshots.py
+    tests ``--times``);
   - a command reading ``out/NAME`` that no earlier command wrote first runs
     ``examples/NAME.toml``.
 
@@ -80,14 +84,19 @@ _PLACEHOLDER = re.compile(r"(^|[\s=,/])([A-Z][A-Z0-9_]*)([\s,.\]]|$)|<\w+>|\.\.\
 
 # -------------------------------------------------------------------- extraction
 
-def toml_blocks() -> list[tuple[str, int, str]]:
-    """(document name, block number, text) of every fenced TOML block."""
+def fenced_blocks(language: str) -> list[tuple[str, int, str]]:
+    """(document name, block number, text) of every fenced block of ``language``."""
     found = []
     for doc in DOCS:
         blocks = [m.group(2) for m in _FENCE.finditer(doc.read_text(encoding="utf-8"))
-                  if m.group(1) == "toml"]
+                  if m.group(1) == language]
         found += [(doc.name, k, text) for k, text in enumerate(blocks)]
     return found
+
+
+def toml_blocks() -> list[tuple[str, int, str]]:
+    """(document name, block number, text) of every fenced TOML block."""
+    return fenced_blocks("toml")
 
 
 def _logical_lines(text: str) -> list[str]:
@@ -157,6 +166,9 @@ def shortened(command: str) -> list[str]:
         args.append("-q")
     if args[0] == "material-test" and "--steps" not in args:
         args += ["--steps", "20"]
+    if args[0] == "plot" and "--times" in args:
+        k = args.index("--times")
+        del args[k:k + 2]
     return args
 
 
@@ -226,6 +238,7 @@ def test_the_documents_show_decks_and_commands():
     that silently finds nothing)."""
     names = {name for name, _, _ in toml_blocks()}
     assert {"README.md", "deck-reference.md", "mesostructure.md"} <= names
+    assert "mesostructure.md" in {name for name, _, _ in fenced_blocks("python")}
     commands = [c for doc in DOCS for c in shell_commands(doc)]
     assert "sphdyn run examples/disc_impact.toml" in commands
     assert any(c.startswith("sphdyn ucs out/ucs_mesostructure-ensemble/sample_*")
@@ -251,6 +264,14 @@ def test_toml_block_checks_and_runs(doc, number, text, scratch):
     _check_and_run(path)
 
 
+@pytest.mark.parametrize("doc, number, text", fenced_blocks("python"),
+                         ids=[f"{d}-{k}" for d, k, _ in fenced_blocks("python")])
+def test_python_block_runs(doc, number, text, scratch):
+    """A Python snippet of the documents runs as a user would paste it (the
+    mesostructure snippet once used ``x`` and ``dx`` without making them)."""
+    exec(compile(text, f"{doc} python block #{number}", "exec"), {"__name__": "__main__"})
+
+
 def test_documented_commands_run(scratch, capsys):
     ran = 0
     for doc in DOCS:
@@ -267,3 +288,58 @@ def test_documented_commands_run(scratch, capsys):
                                f"{capsys.readouterr().err[-2000:]}")
             ran += 1
     assert ran >= 15
+
+
+def test_package_summary_and_docstring_do_not_call_existing_parts_planned():
+    """pyproject's description and the package docstring (shown by pip and
+    help()) name the finite elements, rebar and blast that exist, not as
+    "planned" (they did after all three were in)."""
+    import sphdyn
+
+    with open(ROOT / "pyproject.toml", "rb") as f:
+        summary = tomllib.load(f)["project"]["description"]
+    for text in (summary, sphdyn.__doc__):
+        assert "planned" not in text.lower()
+        for part in ("FEM" if text is summary else "finite elements", "rebar", "blast"):
+            assert part in text, (part, text)
+
+
+#: a repository path to a script, deck or page: ``examples/gurney.py``
+_REPO_PATH = re.compile(
+    r"\b((?:examples|tools|benchmarks|studies|tests|docs)/[\w./-]*\.(?:py|toml|md))\b")
+
+
+def referenced_paths() -> list[tuple[str, str]]:
+    """(file, path) of every script, deck or page path named in the example
+    decks, README.md and docs/*.md (placeholders such as ``NAME`` left out)."""
+    sources = [*sorted((ROOT / "examples").glob("*.toml")), *DOCS]
+    return [(src.name, m.group(1)) for src in sources
+            for m in _REPO_PATH.finditer(src.read_text(encoding="utf-8"))
+            if not re.search(r"[A-Z]{2,}", m.group(1))]
+
+
+def test_every_script_and_deck_named_in_the_decks_and_docs_exists():
+    """The decks' comments and the docs point at files that exist (two decks
+    once named examples/shock_tube.py and examples/gurney.py, which never
+    did; both cases are run by examples/explosives_1d.py)."""
+    found = referenced_paths()
+    assert len({p for _, p in found if p.endswith(".py")}) >= 10
+    missing = sorted({f"{src}: {path}" for src, path in found if not (ROOT / path).exists()})
+    assert not missing, "\n".join(missing)
+
+
+def test_readme_says_how_long_the_suite_takes_and_how_to_shorten_it():
+    """README: the suite's duration and the quick options, each of which works
+    with the test extras (the "slow" marker is registered, pytest-xdist is in
+    the extras); the two setup commands stay as they are."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert "about 15 minutes on 2 cores" in text
+    assert '`pytest -m "not slow"`' in text and "`pytest -n 2`" in text
+    with open(ROOT / "pyproject.toml", "rb") as f:
+        project = tomllib.load(f)
+    assert any(m.startswith("slow:") for m in project["tool"]["pytest"]["ini_options"]["markers"])
+    assert any(d.startswith("pytest-xdist") for d in project["project"]["optional-dependencies"]["test"])
+    blocks = [b for lang, _, b in [(m.group(1), 0, m.group(2)) for m in _FENCE.finditer(text)]
+              if lang == "bash"]
+    assert blocks[:2] == ["pip install . && sphdyn run examples/disc_impact.toml\n",
+                          "pip install '.[test]' && pytest\n"]

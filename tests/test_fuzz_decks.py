@@ -1,9 +1,14 @@
 """Fuzzing the deck: mutated example decks end in status 0 or 2, never a traceback.
 
 Every example deck is mutated deterministically (one mutation per case,
-seeded by the case number): a key deleted or renamed, a value of the wrong
-type or unit, negative, zero, huge or not finite, a table emptied, a body
-duplicated, nonsense text, a file reference to a missing file. Each mutated
+seeded by the case number; the mutations take turns, each on decks drawn
+from the examples): a key deleted or renamed, a value of the wrong type or
+unit, negative, zero, huge or not finite, a table emptied, a body
+duplicated, nonsense text, a file reference to a missing file; and absurd
+sizes, counts and factors: a number times 1e6, sph.h_factor or
+support_scale of 1e6, mesh divisions of 1e9, dx of 1e-9 m, whole numbers
+times 1e9, a domain box of 1e30 m, t_end of 1e30 s with output every
+1e-30 s. Each mutated
 deck goes through ``sphdyn check`` in-process: it must return 0, or 2 with a
 one-paragraph message that names a field and a fix; no exception may escape.
 A few accepted ones also run two steps.
@@ -129,6 +134,81 @@ def _missing_file(doc, rng):
         doc["body"] = [{"mesostructure": {"photo": "missing.png"}}]
 
 
+def _dimension(doc) -> int:
+    run = doc.get("run")
+    dim = run.get("dimension") if isinstance(run, dict) else None
+    return dim if dim in (1, 2, 3) else 3
+
+
+def _tables(doc, section) -> list:
+    items = doc.get(section)
+    return [t for t in items if isinstance(t, dict)] if isinstance(items, list) else []
+
+
+def _sph_factor(key):
+    """sph.<key> set to 1e6 (or 1e-9 for support_scale, every other case)."""
+    def mutate(doc, rng):
+        sph = doc.setdefault("sph", {}) if isinstance(doc.get("sph", {}), dict) else {}
+        sph[key] = rng.choice([1e6, 1e-9]) if key == "support_scale" else 1e6
+    return mutate
+
+
+def _mesh_divisions(doc, rng):
+    """A mesh's element count to 1e9 (block divisions, line divisions or
+    element length, prism element size), or, without meshes, a body's dx."""
+    meshes = _tables(doc, "mesh")
+    if not meshes:
+        return _tiny_dx(doc, rng)
+    mesh = rng.choice(meshes)
+    if isinstance(mesh.get("block"), dict):
+        mesh["block"]["divisions"] = [10**9] * _dimension(doc)
+    elif isinstance(mesh.get("line"), dict):
+        line = mesh["line"]
+        line.pop("element_length", None)
+        line["divisions"] = 10**9
+    elif isinstance(mesh.get("prism"), dict):
+        mesh["prism"]["element_size"] = "1e-9 m"
+    else:
+        mesh["block"] = {"lo": [0] * _dimension(doc), "hi": [1] * _dimension(doc),
+                         "divisions": [10**9] * _dimension(doc)}
+
+
+def _tiny_dx(doc, rng):
+    """A body's dx of 1e-9 m (or, without bodies, a mesh's divisions)."""
+    bodies = _tables(doc, "body")
+    if bodies:
+        rng.choice(bodies)["dx"] = "1e-9 m"
+    elif _tables(doc, "mesh"):
+        _mesh_divisions(doc, rng)
+
+
+def _huge_count(doc, rng):
+    """A whole number (a count: divisions, octaves, repeat, history_every,
+    particles_per_element, classes, seed ...) times 1e9."""
+    paths = [p for p in _leaves(doc, (int,))
+             if not isinstance(_parent(doc, p)[p[-1]], bool)]
+    if not paths:
+        return _number(lambda x: x * 1e9)(doc, rng)
+    path = rng.choice(paths)
+    _set(doc, path, max(abs(_parent(doc, path)[path[-1]]), 1) * 10**9)
+
+
+def _huge_domain(doc, rng):
+    """A [domain] box of 1e30 m on every side."""
+    dim = _dimension(doc)
+    domain = doc.setdefault("domain", {}) if isinstance(doc.get("domain", {}), dict) else {}
+    domain["lo"] = [-1e30] * dim
+    domain["hi"] = [1e30] * dim
+
+
+def _endless_run(doc, rng):
+    """t_end of 1e30 s with an output every 1e-30 s (or every step)."""
+    if isinstance(doc.get("run"), dict):
+        doc["run"]["t_end"] = 1e30
+    output = doc.setdefault("output", {}) if isinstance(doc.get("output", {}), dict) else {}
+    output["every"] = rng.choice([1e-30, "1e-30 s"])
+
+
 MUTATIONS = {
     "delete": _delete, "rename": _rename, "wrong_type": _wrong_type,
     "wrong_unit": _wrong_unit, "negative": _number(lambda x: -abs(x) - 1.0),
@@ -136,14 +216,19 @@ MUTATIONS = {
     "tiny": _number(lambda x: 1e-300), "not_finite": _number(lambda x: math.inf),
     "empty_table": _empty_table, "duplicate_body": _duplicate_body,
     "nonsense": _nonsense, "missing_file": _missing_file,
+    # absurd sizes, counts and factors (issue 57)
+    "factor_1e6": _number(lambda x: x * 1e6), "h_factor_1e6": _sph_factor("h_factor"),
+    "support_scale": _sph_factor("support_scale"), "divisions_1e9": _mesh_divisions,
+    "dx_1e-9": _tiny_dx, "count_1e9": _huge_count, "domain_1e30": _huge_domain,
+    "t_end_1e30": _endless_run,
 }
 
 
 def mutated_deck(case: int) -> tuple[str, dict]:
     """``(description, document)`` of fuzz case ``case`` (deterministic)."""
     rng = random.Random(20261124 + case)
-    example = EXAMPLES[case % len(EXAMPLES)]
-    name = list(MUTATIONS)[(case // len(EXAMPLES)) % len(MUTATIONS)]
+    name = list(MUTATIONS)[case % len(MUTATIONS)]
+    example = rng.choice(EXAMPLES)
     doc = tomllib.loads(example.read_text(encoding="utf-8"))
     MUTATIONS[name](doc, rng)
     if isinstance(doc.get("run"), dict):
@@ -181,6 +266,19 @@ def checked(tmp_path_factory):
     return base, results
 
 
+def test_every_mutation_is_tried_on_several_decks():
+    """Each mutation (the absurd sizes among them) gets N_CASES / 21 cases,
+    at least 10, on at least 5 different examples."""
+    tried, cases = {}, {}
+    for case in range(N_CASES):
+        what, _ = mutated_deck(case)
+        deck, name = what.split(":")
+        tried.setdefault(name, set()).add(deck)
+        cases[name] = cases.get(name, 0) + 1
+    assert set(tried) == set(MUTATIONS) and min(cases.values()) >= 10
+    assert all(len(decks) >= 5 for decks in tried.values()), tried
+
+
 def test_at_least_200_mutated_decks_end_in_0_or_2_with_one_paragraph(checked, capsys):
     _, results = checked
     assert len(results) >= 200
@@ -204,7 +302,8 @@ def test_at_least_200_mutated_decks_end_in_0_or_2_with_one_paragraph(checked, ca
 def test_a_few_accepted_mutants_run_two_steps(checked, capsys):
     base, results = checked
     small = ("elastic_disc_bounce", "ucs_homogeneous", "two_boxes_close",
-             "rings_gray2001")
+             "rings_gray2001", "rings_gray2001_artificial_stress",
+             "rings_gray2001_total_lagrangian", "sod_shock_tube", "gurney_1d")
     runnable = [(case, what, path) for case, (what, path, rc) in sorted(results.items())
                 if rc in (0, None) and what.split(":")[0] in small]
     ran = 0

@@ -100,3 +100,42 @@ def test_cli_material_from_deck(tmp_path, capsys):
     assert (tmp_path / "cscm_uniaxial-tension.png").exists()
     assert main(["material-test", "--deck", str(DECK),
                  "--material", "nope"]) == 2
+
+
+def test_cli_cscm_without_a_density_runs_as_readme_shows(tmp_path, capsys):
+    """`sphdyn material-test cscm --path uniaxial-compression` runs without
+    --param density (it failed for want of one): 2400 kg/m^3 is assumed and
+    said on stderr. The density does not enter a strain-driven point's
+    stress, so the summary equals the one with --param density=1000 exactly."""
+    import json
+
+    args = ["material-test", "cscm", "--path", "uniaxial-compression", "--steps", "20"]
+    assert main(args + ["--out", str(tmp_path / "a")]) == 0
+    out, err = capsys.readouterr()
+    assert "2400 kg/m^3 assumed" in err
+    assumed = json.loads(out)
+    assert main(args + ["--param", "density=1000", "--out", str(tmp_path / "b")]) == 0
+    out, err = capsys.readouterr()
+    assert "assumed" not in err
+    given = json.loads(out)
+    assert assumed["peak_stress_Pa"] == given["peak_stress_Pa"] < 0
+
+
+@pytest.mark.parametrize("argv, fix", [
+    (["gas", "--param", "gamma=1.4"], "Fix: add --param density=2400."),
+    (["gas", "--param", "density=1", "--param", "eos=linear_polynomial",
+      "--param", "gamma=1.4"], "--param eos=ideal_gas"),
+    (["high_explosive", "--param", "density=1600"], "--param preset=tnt"),
+    (["cscm", "--param", "fcc=3e7"], "did you mean 'fc'?"),
+])
+def test_cli_material_test_fixes_are_in_its_own_syntax(argv, fix, tmp_path, capsys):
+    """Every fix of a bad material-test is written as --param key=value, not
+    as a deck line (it said `add density = "2400 kg/m^3"`); an unknown key
+    lists the material's parameters only (no name, model or tables)."""
+    assert main(["material-test", *argv, "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert fix in err, err
+    assert " = \"" not in err.split("Fix:", 1)[1], err
+    if "did you mean" in fix:
+        assert "the parameters: density, fc," in err
+        assert "name," not in err and "variation" not in err

@@ -535,3 +535,42 @@ def test_a_quarter_model_with_rollers_meets_a_wall_as_the_whole_model_does():
     where = {tuple(k): i for i, k in enumerate(key(x0_all))}
     match = np.array([where[tuple(k)] for k in key(x0_q)])
     assert np.abs(x_q - x_all[match]).max() < 1e-9 * 0.04
+
+
+def test_sets_and_gauges_name_the_particles_of_a_converted_mesh_by_the_mesh_name(capsys):
+    """The particles of a [mesh.convert] form a body named as the mesh (the
+    docs say so), and a [[set]] or [[gauge]] may name it: `body = "bar"` was
+    refused with "there is no body named 'bar'". The set holds exactly the
+    converted particles (all of them, or those in its region); the gauge
+    sits on the converted particle nearest its point."""
+    source = BLOCK + ('\nconvert = {region = {shape = "box", lo = [0.3, -1, -1], '
+                      'hi = [0.7, 1, 1]}}')
+    extra = """
+[[set]]
+name = "converted"
+body = "bar"
+[[set]]
+name = "right_half"
+body = "bar"
+region = {shape = "box", lo = [0.5, -1, -1], hi = [1, 1, 1]}
+[[gauge]]
+name = "mid"
+type = "point"
+body = "bar"
+point = [0.45, 0.05, 0.05]
+"""
+    deck = bar_deck(source=source, extra=extra)
+    model = build_model(deck)
+    assert model.body_names == ["bar"]
+    assert np.array_equal(model.sets["converted"], np.arange(4))
+    assert np.allclose(model.particles.x[model.sets["right_half"], 0], [0.55, 0.65])
+    from sphdyn.gauges import build_gauges
+
+    parts = build_stepper(deck, model).parts
+    (gauge,) = build_gauges(deck, parts)
+    ((pk, i),) = gauge.items  # the converted particle at x = 0.45 (0.5 m from a node)
+    assert parts[pk].kind == "sph" and np.allclose(parts[pk].kin.x0[i], [0.45, 0.05, 0.05])
+    with pytest.raises(DeckError, match="there is no body named 'rod'.*bar"):
+        bar_deck(source=source, extra=extra.replace('body = "bar"', 'body = "rod"', 1))
+    with pytest.raises(DeckError, match="there is no body named 'bar'"):
+        bar_deck(extra=extra)  # without [mesh.convert] the mesh makes no particles

@@ -82,3 +82,103 @@ def test_history_width_is_the_built_parts_layout(deck):
 
     part = build_stepper(d).part("sph")
     assert history_width(d) == part.p.hist.shape[1]
+
+
+def _mutated(tmp_path, deck: str, path: tuple, value) -> str:
+    """``examples/<deck>.toml`` with the key at ``path`` set to ``value``."""
+    import tomllib
+
+    import tomli_w
+
+    with open(EXAMPLES / f"{deck}.toml", "rb") as f:
+        doc = tomllib.load(f)
+    node = doc
+    for key in path[:-1]:
+        node = node[key]
+    node[path[-1]] = value
+    out = tmp_path / f"{deck}.toml"
+    out.write_text(tomli_w.dumps(doc))
+    return str(out)
+
+
+@pytest.mark.parametrize("deck, path, value, field", [
+    ("elastic_disc_bounce", ("sph", "h_factor"), 1e6, "sph.h_factor"),
+    ("disc_impact", ("sph", "support_scale"), 1e6, "sph.support_scale"),
+    ("sod_shock_tube", ("sph", "neighbours"), {"skin_factor": 1e9}, "sph.neighbours.skin_factor"),
+    ("elastic_disc_bounce", ("sph", "h_factor"), 1e300, "sph.h_factor"),
+    ("disc_impact", ("sph", "support_scale"), 1e-9, "sph.support_scale"),
+    ("beam_fem", ("mesh", 0, "block", "divisions"), [1_000_000_000, 8, 8],
+     "mesh[0].block.divisions"),
+    ("beam_hybrid", ("mesh", 0, "block", "divisions"), [1_000_000, 80, 80],
+     "mesh[0].block.divisions"),
+    ("blast_slab_coarse", ("mesh", 0, "line", "element_length"), "1e-9 m",
+     "mesh[0].line.element_length"),
+    ("igirder_fem", ("mesh", 0, "prism", "element_size"), "1e-9 m",
+     "mesh[0].prism.element_size"),
+    ("disc_impact", ("body", 0, "dx"), "1e-9 m", "body[0].dx"),
+])
+def test_absurd_sizes_are_refused_before_anything_large_is_allocated(
+        tmp_path, capsys, deck, path, value, field):
+    """`sphdyn check` of a deck whose numbers ask for an absurd model exits 2
+    naming the key and a fix, allocating little on the way: a smoothing-length
+    factor of 1e6 made the neighbour count allocate 141 TiB
+    (numpy ArrayMemoryError); a mesh's element count had no bound before its
+    particles were counted; a support_scale of 1e-9 (no neighbour at all)
+    passed. The peak of Python allocations (tracemalloc,
+    which sees NumPy's buffers) stays below 100 MB, far below any of these
+    models and above the examples' own meshes (beam: 10,240 hexes)."""
+    import tracemalloc
+
+    from sphdyn.cli import main
+
+    deck_path = _mutated(tmp_path, deck, path, value)
+    tracemalloc.start()
+    try:
+        rc = main(["check", deck_path])
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    err = capsys.readouterr().err
+    assert rc == 2, err
+    assert err.count("\n") <= 2 and field in err and "Fix:" in err, err
+    assert peak < 100e6
+
+
+@pytest.mark.parametrize("radius, dim", [(40.5, 3), (1e6, 2), (1e6, 1)])
+def test_lattice_neighbours_beyond_the_enumerated_radius_is_the_ball(radius, dim):
+    """Past 40 spacings the count is the ball's volume minus one (no point
+    grid); at 40.5 dx in 3D it is within 1 % of the enumerated count at
+    40 dx scaled by the volume ratio (the surface points' share there is
+    3/40 at most; 1 % is what the two radii's counts differ by beyond the
+    volume ratio). An overflowing radius gives inf."""
+    from sphdyn.preflight import ball_volume
+
+    got = lattice_neighbours(radius, dim)
+    assert got == ball_volume(radius, dim) - 1.0
+    if dim == 3:
+        near = lattice_neighbours(40.0, 3) * (radius / 40.0) ** 3
+        assert got == pytest.approx(near, rel=0.01)
+    assert lattice_neighbours(1e300, 3) == math.inf
+
+
+def test_check_counts_the_particles_of_converted_and_eroding_elements(capsys):
+    """Particles made from elements count: beam_hybrid's converted region
+    (64 x 8 x 8 = 4096 elements) and its hybrid layer (2 x 64 one-point
+    elements) make 4224 particles, which the estimate before the build
+    counts exactly on the generated mesh and `check` reports (it said
+    "about 0 particles"); erosion into particles may add one per element
+    of erosion_blocks_sph (1000), which check says."""
+    from sphdyn.cli import main
+
+    d = load_deck(EXAMPLES / "beam_hybrid.toml")
+    est = estimate_size(d)
+    assert est.bodies == {"beam": 4224.0} and est.particles == 4224.0
+    assert est.pairs_per_particle == 80
+    assert main(["check", str(EXAMPLES / "beam_hybrid.toml")]) == 0
+    assert "estimate: about 4,224 particles, 80 neighbours" in capsys.readouterr().out
+    d = load_deck(EXAMPLES / "erosion_blocks_sph.toml")
+    est = estimate_size(d)
+    assert est.debris == {"block_debris": 1000.0} and est.particles == 1000.0
+    assert main(["check", str(EXAMPLES / "erosion_blocks_sph.toml")]) == 0
+    assert ("about 0 particles (+ up to 1,000 from eroding elements)"
+            in capsys.readouterr().out)

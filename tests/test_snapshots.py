@@ -112,8 +112,18 @@ class TestSelectFrames:
 
     def test_times_pick_nearest(self):
         assert select_frames(self.times, times=[0.9e-4, 3.4e-4, 5.6e-4]) == [1, 3, 6]
-        # Outside the run: the first/last frame; duplicates dropped; sorted.
-        assert select_frames(self.times, times=[1.0, -1.0, 2.1e-4, 1.9e-4]) == [0, 2, 6]
+        # Within half a frame interval of the ends: the first/last frame;
+        # duplicates dropped; sorted.
+        assert select_frames(self.times, times=[6.4e-4, -0.4e-4, 2.1e-4, 1.9e-4]) == [
+            0, 2, 6]
+
+    @pytest.mark.parametrize("t", [6.6e-4, -0.6e-4, 1.0])
+    def test_times_outside_the_run_are_refused(self, t):
+        """A time more than half a frame interval (0.05 ms here) past either
+        end is refused naming the run's range (it once showed the last
+        frame without a word)."""
+        with pytest.raises(ValueError, match=r"outside the run.*span 0 to 0\.0006 s"):
+            select_frames(self.times, times=[2e-4, t])
 
     def test_bad_input(self):
         with pytest.raises(ValueError):
@@ -231,6 +241,16 @@ def test_bad_limits_and_empty_slab(run2d, run3d, tmp_path):
     assert path.is_file()
 
 
+def test_cli_times_outside_the_run_exit_2_naming_the_range(run2d, capsys):
+    """`sphdyn plot --times` beyond the run's frames exits 2 with the run's
+    time range and writes nothing."""
+    target = run2d / "plots" / "snapshots_density.png"
+    assert main(["plot", str(run2d), "--snapshots", "density", "--times", "0.1 ms,5 ms"]) == 2
+    err = capsys.readouterr().err
+    assert "0.005 s is outside the run" in err and "0 to 0.0006 s" in err and "Fix:" in err
+    assert not target.exists()
+
+
 def test_no_frames(tmp_path):
     with pytest.raises(FileNotFoundError):
         plot_snapshots(tmp_path)
@@ -273,3 +293,56 @@ def test_several_runs_one_row_each(run2d, tmp_path):
     assert main(["plot", str(run2d), str(run2d), "--snapshots", "speed", "--n", "2",
                  "--out", str(tmp_path / "cli.png")]) == 0
     _check_png(tmp_path / "cli.png")
+
+
+def _run_1d(path, n_frames=3, with_deck=True):
+    """A 1D run directory written directly: 41 particles on x in [-0.02, 0.02]
+    m, frame k at t = k * 1e-5 s with density 1000 + k * x (kg/m^3)."""
+    from sphdyn.io.hdf5 import write_frame
+
+    x = np.linspace(-0.02, 0.02, 41)[::-1].copy()  # stored out of x order
+    pos = np.column_stack([x, np.zeros_like(x), np.zeros_like(x)])
+    for k in range(n_frames):
+        write_frame(path / "frames" / f"frame_{k:05d}.h5", k * 1e-5, k,
+                    {"position": pos, "density": 1000.0 + k * x,
+                     "velocity": np.column_stack([k * x, 0 * x, 0 * x])})
+    if with_deck:
+        (path / "deck.resolved.toml").write_text('[run]\ntitle = "bar"\ndimension = 1\n')
+    return path
+
+
+@pytest.mark.parametrize("with_deck", [True, False])
+def test_1d_snapshots_are_the_field_along_x_one_line_per_frame(tmp_path, monkeypatch,
+                                                               with_deck):
+    """A 1D run (the deck's dimension, or every y and z zero) gives one line
+    per frame of the field against x, in x order, with the frame's time
+    (it ended in an IndexError). Values are drawn as stored: exact."""
+    from sphdyn.io import snapshots
+
+    drawn = []
+    real = snapshots.save_figure
+    monkeypatch.setattr(snapshots, "save_figure",
+                        lambda fig, dest, dpi=None: drawn.append(fig) or real(fig, dest, dpi))
+    run = _run_1d(tmp_path / "r", with_deck=with_deck)
+    path = plot_snapshots(run, "density", n=3)
+    assert path == run / "plots" / "snapshots_density.png"
+    _check_png(path, min_bytes=5_000)
+    (ax,) = drawn[-1].axes
+    lines = ax.get_lines()
+    assert [ln.get_label() for ln in lines] == ["t = 0 µs", "t = 10 µs", "t = 20 µs"]
+    x = np.linspace(-0.02, 0.02, 41)
+    for k, ln in enumerate(lines):
+        assert np.array_equal(ln.get_xdata(), x * 1e3)
+        assert np.array_equal(ln.get_ydata(), 1000.0 + k * x)
+    assert ax.get_xlabel() == "x [mm]" and ax.get_ylabel() == "density [kg/m^3]"
+
+
+def test_1d_snapshots_of_two_runs_and_through_the_cli(tmp_path, capsys):
+    """Two 1D runs: one axes per run; the CLI writes the PNG and exits 0."""
+    a = _run_1d(tmp_path / "a")
+    b = _run_1d(tmp_path / "b", n_frames=2)
+    assert main(["plot", str(a), str(b), "--snapshots", "velocity_x", "--out",
+                 str(tmp_path / "two.png")]) == 0
+    _check_png(tmp_path / "two.png", min_bytes=5_000)
+    assert main(["plot", str(a), "--snapshots", "density,speed"]) == 0
+    assert capsys.readouterr().out.split()[-1].endswith("snapshots_speed.png")

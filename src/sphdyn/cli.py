@@ -194,7 +194,7 @@ def cmd_check(args) -> int:
 
     deck = load_deck(args.deck, args.set)
     model = build_model(deck)  # refuses a model over the memory limit before building
-    estimate = estimate_size(deck)
+    estimate = estimate_size(deck, model)
     p = model.particles
     limit, source = memory_limit(deck)
     if deck.gauge:  # placed on the stepper's parts, as a run places them
@@ -349,27 +349,40 @@ def cmd_bench(args) -> int:
     return 0
 
 
-def _param_value(key: str, text: str):
-    """``true``/``false`` -> bool, else a float (SI units)."""
+#: Density [kg/m^3] a material test assumes when none is given: a material
+#: point driven by strain has a stress independent of its density (it sets
+#: only the wave speed), so the test needs none; normal-weight concrete, or
+#: steel for the J2 metal. Fluids (gas, explosives) still need theirs.
+MATERIAL_TEST_DENSITY = {"j2": 7850.0}
+MATERIAL_TEST_DENSITY_DEFAULT = 2400.0
+
+
+def _param_value(text: str):
+    """``true``/``false`` -> bool, a number -> float (SI units), else the text
+    (a word such as ``linear_polynomial``, or a quantity with units, which
+    the material's table checks)."""
     low = text.strip().lower()
     if low in ("true", "false"):
         return low == "true"
     try:
         return float(text)
     except ValueError:
-        raise ValueError(f"--param {key}={text}: {text!r} is not a number. Fix: give "
-                         "the value as a number in SI units (or true/false)") from None
+        return text.strip()
 
 
-def _material_params(name: str, params: dict) -> dict:
+def _material_params(name: str, params: dict, given: dict | None = None) -> dict:
     """Check ``--param`` values against the material's deck table.
 
+    ``given``: the command line's text of each value (for the messages).
     Returns the values with the table's defaults filled in (SI, None
-    dropped); raises ValueError with one ``--param`` line per problem.
+    dropped); raises ValueError with one ``--param`` line per problem, its
+    fix written as ``--param key=value``.
     """
     from pydantic import ValidationError
 
     from .deck.errors import explain
+    from .deck.introspect import is_model, strip_optional
+    from .deck.sections.material import NOT_PARAMETERS
     from .materials import available_models, get_model
 
     if name not in available_models():
@@ -379,13 +392,33 @@ def _material_params(name: str, params: dict) -> dict:
     schema = get_model(name).schema
     if schema is None:
         return params
+    keys = tuple(k for k, info in schema.model_fields.items()
+                 if k not in NOT_PARAMETERS and not is_model(strip_optional(info.annotation)))
     raw = {"name": "material-test", "model": name, **params}
     try:
         table = schema.model_validate(raw)
     except ValidationError as exc:
-        raise ValueError("\n".join(f"--param {line}" for line in explain(exc, raw, schema))
-                         ) from None
+        lines = []
+        for line in explain(exc, raw, schema, params=keys):
+            key = line.split(":", 1)[0]
+            shown = f" {key}={given[key]}" if given and key in given else (
+                "" if key == "deck" else f" {key}")  # "deck": the values together
+            lines.append(f"--param{shown}{line[len(key):]}")
+        raise ValueError("\n".join(lines)) from None
     return table.values()
+
+
+def _test_density(name: str, params: dict) -> float | None:
+    """The material test's density (:data:`MATERIAL_TEST_DENSITY`) when
+    ``params`` give none and the model is a solid (a fluid's state needs its
+    own), else None."""
+    from .materials import available_models, get_model
+
+    if "density" in params or name not in available_models():
+        return None
+    if get_model(name).initial_state is not None:  # a gas or explosive
+        return None
+    return MATERIAL_TEST_DENSITY.get(name, MATERIAL_TEST_DENSITY_DEFAULT)
 
 
 def cmd_material_test(args) -> int:
@@ -418,12 +451,21 @@ def cmd_material_test(args) -> int:
         name = mat.model
     if not name:
         raise ValueError("give MODEL or --deck DECK --material NAME")
+    given = {}
     for item in args.param or []:
         key, sep, value = item.partition("=")
         if not sep:
-            raise ValueError(f"--param {item!r}: write KEY=VALUE (SI units)")
-        params[key.strip()] = _param_value(key.strip(), value)
-    params = _material_params(name, params)
+            raise ValueError(f"--param {item!r}: write KEY=VALUE (SI units). Fix: e.g. "
+                             "--param density=2400")
+        params[key.strip()] = _param_value(value)
+        given[key.strip()] = value
+    rho = None if args.deck else _test_density(name, params)
+    params = _material_params(name, params if rho is None else {**params, "density": rho},
+                              given)
+    if rho is not None:
+        print(f"sphdyn: no density given; {rho:g} kg/m^3 assumed (a strain-driven "
+              "material point's stress does not depend on it; --param density=... to "
+              "change)", file=sys.stderr)
     _writable_dir(args.out, "--out")
     res = drive(name, params, args.path, strain=args.strain, rate=args.rate,
                 n_steps=args.steps, confinement=args.confinement or 0.0, size=args.size,
@@ -534,8 +576,9 @@ def build_parser() -> argparse.ArgumentParser:
                    "(e.g. a case with and without a remedy)")
     p.add_argument("--snapshots", action="append", metavar="FIELD",
                    help="instead of the history plots, panels of the particles coloured "
-                   "by FIELD (von_mises, damage, speed, stress_yy, ...) into "
-                   "DIR/plots/snapshots_FIELD.png; repeatable or a comma list")
+                   "by FIELD (von_mises, damage, speed, stress_yy, ...; 1D runs: FIELD "
+                   "along x, one line per time) into DIR/plots/snapshots_FIELD.png; "
+                   "repeatable or a comma list")
     p.add_argument("--out", metavar="PNG",
                    help="snapshots: the PNG to write (one field only)")
     p.add_argument("--times", metavar="T1,T2,...",

@@ -32,20 +32,34 @@ import numpy as np
 
 from .io.atomic import atomic_path
 from .io.plots import save_figure
-from .io import list_frames, read_frame
+from .io import read_frame
+from .io.frames import frames_of_run
 from .io.history import read_history_csv
 
 __all__ = ["compression_curve", "ensemble_report"]
 
 
-def _specimen(run_dir: Path, wall: str) -> tuple[float, float, np.ndarray]:
-    """Height H [m], cross-section A [m^2, m in 2D] and the wall normal (3,)."""
+class UnknownWall(ValueError):
+    """The wall named is not a [[wall]] of the run: a mistake in the request,
+    not in one sample, so :func:`ensemble_report` does not skip it."""
+
+
+def _specimen(run_dir: Path, wall: str, moves: bool = True
+              ) -> tuple[float, float, np.ndarray]:
+    """Height H [m], cross-section A [m^2, m in 2D] and the wall normal (3,);
+    ``moves``: whether the history has the wall's displacement."""
     with open(run_dir / "deck.resolved.toml", "rb") as f:
         deck = tomllib.load(f)
     walls = {w["name"]: w for w in deck.get("wall", [])}
     if wall not in walls:
-        raise ValueError(f"{run_dir}: no [[wall]] named {wall!r} (walls: "
-                         f"{', '.join(walls) or 'none'})")
+        fix = (f"name the moving platen: one of {', '.join(walls)}" if walls else
+               "give run directories of a deck whose platens are [[wall]]s")
+        raise UnknownWall(f"{run_dir}: no [[wall]] named {wall!r} (walls: "
+                          f"{', '.join(walls) or 'none'}). Fix: {fix}")
+    if not moves:
+        raise ValueError(f"{run_dir}: history has no 'd_wall_{wall}': wall {wall!r} does "
+                         "not move. Fix: name the moving platen (a [[wall]] with a "
+                         "velocity)")
     normal = np.asarray(walls[wall]["normal"], float)
     normal = np.pad(normal, (0, 3 - normal.size)) / np.linalg.norm(normal)
     dim = int(deck["run"]["dimension"])
@@ -54,9 +68,7 @@ def _specimen(run_dir: Path, wall: str) -> tuple[float, float, np.ndarray]:
     if any(float(b["dx"]) != dx for b in bodies):
         raise ValueError(f"{run_dir}: bodies with different dx; the specimen must be "
                          "one lattice")
-    frames = list_frames(run_dir)
-    if not frames:
-        raise FileNotFoundError(f"no frames in {run_dir / 'frames'}")
+    frames = frames_of_run(run_dir)
     x = np.asarray(read_frame(frames[0])[2]["position"], float)
     s = x @ normal
     height = float(s.max() - s.min()) + dx
@@ -73,11 +85,8 @@ def compression_curve(run_dir, wall: str) -> dict:
     """
     run_dir = Path(run_dir)
     h = read_history_csv(run_dir / "history.csv")
-    height, area, _ = _specimen(run_dir, wall)
     key_f, key_d = f"F_wall_{wall}", f"d_wall_{wall}"
-    if key_d not in h:
-        raise ValueError(f"{run_dir}: history has no {key_d!r}; give the wall a "
-                         "velocity (a moving platen)")
+    height, area, _ = _specimen(run_dir, wall, moves=key_d in h)
     # d_wall is the displacement along the wall normal, i.e. into the specimen
     strain = h[key_d] / height
     stress = h[key_f] / area
@@ -100,7 +109,8 @@ def ensemble_report(sample_dirs, wall: str, out, homogeneous=None) -> dict:
     ----------
     sample_dirs : run directories (e.g. ``OUT/sample_*`` of ``sphdyn ensemble``);
         runs without history are skipped and counted.
-    wall : name of the moving platen.
+    wall : name of the moving platen (a ValueError naming the run's walls if
+        it has none of that name).
     out : directory for ``ucs_samples.csv`` (peak per sample),
         ``ucs_statistics.json`` (mean, std, coefficient of variation of peak
         stress and strain at peak) and ``ucs_curves.png``.
@@ -110,19 +120,33 @@ def ensemble_report(sample_dirs, wall: str, out, homogeneous=None) -> dict:
     Returns
     -------
     dict with the statistics (as written to the JSON file).
+
+    Raises
+    ------
+    ValueError
+        If a run has no wall ``wall``, or no directory gives a curve.
     """
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    rows, curves, skipped = [], [], 0
-    for d in sorted(Path(s) for s in sample_dirs):
+    rows, curves, skipped, reasons = [], [], 0, []
+    dirs = sorted(Path(s) for s in sample_dirs)
+    for d in dirs:
         try:
             c = compression_curve(d, wall)
-        except (FileNotFoundError, ValueError):
+        except UnknownWall:
+            raise
+        except (FileNotFoundError, ValueError) as exc:
             skipped += 1
+            reasons.append(str(exc))
             continue
         curves.append(c)
         rows.append({"sample": d.name, "peak_stress_Pa": c["peak_stress"],
                      "strain_at_peak": c["strain_at_peak"]})
+    if not curves:
+        raise ValueError(f"none of the {len(dirs)} directories gives a curve; the first: "
+                         f"{reasons[0] if reasons else 'none given'}. Fix: give run "
+                         "directories of compression runs (with deck.resolved.toml, "
+                         "history.csv and frames)")
+    out.mkdir(parents=True, exist_ok=True)
     peaks = np.array([r["peak_stress_Pa"] for r in rows])
     strains = np.array([r["strain_at_peak"] for r in rows])
     stats = {"peak_stress": _stats(peaks), "strain_at_peak": _stats(strains),

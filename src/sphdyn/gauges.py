@@ -99,7 +99,9 @@ def _candidates(deck, parts, spec):
                 out.append((pk, np.arange(q.n)))
         elif spec.body is not None:
             if part.kind == "sph":
-                k = [b.name for b in deck.body].index(spec.body)
+                from .model import particle_body_names
+
+                k = particle_body_names(deck).index(spec.body)
                 out.append((pk, np.flatnonzero(q.body == k)))
         else:
             out.append((pk, np.arange(q.n)))

@@ -169,6 +169,17 @@ def _convert(spec, mesh: MeshData, mat: np.ndarray, where: str, dim: int):
     return remaining, mat[~mask], converted
 
 
+def converted_count(spec, k: int, dim: int) -> int:
+    """Particles the [mesh.convert] of the [[mesh]] ``spec`` (table ``k``)
+    makes: one per converted element and, with the hybrid coupling, one per
+    integration point of the transition layer (as :func:`build_meshes`
+    makes them; the same DeckErrors)."""
+    where = f"mesh[{k}] '{spec.name}'"
+    mesh = _read(spec, where, dim)
+    _, _, conv = _convert(spec, mesh, np.zeros(mesh.n_elements, np.int32), where, dim)
+    return conv.x.shape[0] + (conv.hybrid.x.shape[0] if conv.hybrid is not None else 0)
+
+
 def build_meshes(deck) -> list[MeshModel]:
     """Every [[mesh]] of a validated deck, read, checked and converted.
 

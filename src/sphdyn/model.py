@@ -23,7 +23,8 @@ from .interactions.wall import STIFFNESS, WallSpec
 from .deck import DeckError
 from .deck.errors import format_problem
 from .detonation import light_explosives
-from .preflight import checked_lattices, history_models, support_radius
+from .preflight import (check_meshes_in_domain, checked_lattices, history_models,
+                        support_radius)
 from .materials import MaterialGroup, get_model, history_layout
 from .materials.uniaxial import UNIAXIAL, uniaxial_params
 from .mesh_model import MeshModel, build_meshes, mesh_node_set, pressure_faces
@@ -194,12 +195,14 @@ def build_model(deck) -> Model:
 
     Raises :class:`~sphdyn.deck.DeckError` before making any particle if the
     model would exceed ``run.memory_limit``, and before anything else if
-    bodies overlap, start through a wall or are smaller than their dx
-    (:mod:`sphdyn.preflight`).
+    bodies overlap, start through a wall or outside the [domain] box or are
+    smaller than their dx, and before making parts if a mesh lies outside
+    the box (:mod:`sphdyn.preflight`).
     """
     dim = deck.run.dimension
     _, lattices = checked_lattices(deck)
     meshes = build_meshes(deck)
+    check_meshes_in_domain(deck, meshes)
     mats = {m.name: m for m in deck.material}
     mat_index = {m.name: k for k, m in enumerate(deck.material)}
     models = {m.name: get_model(m.model) for m in deck.material}
@@ -248,19 +251,18 @@ def build_model(deck) -> Model:
         p.h0[:] = p.h
         p.body[:] = b
         parts.append(p)
-    body_names = [b.name for b in deck.body]
+    body_names = particle_body_names(deck)
     for mm in meshes:
         if mm.converted is not None:
-            parts.append(_converted_particles(deck, mm, len(body_names), density_of, n_hist))
+            parts.append(_converted_particles(deck, mm, body_names.index(mm.name),
+                                              density_of, n_hist))
             phase_parts.append(np.full(parts[-1].n, -1, np.int8))
-            body_names.append(_converted_name(mm, body_names))
     n_bodies = sum(p.n for p in parts)  # the particles of bodies and converted meshes
     for mm in sublayer_meshes(meshes):  # bars' nodes as particles (thesis 6.1)
-        parts.append(_sublayer_particles(deck, mm, len(body_names), n_hist))
+        parts.append(_sublayer_particles(deck, mm, body_names.index(f"{mm.name}_sublayer"),
+                                         n_hist))
         phase_parts.append(np.full(parts[-1].n, -1, np.int8))
-        body_names.append(_extra_name(mm, body_names, "sublayer"))
-    for mm in debris_meshes(meshes):  # bodies that start empty: eroded elements
-        body_names.append(_extra_name(mm, body_names, "debris"))
+    # the debris bodies (eroded elements) start empty
     particles = (Particles.concatenate(parts) if parts
                  else Particles.allocate(0, dim, n_hist))
     particles.hist_names = hist_names  # the joined parts' columns (history_layout)
@@ -298,7 +300,7 @@ def build_model(deck) -> Model:
             particles.sig[g.idx] = -p0 * np.eye(3)
     light_explosives(deck, particles, groups)
 
-    body_index = {b.name: k for k, b in enumerate(deck.body)}
+    body_index = {name: k for k, name in enumerate(body_names)}
     sets: dict[str, np.ndarray] = {}
     mesh_sets: dict[str, tuple[str, np.ndarray]] = {}
     for k, s in enumerate(deck.set):
@@ -362,15 +364,34 @@ def sublayer_meshes(meshes) -> list[MeshModel]:
     return [mm for mm in meshes if mm.spec.sublayer is not None]
 
 
-def _extra_name(mm: MeshModel, taken: list[str], what: str) -> str:
-    """The body name of a mesh's ``what`` particles: ``<mesh>_<what>``."""
-    name = f"{mm.name}_{what}"
-    if name in taken:
-        key = "erosion" if what == "debris" else what
-        raise DeckError([format_problem(
-            f"mesh[{mm.index}] '{mm.name}'.{key}", f"its particles form a body named "
-            f"'{name}', and a [[body]] has that name", "rename the mesh or the body")])
-    return name
+def mesh_bodies(deck) -> list[tuple[int, str, str]]:
+    """The particle bodies made from meshes, in body-index order after the
+    [[body]]s: ``(mesh index, deck key, body name)`` of every mesh's
+    converted particles (``convert``, named as the mesh), then of every
+    bar's sublayer particles (``sublayer``, ``<mesh>_sublayer``), then of
+    the debris of elements eroding into particles (``erosion``,
+    ``<mesh>_debris``)."""
+    mesh = list(enumerate(deck.mesh))
+    return ([(k, "convert", m.name) for k, m in mesh if m.convert is not None]
+            + [(k, "sublayer", f"{m.name}_sublayer") for k, m in mesh
+               if m.sublayer is not None]
+            + [(k, "erosion", f"{m.name}_debris") for k, m in mesh
+               if m.erosion is not None and m.erosion.to == "particles"])
+
+
+def particle_body_names(deck) -> list[str]:
+    """Names of the particle bodies by body index (``Particles.body``): the
+    [[body]]s, then :func:`mesh_bodies`. A mesh body whose name a [[body]]
+    has already is a DeckError."""
+    names = [b.name for b in deck.body]
+    for k, key, name in mesh_bodies(deck):
+        if name in names:
+            mesh = deck.mesh[k].name
+            raise DeckError([format_problem(
+                f"mesh[{k}] '{mesh}'.{key}", f"its particles form a body named "
+                f"'{name}', and a [[body]] has that name", "rename the mesh or the body")])
+        names.append(name)
+    return names
 
 
 def _sublayer_particles(deck, mm: MeshModel, b: int, n_hist: int) -> Particles:
@@ -477,7 +498,14 @@ def _sublayer_groups(deck, meshes, particles: Particles, body_names: list[str],
                     f"\"{stiffness}\" scales the bar material's stresses, which model "
                     f"'{model.name}' does not allow", "use a bar material of model "
                     f"{' or '.join(SPLIT_MODELS)}, or stiffness = \"material\" or \"none\"")])
-            values = mat.stress_scaled(float(particles.rho0[rows[0]]) / mat.density)
+            ratio = float(particles.rho0[rows[0]]) / mat.density
+            values = mat.stress_scaled(ratio)
+            if not all(np.isfinite(v) for v in values.values() if isinstance(v, float)):
+                raise DeckError([format_problem(
+                    f"material[{k}] '{mat.name}'.density",
+                    f"\"{stiffness}\" scales the bar's stresses by the concrete's "
+                    f"density over the bar's, {ratio:.3g}, and they overflow",
+                    "give the bar material its density (steel: 7850 kg/m^3)")])
             packed = model.pack(values)
             if stiffness == "axial":
                 model, packed = UNIAXIAL, uniaxial_params(model.name, packed)
@@ -485,15 +513,6 @@ def _sublayer_groups(deck, meshes, particles: Particles, body_names: list[str],
                                         rows.astype(np.int64), k,
                                         first[model.history_names]))
     return groups
-
-
-def _converted_name(mm: MeshModel, taken: list[str]) -> str:
-    """The body name of a mesh's converted particles: the mesh's name."""
-    if mm.name in taken:
-        raise DeckError([format_problem(
-            f"mesh[{mm.index}] '{mm.name}'.convert", f"its particles form a body named "
-            f"'{mm.name}', and a [[body]] has that name", "rename the mesh or the body")])
-    return mm.name
 
 
 def _converted_particles(deck, mm: MeshModel, b: int, density_of, n_hist: int) -> Particles:

@@ -1,13 +1,18 @@
 """Checks of a deck's model before it is built or run: its size and its placement.
 
 * :func:`estimate_size` counts the particles of every body from the closed-form
-  volume of its geometry over ``dx**dim`` and the neighbour-list pairs from the
+  volume of its geometry over ``dx**dim`` (and those a mesh's elements make),
+  the elements of generated meshes and the neighbour-list pairs from the
   kernel support, before a single particle is made; :func:`check_size` refuses
-  a model over ``run.memory_limit`` (default: half of this machine's memory),
-  so a mistyped ``dx`` cannot hang ``sphdyn check`` and end in a MemoryError.
+  a support holding no neighbour or more than :data:`MAX_NEIGHBOURS`, and a
+  model over ``run.memory_limit`` (default: half of this machine's memory),
+  naming the key behind it, so a mistyped ``dx``, ``divisions`` or
+  ``h_factor`` cannot hang ``sphdyn check`` and end in a MemoryError. Nothing
+  here allocates more than the limit to find that out.
 * :func:`placement_problems` finds, on the built lattices, bodies that
-  overlap, bodies that start through a wall and bodies of a single particle:
-  decks that validate but would die mid-run.
+  overlap, bodies that start through a wall or outside the [domain] box and
+  bodies of a single particle (:func:`check_meshes_in_domain`: meshes outside
+  the box): decks that validate but would die mid-run.
 
 Both raise :class:`~sphdyn.deck.DeckError` (exit status 2 on the command line),
 one ``<path>: <what>. Fix: <what to write>`` line per problem.
@@ -57,13 +62,27 @@ def ball_volume(radius: float, dim: int) -> float:
     return math.pi * _power(radius, 2) if dim == 2 else 4.0 / 3.0 * math.pi * _power(radius, 3)
 
 
-def lattice_neighbours(radius: float, dim: int) -> int:
+#: Largest radius [lattice spacings] whose points :func:`lattice_neighbours`
+#: counts one by one: (2 * 40 + 1)^3 = 531,441 points, 4 MB; beyond it the
+#: ball's volume (the count's relative error falls as 1 / radius).
+ENUMERATED_RADIUS = 40.0
+
+
+def lattice_neighbours(radius: float, dim: int) -> float:
     """Points of the unit cubic (square, 1D) lattice within ``radius`` of a
     lattice point, itself not counted: ``#{p in Z^dim, 0 < |p| < radius}``
     (strictly inside, as the neighbour lists exclude ties). The list of an
     interior particle of a regular lattice of spacing dx at the build, for
     a Verlet radius of ``radius`` dx; its ball's volume differs by the
-    points near the sphere (80 against 77 for the disc's 2.64 dx)."""
+    points near the sphere (80 against 77 for the disc's 2.64 dx).
+
+    Counted point by point up to :data:`ENUMERATED_RADIUS`; beyond it (an
+    absurd smoothing length) the ball's volume minus one, so that the count
+    allocates nothing that grows with ``radius`` (inf when it overflows).
+    """
+    if not radius <= ENUMERATED_RADIUS:  # nan and inf too
+        n = ball_volume(radius, dim) - 1.0
+        return n if math.isfinite(n) else math.inf
     k = int(math.ceil(radius))
     axis = np.arange(-k, k + 1, dtype=float) ** 2
     r2 = axis
@@ -178,32 +197,51 @@ def show_count(n: float) -> str:
 class SizeEstimate:
     """Particles and memory of a deck's model, estimated from its geometry."""
 
-    #: body name -> estimated particle count
+    #: body name -> estimated particle count (the particles of a
+    #: [mesh.convert] under the mesh's name)
     bodies: dict
+    #: particles at the start, and those eroding elements may add later
     particles: float
     pairs_per_particle: float
     bytes_particles: float
     bytes_neighbours: float
-    #: mesh name -> element count of the generated meshes (files: not counted)
+    #: mesh name -> element count of the generated meshes (files: not counted
+    #: before the build)
     meshes: dict = None
+    #: debris body name -> the most particles its eroding mesh can make
+    debris: dict = None
+    #: deck path -> bytes of other arrays made from the deck's numbers
+    #: (a photo's pixels)
+    other: dict = None
 
     @property
     def bytes_meshes(self) -> float:
         return ELEMENT_BYTES * float(sum((self.meshes or {}).values()))
 
     @property
+    def bytes_other(self) -> float:
+        return float(sum((self.other or {}).values()))
+
+    @property
     def bytes(self) -> float:
         """Estimated memory of the model [bytes]."""
-        return self.bytes_particles + self.bytes_neighbours + self.bytes_meshes
+        return (self.bytes_particles + self.bytes_neighbours + self.bytes_meshes
+                + self.bytes_other)
 
     def summary(self) -> str:
         """One line: particles, neighbours and memory."""
         meshes = (f" + {show_count(sum(self.meshes.values()))} elements "
                   f"{show_bytes(self.bytes_meshes)}" if self.meshes else "")
-        return (f"about {show_count(self.particles)} particles, {self.pairs_per_particle:.0f} "
-                f"neighbours each, {show_bytes(self.bytes)} (particles "
+        other = (f" + {', '.join(self.other)} {show_bytes(self.bytes_other)}"
+                 if self.other else "")
+        later = sum((self.debris or {}).values())
+        start = self.particles - later
+        born = f" (+ up to {show_count(later)} from eroding elements)" if later else ""
+        return (f"about {show_count(start)} particles{born}, "
+                f"{show_count(self.pairs_per_particle)} neighbours each, "
+                f"{show_bytes(self.bytes)} (particles "
                 f"{show_bytes(self.bytes_particles)} + neighbour lists "
-                f"{show_bytes(self.bytes_neighbours)}{meshes})")
+                f"{show_bytes(self.bytes_neighbours)}{meshes}{other})")
 
 
 def history_models(deck) -> list:
@@ -233,51 +271,204 @@ def history_width(deck) -> int:
     return max(width, 1)
 
 
-def estimate_size(deck) -> SizeEstimate:
-    """Estimate the model of a validated deck without building it.
+#: Bytes per pixel of a section photo while it is read and segmented (grey
+#: levels, mask, labels and distance maps in float64 and int64), rounded up.
+PHOTO_PIXEL_BYTES = 48
+
+
+def verlet_radius(sph) -> float:
+    """The Verlet radius of the deck's [sph] section ``sph`` in particle
+    spacings: ``q_max * support_scale * h_factor * (1 + skin_factor)``."""
+    return support_radius(sph) * sph.h_factor * (1.0 + sph.neighbours.skin_factor)
+
+
+def estimate_size(deck, model=None) -> SizeEstimate:
+    """Estimate the model of a validated deck; without ``model``, before
+    building it, and allocating nothing that grows with the deck's numbers
+    beyond its memory limit.
 
     Particles per body: the closed-form volume of its geometry over
-    ``dx**dim``. Neighbours per particle: the lattice points in the Verlet
-    radius ``q_max * support_scale * h_factor * (1 + skin_factor) * dx``
-    (:func:`lattice_neighbours`).
-    Memory: :data:`PARTICLE_BYTES` plus 8 bytes per history variable per
-    particle and :data:`PAIR_BYTES` per neighbour pair.
+    ``dx**dim``; the particles of a generated mesh's [mesh.convert] (one per
+    converted element, and the hybrid layer's points) counted on the
+    generated mesh when its elements fit in the memory limit; the debris of
+    eroding elements at most ``particles_per_element`` per element. With a
+    built ``model`` (:func:`sphdyn.model.build_model`) the counts are its
+    own. Neighbours per particle: the lattice points in the Verlet radius
+    (:func:`verlet_radius` dx, :func:`lattice_neighbours`), at most the
+    other particles. Memory: :data:`PARTICLE_BYTES` plus 8 bytes per history
+    variable per particle, :data:`PAIR_BYTES` per neighbour pair,
+    :data:`ELEMENT_BYTES` per element, :data:`PHOTO_PIXEL_BYTES` per pixel
+    of a section photo.
     """
     dim = deck.run.dimension
-    sph = deck.sph
-    bodies = {b.name: lattice_count(shape_volume(b.geometry, dim), b.dx, dim)
-              for b in deck.body}
-    n = float(sum(bodies.values()))
-    radius = support_radius(sph) * sph.h_factor * (1.0 + sph.neighbours.skin_factor)
-    pairs = float(lattice_neighbours(radius, dim))
+    if model is not None:
+        counts = np.bincount(model.particles.body, minlength=len(model.body_names))
+        bodies = {name: float(c) for name, c in zip(model.body_names, counts)}
+        meshes = {mm.name: float(mm.cells.shape[0]) for mm in model.meshes}
+    else:
+        bodies = {b.name: lattice_count(shape_volume(b.geometry, dim), b.dx, dim)
+                  for b in deck.body}
+        meshes = {m.name: _element_count(m, dim) for m in deck.mesh if m.file is None}
+        if ELEMENT_BYTES * sum(meshes.values()) <= memory_limit(deck)[0]:
+            bodies.update(_converted_counts(deck))
+    debris = {f"{m.name}_debris": meshes.get(m.name, 0.0) * m.erosion.particles_per_element
+              for m in deck.mesh if m.erosion is not None and m.erosion.to == "particles"}
+    for name in debris:
+        bodies.pop(name, None)
+    n = float(sum(bodies.values())) + float(sum(debris.values()))
+    pairs = min(lattice_neighbours(verlet_radius(deck.sph), dim), max(n - 1.0, 0.0))
     per_particle = PARTICLE_BYTES + 8 * history_width(deck)
-    meshes = {m.name: _element_count(m, dim) for m in deck.mesh if m.file is None}
     return SizeEstimate(bodies, n, pairs, n * per_particle,
-                        n * pairs * PAIR_BYTES if n and pairs else 0.0, meshes)
+                        n * pairs * PAIR_BYTES if n and pairs else 0.0, meshes, debris,
+                        _photo_bytes(deck))
+
+
+def _converted_counts(deck) -> dict:
+    """mesh name -> particles of the [mesh.convert] of each generated mesh."""
+    from .mesh_model import converted_count
+
+    dim = deck.run.dimension
+    return {m.name: float(converted_count(m, k, dim)) for k, m in enumerate(deck.mesh)
+            if m.convert is not None and m.file is None}
+
+
+def _photo_bytes(deck) -> dict:
+    """``body[b].mesostructure.photo`` -> bytes of reading and segmenting it
+    (its pixel count from the file's header, nothing decoded)."""
+    out = {}
+    for b, body in enumerate(deck.body):
+        ms = body.mesostructure
+        if ms is None or ms.photo is None:
+            continue
+        try:
+            from PIL import Image
+
+            with Image.open(ms.photo) as im:
+                w, h = im.size
+        except Exception:  # noqa: BLE001 -- unreadable: the build names the file
+            continue
+        out[f"body[{b}].mesostructure.photo"] = PHOTO_PIXEL_BYTES * float(w) * float(h)
+    return out
 
 
 def _element_count(mesh, dim: int) -> float:
-    """Elements of a generated [[mesh]] (the prism's by its volume)."""
+    """Elements of a generated [[mesh]] (the prism's by its volume); inf
+    when the count overflows."""
     if mesh.block is not None:
-        return float(np.prod(mesh.block.divisions))
+        return math.prod(float(d) for d in mesh.block.divisions)
     if mesh.prism is not None:
         return lattice_count(prism_volume(mesh.prism, dim), mesh.prism.element_size, dim)
-    return float(mesh.line.count)
+    line = mesh.line
+    if line.divisions is not None:
+        per = float(line.divisions) * len(line.segments_ends)
+    else:
+        per = sum(max(1.0, math.dist(p, q) / line.element_length)
+                  for p, q in line.segments_ends)
+    n = float(line.repeat) * per
+    return n if math.isfinite(n) else math.inf
 
 
 def _mesh_source(mesh) -> str:
     """The deck key that sets a generated mesh's size."""
     if mesh.prism is not None:
         return "prism.element_size"
+    if mesh.file is not None:
+        return "file"
+    if mesh.line is not None and mesh.line.divisions is None:
+        return "line.element_length"
     return f"{'block' if mesh.block is not None else 'line'}.divisions"
 
 
+#: Neighbours per particle above which an estimate over the memory limit is
+#: blamed on the smoothing length rather than on the particle count: a list
+#: of a few hundred is the most any deck of the thesis uses (the 3D Verlet
+#: ball of 2.64 dx holds 80).
+TOO_MANY_NEIGHBOURS = 1000.0
+#: Neighbours per particle of a regular lattice's interior (the Verlet ball,
+#: :func:`lattice_neighbours`) above which a deck is refused whatever its
+#: memory: 125 times the 3D default's 80 (a support radius of about 13 dx in
+#: 3D, 56 dx in 2D, 5000 dx in 1D), which smooths a body over most of its
+#: size and makes each step cost as much as 125 ordinary ones. No deck of
+#: the thesis comes near it.
+MAX_NEIGHBOURS = 1e4
+
+
+def has_particles(deck) -> bool:
+    """Whether the model has SPH particles now or later: bodies, or meshes
+    converted, with a sublayer or eroding into particles."""
+    return bool(deck.body) or any(
+        m.convert is not None or m.sublayer is not None
+        or (m.erosion is not None and m.erosion.to == "particles") for m in deck.mesh)
+
+
+def _radius_field(sph, smallest: bool = False) -> tuple[str, float]:
+    """The [sph] key that stretches the Verlet radius most over its
+    default (``smallest``: shrinks it most), and its value."""
+    from .deck.sections.sph import Sph
+
+    default = Sph()
+    ratios = {"sph.h_factor": sph.h_factor / default.h_factor,
+              "sph.support_scale": sph.support_scale / default.support_scale,
+              "sph.neighbours.skin_factor": (1.0 + sph.neighbours.skin_factor)
+              / (1.0 + default.neighbours.skin_factor)}
+    key = (min if smallest else max)(ratios, key=lambda k: ratios[k])
+    return key, {"sph.h_factor": sph.h_factor, "sph.support_scale": sph.support_scale,
+                 "sph.neighbours.skin_factor": sph.neighbours.skin_factor}[key]
+
+
 def check_size(deck) -> SizeEstimate:
-    """Refuse a deck whose model would exceed its memory limit; return the estimate."""
+    """Refuse a deck whose model would exceed its memory limit (naming the
+    deck key that makes it large); return the estimate."""
+    dim = deck.run.dimension
+    radius = verlet_radius(deck.sph)
+    per = lattice_neighbours(radius, dim)
+    if has_particles(deck) and per == 0:
+        key, value = _radius_field(deck.sph, smallest=True)
+        raise DeckError([format_problem(
+            key, f"{key} = {value:g} gives a Verlet radius of {radius:.3g} particle "
+            "spacings: a particle has no neighbour on its lattice, so the particles "
+            "would not interact", "use h_factor 1.2-2 (h = h_factor dx) and "
+            "support_scale about 1 (a support of 2-3 spacings)")])
+    if has_particles(deck) and not per <= MAX_NEIGHBOURS:
+        key, value = _radius_field(deck.sph)
+        raise DeckError([format_problem(
+            key, f"{key} = {value:g} gives a Verlet radius of {radius:.3g} particle "
+            f"spacings, about {show_count(per)} neighbours per particle in {dim}D (more "
+            f"than {MAX_NEIGHBOURS:,.0f}: the kernel would smooth over the whole body)",
+            "use h_factor 1.2-2 (h = h_factor dx), support_scale about 1 and "
+            "skin_factor below 1 (a few dozen neighbours each)")])
     est = estimate_size(deck)
+    _refuse_over_limit(deck, est)
+    return est
+
+
+def _refuse_over_limit(deck, est: SizeEstimate) -> None:
+    """DeckError naming the key behind the largest share of an estimate over
+    the memory limit: a body's dx, a mesh's divisions, the smoothing length
+    (:data:`TOO_MANY_NEIGHBOURS`) or a photo."""
     limit, source = memory_limit(deck)
     if not est.bytes <= limit:  # nan (inf * 0) counts as too large
-        if est.meshes and est.bytes_meshes >= est.bytes_particles:
+        shares = {"particles": est.bytes_particles, "neighbours": est.bytes_neighbours,
+                  "meshes": est.bytes_meshes, "other": est.bytes_other}
+        top = max(shares, key=lambda k: shares[k] if not math.isnan(shares[k]) else math.inf)
+        if top == "neighbours" and not est.pairs_per_particle <= TOO_MANY_NEIGHBOURS:
+            key, value = _radius_field(deck.sph)
+            raise DeckError([format_problem(
+                key, f"{key} = {value:g} gives each particle about "
+                f"{show_count(est.pairs_per_particle)} neighbours (Verlet radius "
+                f"{verlet_radius(deck.sph):.3g} dx): the model needs {est.summary()}, "
+                f"over the memory limit of {show_bytes(limit)} ({source})",
+                "use h_factor 1.2-2 (h = h_factor dx), support_scale about 1 and "
+                "skin_factor below 1 (a few dozen neighbours each)")])
+        if top == "other":
+            key = max(est.other, key=lambda k: est.other[k])
+            raise DeckError([format_problem(
+                key, f"the photo needs {show_bytes(est.other[key])} to read and segment: "
+                f"the model needs {est.summary()}, over the memory limit of "
+                f"{show_bytes(limit)} ({source})",
+                "scale the photo down (and its pixel_size up by the same factor), or "
+                "raise run.memory_limit")])
+        if est.meshes and (top == "meshes" or not deck.body):
             k = max(range(len(deck.mesh)), key=lambda j: est.meshes.get(deck.mesh[j].name, 0))
             m = deck.mesh[k]
             raise DeckError([format_problem(
@@ -287,16 +478,30 @@ def check_size(deck) -> SizeEstimate:
                 f"{show_count(est.meshes[m.name])} elements",
                 "use fewer divisions, or raise run.memory_limit above "
                 f"{show_bytes(est.bytes)} if the machine has that memory")])
-        b = max(range(len(deck.body)), key=lambda k: est.bodies[deck.body[k].name])
-        big = deck.body[b]
+        sources = {**est.bodies, **(est.debris or {})}
+        name = max(sources, key=lambda k: sources[k]) if sources else None
+        names = [b.name for b in deck.body]
+        if name in names or not deck.mesh:
+            b = names.index(name) if name in names else 0
+            big = deck.body[b]
+            raise DeckError([format_problem(
+                f"body[{b}].dx",
+                f"the model needs {est.summary()}, over the memory limit of "
+                f"{show_bytes(limit)} ({source}); body '{big.name}' alone has about "
+                f"{show_count(est.bodies.get(big.name, 0.0))} particles at dx = "
+                f"{big.dx:g} m",
+                f"make dx larger or the bodies smaller, or raise run.memory_limit above "
+                f"{show_bytes(est.bytes)} if the machine has that memory")])
+        k = next((j for j, m in enumerate(deck.mesh)
+                  if name in (m.name, f"{m.name}_debris", f"{m.name}_sublayer")), 0)
+        m = deck.mesh[k]
         raise DeckError([format_problem(
-            f"body[{b}].dx",
+            f"mesh[{k}].{_mesh_source(m)}",
             f"the model needs {est.summary()}, over the memory limit of "
-            f"{show_bytes(limit)} ({source}); body '{big.name}' alone has about "
-            f"{show_count(est.bodies[big.name])} particles at dx = {big.dx:g} m",
-            f"make dx larger or the bodies smaller, or raise run.memory_limit above "
+            f"{show_bytes(limit)} ({source}); mesh '{m.name}' makes about "
+            f"{show_count(sources.get(name, 0.0))} particles",
+            "use fewer or larger elements, or raise run.memory_limit above "
             f"{show_bytes(est.bytes)} if the machine has that memory")])
-    return est
 
 
 def _count_and_depth(depth: np.ndarray, tol: float) -> tuple[int, float]:
@@ -310,7 +515,8 @@ def placement_problems(deck, positions: list[np.ndarray]) -> list[str]:
 
     A body of fewer than two particles (smaller than dx); a body whose
     particles lie inside another body's geometry (overlap); a body with
-    particles behind a wall's plane (starting through the wall).
+    particles outside the [domain] box; a body with particles behind a
+    wall's plane (starting through the wall).
     """
     dim = deck.run.dimension
     problems = []
@@ -340,6 +546,10 @@ def placement_problems(deck, positions: list[np.ndarray]) -> list[str]:
                     "deep)",
                     f"move '{body_b.name}' or '{body_a.name}' apart so that their "
                     "geometries at most touch"))
+    for b, (body, x) in enumerate(zip(deck.body, positions)):
+        line = outside_problem(deck, f"body[{b}].geometry", f"body '{body.name}'", x)
+        if line:
+            problems.append(line)
     for w, wall in enumerate(deck.wall):
         normal = np.asarray(wall.normal) / np.linalg.norm(wall.normal)
         for body, x in zip(deck.body, positions):
@@ -354,6 +564,62 @@ def placement_problems(deck, positions: list[np.ndarray]) -> list[str]:
                     f"move the body to the side wall '{wall.name}''s normal points "
                     "to, or move the wall's point (or flip its normal)"))
     return problems
+
+
+def domain_box(deck) -> tuple[np.ndarray, np.ndarray] | None:
+    """The deck's [domain] box ``(lo, hi)`` (3,) each, -inf/inf for an absent
+    corner and for the axes beyond the dimension; None without lo and hi."""
+    d, dim = deck.domain, deck.run.dimension
+    if d.lo is None and d.hi is None:
+        return None
+    lo = np.full(3, -np.inf) if d.lo is None else np.asarray(d.lo, float).copy()
+    hi = np.full(3, np.inf) if d.hi is None else np.asarray(d.hi, float).copy()
+    lo[dim:], hi[dim:] = -np.inf, np.inf
+    return lo, hi
+
+
+def _box_text(lo: np.ndarray, hi: np.ndarray, dim: int) -> str:
+    return (f"[{', '.join(f'{v:g}' for v in lo[:dim])}] .. "
+            f"[{', '.join(f'{v:g}' for v in hi[:dim])}] m")
+
+
+def outside_problem(deck, where: str, what: str, x: np.ndarray,
+                    items: str = "particles") -> str | None:
+    """The problem line of items ``x`` (n, 3) [m] outside the [domain] box
+    (outside as the run's guard sees it: below lo or above hi on an axis),
+    or None. ``where`` is the deck path named, ``what`` the thing
+    (``"body 'disc'"``), ``items`` what its points are."""
+    box = domain_box(deck)
+    if box is None or not x.size:
+        return None
+    lo, hi = box
+    depth = np.max(np.maximum(lo - x, x - hi), axis=1)  # > 0 outside
+    out = depth > 0.0
+    if not out.any():
+        return None
+    dim = deck.run.dimension
+    how = "wholly" if out.all() else "partly"
+    return format_problem(
+        where, f"{what} lies {how} outside the domain box {_box_text(lo, hi, dim)} "
+        f"([domain] lo, hi): {int(out.sum())} of its {x.shape[0]} {items}, up to "
+        f"{float(depth.max()):.3g} m outside, would stop the run at its first step",
+        "move it into the box, or enlarge [domain] lo/hi (or remove them: the box then "
+        "follows the model, widened by [domain] margin)")
+
+
+def check_meshes_in_domain(deck, meshes) -> None:
+    """DeckError for meshes (:class:`~sphdyn.mesh_model.MeshModel`) whose
+    nodes or converted particles lie outside the [domain] box."""
+    problems = []
+    for mm in meshes:
+        x = mm.points if mm.converted is None else np.concatenate(
+            [mm.points, mm.converted.x])
+        line = outside_problem(deck, f"mesh[{mm.index}] '{mm.name}'", f"mesh '{mm.name}'", x,
+                               "nodes" if mm.converted is None else "nodes and particles")
+        if line:
+            problems.append(line)
+    if problems:
+        raise DeckError(problems)
 
 
 def check_placement(deck, positions: list[np.ndarray]) -> None:

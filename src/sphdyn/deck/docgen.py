@@ -141,6 +141,15 @@ def _default(info: Any) -> str:
     return f"`{_toml(info.default)}`"
 
 
+def plural(kind: str) -> str:
+    """The plural of a type name: ``quantities``, ``lists of numbers``,
+    ``vectors of quantity`` (the head noun takes the ending)."""
+    head, sep, tail = kind.partition(" of ")
+    if sep:
+        return f"{plural(head)} of {tail}"
+    return kind[:-1] + "ies" if kind.endswith("y") else kind + "s"
+
+
 def describe(annotation: Any) -> tuple[str, str, str]:
     """Return the (type, unit, allowed) columns for a field annotation."""
     meta = metadata(annotation)
@@ -154,7 +163,8 @@ def describe(annotation: Any) -> tuple[str, str, str]:
         elif isinstance(f, Bounds):
             allowed.append(f.interval())
         elif isinstance(f, Reference):
-            allowed.append(f"name of a [[{f.section}]]")
+            allowed.append(f"name of a [[{f.section}]]" + (
+                " or of a mesh's particles" if f.mesh_bodies else ""))
         elif isinstance(f, UniqueName):
             allowed.append("unique name")
         elif isinstance(f, NonEmpty):
@@ -184,7 +194,7 @@ def describe(annotation: Any) -> tuple[str, str, str]:
                 issubclass(strip_optional(element), BaseModel):
             kind = "tables"
         else:
-            kind = f"list of {describe(element)[0]}s"
+            kind = f"list of {plural(describe(element)[0])}"
             allowed += [a for a in describe(element)[2].split("; ") if a]
     elif not kind:
         kind = {float: "quantity" if unit else "number", int: "integer",

@@ -6,6 +6,7 @@ path of the offending key (union tags dropped, list entries ``[i]``) and
 labelled with the name of the enclosing table.
 """
 
+import re
 from dataclasses import dataclass
 from typing import Any, Literal, Optional, get_args, get_origin
 
@@ -62,6 +63,34 @@ def locate(loc: tuple, raw: Any, root: type[BaseModel]) -> Where:
     return where
 
 
+def _param_example(where: Where) -> str:
+    """``--param key=value`` a user could write for the key at ``where``
+    (``sphdyn material-test``): SI numbers, bare words."""
+    key, ann = where.key, where.annotation
+    core = strip_optional(ann)
+    value = "<value>"
+    if get_origin(core) is Literal:
+        value = str(get_args(core)[0])
+    elif core is bool:
+        value = "true"
+    for meta in metadata(ann):
+        func = getattr(meta, "func", None)
+        if isinstance(func, Quantity):
+            value = f"{func.dim.si_example:g}"
+    return f"--param {key}={value}"
+
+
+#: ``key = "value"`` or ``key = value`` in a deck-syntax fix
+_ASSIGNMENT = re.compile(r"\b([A-Za-z_]\w*) = (?:\"([^\"]*)\"|([\w.+-]+))")
+
+
+def as_params(fix: str) -> str:
+    """A fix written in deck syntax (``eos = "ideal_gas"``) in the syntax of
+    ``sphdyn material-test`` (``--param eos=ideal_gas``)."""
+    return _ASSIGNMENT.sub(lambda m: f"--param {m[1]}={m[2] if m[2] is not None else m[3]}",
+                           fix)
+
+
 def _example(where: Where) -> str:
     """A TOML snippet a user could write for the key at ``where``."""
     key, ann = where.key, where.annotation
@@ -100,8 +129,17 @@ _TYPE_NAMES = {
 }
 
 
-def _explain_one(err: dict, where: Where) -> tuple[str, str]:
-    """Return ``(what, fix)`` for one pydantic error."""
+def _explain_one(err: dict, where: Where, params: tuple = ()) -> tuple[str, str]:
+    """Return ``(what, fix)`` for one pydantic error. With ``params`` (the
+    keys a command line may set), fixes are written as ``--param key=value``."""
+    if params:
+        what, fix = _explain_one(err, where)
+        if err["type"] == "missing":
+            return what, f"add {_param_example(where)}"
+        if err["type"] == "extra_forbidden":
+            return what, suggest(str(where.key), list(params),
+                                 f"remove it; the parameters: {', '.join(params)}")
+        return what, as_params(fix)
     kind, ctx, value = err["type"], err.get("ctx") or {}, err.get("input")
     if kind == "deck":
         return ctx["what"], ctx["fix"]
@@ -141,7 +179,8 @@ def format_problem(path: str, what: str, fix: str) -> str:
     return f"{path or 'deck'}: {what}. Fix: {fix}"
 
 
-def explain(exc: ValidationError, raw: Any, root: type[BaseModel]) -> list[str]:
+def explain(exc: ValidationError, raw: Any, root: type[BaseModel],
+            params: tuple = ()) -> list[str]:
     """Turn a ``ValidationError`` from validating ``raw`` into problem lines.
 
     Parameters
@@ -152,6 +191,9 @@ def explain(exc: ValidationError, raw: Any, root: type[BaseModel]) -> list[str]:
         The data that was validated (used to find names for the labels).
     root : type of BaseModel
         The model that was validated.
+    params : tuple of str, optional
+        The keys a command line sets with ``--param key=value`` (``sphdyn
+        material-test``): fixes are then written in that syntax.
 
     Returns
     -------
@@ -161,7 +203,7 @@ def explain(exc: ValidationError, raw: Any, root: type[BaseModel]) -> list[str]:
     lines = []
     for err in exc.errors(include_url=False):
         where = locate(err["loc"], raw, root)
-        what, fix = _explain_one(err, where)
+        what, fix = _explain_one(err, where, params)
         if where.label and where.key != "name":
             what += f" in {where.label}"
         line = format_problem(where.path, what, fix)

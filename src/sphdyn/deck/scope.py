@@ -43,7 +43,30 @@ def scope_of(data: Any) -> Scope:
         items = items if isinstance(items, (list, tuple)) else []
         names[section] = [n for n in (get_key(t, "name") for t in items)
                           if isinstance(n, str)]
+    names[MESH_BODY] = mesh_body_names(get_key(data, "mesh"))
     return Scope(None if dim is None else int(dim), names)
+
+
+#: The key of :attr:`Scope.names` listing the particle bodies made from
+#: meshes, which a reference to a body may name besides the [[body]]s.
+MESH_BODY = "mesh body"
+
+
+def mesh_body_names(meshes: Any) -> list[str]:
+    """Names of the particle bodies that [[mesh]] tables make and that exist
+    from the start: the converted particles of a ``[mesh.convert]`` (named as
+    the mesh) and a bar's ``[mesh.sublayer]`` particles (``<mesh>_sublayer``).
+    (The ``<mesh>_debris`` of erosion starts empty, so nothing can select it.)"""
+    out = []
+    for table in meshes if isinstance(meshes, (list, tuple)) else []:
+        name = get_key(table, "name")
+        if not isinstance(name, str):
+            continue
+        if get_key(table, "convert") is not None:
+            out.append(name)
+        if get_key(table, "sublayer") is not None:
+            out.append(f"{name}_sublayer")
+    return out
 
 
 def dimension() -> Optional[int]:

@@ -17,7 +17,7 @@ from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict,
                       Strict, ValidationInfo)
 
 from .messages import problem, show, show_number, show_vector, suggest
-from .scope import SCOPE, dimension
+from .scope import MESH_BODY, SCOPE, dimension
 from .units import (ACCELERATION, LENGTH, PRESSURE, TIME, VELOCITY, Dimension,
                     QuantityError, to_bytes, to_si)
 
@@ -91,12 +91,18 @@ class Reference:
     """After-validator: the value must be the name of a ``[[section]]``."""
 
     section: str
+    #: also a particle body made from a mesh (``body`` references:
+    #: :func:`~sphdyn.deck.scope.mesh_body_names`)
+    mesh_bodies: bool = False
 
     def __call__(self, name: str) -> str:
         scope = SCOPE.get()
         if scope is None:
             return name
-        known = list(dict.fromkeys(scope.names.get(self.section, [])))
+        known = scope.names.get(self.section, [])
+        if self.mesh_bodies:
+            known = known + scope.names.get(MESH_BODY, [])
+        known = list(dict.fromkeys(known))
         if name in known:
             return name
         if not known:
@@ -246,9 +252,10 @@ def name_of(section: str) -> Any:
     return Annotated[str, Strict(), AfterValidator(UniqueName(section))]
 
 
-def reference_to(section: str) -> Any:
-    """The name of an existing ``[[section]]`` table."""
-    return Annotated[str, Strict(), AfterValidator(Reference(section))]
+def reference_to(section: str, mesh_bodies: bool = False) -> Any:
+    """The name of an existing ``[[section]]`` table (with ``mesh_bodies``,
+    or of a particle body made from a mesh: :func:`~sphdyn.deck.scope.mesh_body_names`)."""
+    return Annotated[str, Strict(), AfterValidator(Reference(section, mesh_bodies))]
 
 
 Position = vector(quantity(LENGTH))

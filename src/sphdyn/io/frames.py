@@ -62,6 +62,22 @@ def list_frames(outdir: str | os.PathLike) -> list[Path]:
     return [f for _, f in sorted(found)]
 
 
+def frames_of_run(outdir: str | os.PathLike) -> list[Path]:
+    """:func:`list_frames`, or a FileNotFoundError saying why there are none
+    and what to do (a missing directory, or a run that wrote no frame)."""
+    outdir = Path(outdir)
+    frames = list_frames(outdir)
+    if frames:
+        return frames
+    if not outdir.is_dir():
+        raise FileNotFoundError(f"{outdir}: no such directory. Fix: give the output "
+                                "directory of a run (out/<deck name>, or the run's --out)")
+    raise FileNotFoundError(
+        f"{outdir}: there are no frames ({outdir / FRAMES_DIR}/frame_*.h5), so nothing "
+        "to export or plot. Fix: give the output directory of a run, or run the deck "
+        "(sphdyn run DECK --out DIR; a run writes its first frame at t = 0)")
+
+
 def _frame_index(path: Path) -> int:
     m = _FRAME_RE.match(path.name)
     assert m is not None
@@ -269,7 +285,7 @@ def export_vtk(outdir: str | os.PathLike) -> Path:
     outdir = Path(outdir)
     vtk_dir = outdir / VTK_DIR
     frames = []
-    for f in list_frames(outdir):
+    for f in frames_of_run(outdir):
         index = _frame_index(f)
         t, _, fields, _ = read_frame(f)
         x, point_data = _split_position(fields)
@@ -321,9 +337,7 @@ def export_csv(outdir: str | os.PathLike, frame: int = -1,
         The path written.
     """
     outdir = Path(outdir)
-    frames = list_frames(outdir)
-    if not frames:
-        raise FileNotFoundError(f"no frames in {outdir / FRAMES_DIR}")
+    frames = frames_of_run(outdir)
     if not -len(frames) <= frame < len(frames):
         raise ValueError(f"frame {frame}: {outdir} has {len(frames)} frames. Fix: give "
                          f"--frame from 0 to {len(frames) - 1}, or -1 for the last")

@@ -4,6 +4,7 @@
 (``outdir/frames/frame_*.h5``), all on one colour scale with one colour bar,
 like the ring and disc figures of the thesis and the paper:
 
+* 1D runs: the field along x, one line per frame (one axes per run);
 * 2D runs: the particles at their x-y positions;
 * 3D runs: the particles of a slab around the mid-plane of ``slice_axis``,
   in the other two coordinates.
@@ -28,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from .plots import save_figure, time_unit
-from .frames import list_frames
+from .frames import frames_of_run
 from .hdf5 import read_frame, read_frame_header
 
 __all__ = ["plot_snapshots", "select_frames", "slab_mask", "particle_spacing",
@@ -69,7 +70,9 @@ def select_frames(frame_times, times=None, n: int = 4) -> list[int]:
         Times [s] of the frames, in frame order (non-decreasing).
     times : sequence of float, optional
         Wanted times [s]: the frame nearest to each is taken (the earlier one
-        on a tie). Duplicates are dropped.
+        on a tie). Duplicates are dropped. A time more than half the largest
+        frame interval before the first frame or after the last is refused
+        (ValueError naming the run's time range): no frame shows it.
     n : int, optional
         Without ``times``: the number of frames, evenly spaced in time from
         the first frame to the last, both included (``n = 1``: the last
@@ -94,6 +97,18 @@ def select_frames(frame_times, times=None, n: int = 4) -> list[int]:
             raise ValueError("times is empty")
         if not np.all(np.isfinite(targets)):
             raise ValueError(f"times must be finite, got {list(targets)}")
+        gaps = np.diff(ft)
+        slack = max(0.5 * float(gaps.max()) if gaps.size else 0.0,
+                    1e-9 * max(abs(ft[0]), abs(ft[-1])))
+        outside = targets[(targets < ft[0] - slack) | (targets > ft[-1] + slack)]
+        if outside.size:
+            factor, unit = time_unit(ft[-1] - ft[0] or ft[-1])
+            show = ", ".join(f"{t:g} s" for t in outside)
+            raise ValueError(
+                f"time {show} is outside the run: its {ft.size} frame(s) span "
+                f"{ft[0]:g} to {ft[-1]:g} s ({ft[0] * factor:.4g} to "
+                f"{ft[-1] * factor:.4g} {unit}). Fix: give times from {ft[0]:g} to "
+                f"{ft[-1]:g} s (a run stopped early has no later frames)")
     picked = {int(np.argmin(np.abs(ft - t))) for t in targets}
     return sorted(picked)
 
@@ -221,6 +236,52 @@ def field_values(fields: dict[str, np.ndarray], name: str) -> tuple[np.ndarray, 
 
 # --------------------------------------------------------------------- drawing
 
+def _length_scale(extent: float) -> tuple[float, str]:
+    """Factor and unit of coordinates spanning ``extent`` [m]: mm below 1 m."""
+    return (1e3, "mm") if extent < 1.0 else (1.0, "m")
+
+
+def _line_figure(loaded, field: str, row_labels, out, runs, vmin, vmax, dpi) -> Path:
+    """The 1D snapshots: for each run (one axes per run, stacked) the field
+    against x, one line per selected frame coloured by its time."""
+    from matplotlib import colormaps
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    panels = [pan for run in loaded for pan in run[0]]
+    unit, title = loaded[0][1], loaded[0][3]
+    values = np.concatenate([v[np.isfinite(v)] for _, _, v in panels])
+    magnitude = float(np.abs(values).max()) if values.size else 1.0
+    factor, shown_unit = _display_scale(unit, magnitude)
+    xs = np.concatenate([xy[:, 0] for _, xy, _ in panels])
+    x_factor, x_unit = _length_scale(float(np.ptp(xs)) if xs.size else 0.0)
+    t_max = max(t for t, _, _ in panels)
+    fig = Figure(figsize=(8.0, 1.0 + 2.8 * len(loaded)), layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(len(loaded), 1, sharex=True, squeeze=False)[:, 0]
+    cmap = colormaps["viridis"]
+    for ax, run, label in zip(axes, loaded, row_labels):
+        frames = run[0]
+        for k, (t, xy, v) in enumerate(frames):
+            order = np.argsort(xy[:, 0], kind="stable")
+            colour = cmap(k / max(len(frames) - 1, 1))
+            ax.plot(xy[order, 0] * x_factor, v[order] * factor, color=colour, lw=1.2,
+                    marker="." if len(order) <= 200 else None, ms=3,
+                    label=_time_label(t, t_max))
+        name = field if not shown_unit else f"{field} [{shown_unit}]"
+        ax.set_ylabel(f"{label}\n{name}" if len(runs) > 1 else name,
+                      fontsize=10 if len(runs) == 1 else 8)
+        if vmin is not None or vmax is not None:
+            ax.set_ylim(None if vmin is None else vmin * factor,
+                        None if vmax is None else vmax * factor)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8, loc="best")
+    axes[-1].set_xlabel(f"x [{x_unit}]")
+    fig.suptitle(f"{field}: {title}" if len(runs) == 1 else field, fontsize=11)
+    dest = Path(out) if out is not None else runs[0] / "plots" / f"snapshots_{field}.png"
+    return save_figure(fig, dest, dpi)
+
+
 def _display_scale(unit: str, magnitude: float) -> tuple[float, str]:
     """Factor and unit in which values of ``unit`` are shown."""
     if unit == "Pa":
@@ -299,7 +360,7 @@ def _run_info(outdir: Path) -> tuple[int | None, str]:
     except (OSError, tomllib.TOMLDecodeError):
         return None, ""
     dim = run.get("dimension")
-    return (int(dim) if dim in (2, 3) else None), str(run.get("title", "") or "")
+    return (int(dim) if dim in (1, 2, 3) else None), str(run.get("title", "") or "")
 
 
 def _grid(n_panels: int, box_w: float, box_h: float) -> tuple[int, int]:
@@ -328,22 +389,28 @@ def _run_panels(outdir: Path, field: str, times, n: int, k_slice: int,
     """Frames of one run for :func:`plot_snapshots`.
 
     Returns ``(panels, unit, spacing, title, plane, slab)`` with ``panels`` a
-    list of ``(time [s], xy [m] (n, 2), values [SI] (n,))``.
+    list of ``(time [s], xy [m] (n, 2), values [SI] (n,))``; in 1D ``plane``
+    is ``(0,)`` and ``xy`` is ``(n, 1)``, the x coordinates.
     """
-    frame_files = list_frames(outdir)
-    if not frame_files:
-        raise FileNotFoundError(f"no frames in {outdir / 'frames'}")
+    frame_files = frames_of_run(outdir)
     frame_times = [read_frame_header(f)[0] for f in frame_files]
-    chosen = select_frames(frame_times, times=times, n=n)
+    try:
+        chosen = select_frames(frame_times, times=times, n=n)
+    except ValueError as exc:
+        raise ValueError(f"{outdir}: {exc}") from None
 
     # Spacing and slab from the first frame of the run.
     _, _, first, _ = read_frame(frame_files[0])
     x0 = np.asarray(first["position"], dtype=float)
     dimension, title = _run_info(outdir)
     if dimension is None:
-        dimension = 2 if np.ptp(x0[:, 2]) == 0.0 else 3
+        flat = [np.ptp(x0[:, k]) == 0.0 for k in (1, 2)] if x0.size else [True, True]
+        dimension = 1 if all(flat) else 2 if flat[1] else 3
     spacing = particle_spacing(x0, dimension)
-    if dimension == 2:
+    if dimension == 1:  # the field along x: no plane, no slab
+        plane = (0,)
+        slab = None
+    elif dimension == 2:
         plane = (0, 1)
         slab = None
     else:
@@ -370,7 +437,8 @@ def plot_snapshots(outdir, field: str = "von_mises",
                    slice_axis: str = "z", slice_width: float | None = None,
                    cmap=None, vmin: float | None = None, vmax: float | None = None,
                    marker_size: float | None = None, dpi: int = 110) -> Path:
-    """Panel figure of the particles of selected frames coloured by a field.
+    """Panel figure of the particles of selected frames coloured by a field
+    (1D runs: the field along x, one line per frame).
 
     Parameters
     ----------
@@ -438,6 +506,10 @@ def plot_snapshots(outdir, field: str = "von_mises",
     plane, slab = loaded[0][4], loaded[0][5]
     title = loaded[0][3]
     row_labels = run_labels(runs) if len(runs) > 1 else [""]
+    if vmin is not None and vmax is not None and not float(vmax) > float(vmin):
+        raise ValueError(f"vmax ({vmax}) must be greater than vmin ({vmin})")
+    if len(plane) == 1:
+        return _line_figure(loaded, field, row_labels, out, runs, vmin, vmax, dpi)
     side = float(marker_size) if marker_size is not None else spacing
 
     # Shared colour scale.
@@ -453,8 +525,6 @@ def plot_snapshots(outdir, field: str = "von_mises",
         dlo = -dhi
     else:
         dlo, dhi = lo, hi
-    if vmin is not None and vmax is not None and not float(vmax) > float(vmin):
-        raise ValueError(f"vmax ({vmax}) must be greater than vmin ({vmin})")
     vlo = dlo if vmin is None else float(vmin)
     vhi = dhi if vmax is None else float(vmax)
     if not vhi > vlo:
@@ -529,7 +599,7 @@ def plot_snapshots(outdir, field: str = "von_mises",
             ax.set_xlabel(f"{names[plane[0]]} [mm]")
             ax.xaxis.set_tick_params(labelbottom=True)
         if col == 0:
-            run_label = row_labels[row] + "\n" if row_labels[row] else ""
+            run_label = row_labels[row] + "\n" if len(runs) > 1 else ""
             ax.set_ylabel(f"{run_label}{names[plane[1]]} [mm]",
                           fontsize=10 if len(runs) == 1 else 8)
     label = field if not shown_unit else f"{field} [{shown_unit}]"

@@ -99,7 +99,8 @@ class GasParams(MaterialSection):
                           "\"linear_polynomial\"")
         if self.eos == "linear_polynomial" and self.gamma is not None:
             raise problem("gamma belongs to the ideal gas but eos = \"linear_polynomial\"",
-                          "give C4 = C5 = gamma - 1 instead, or set eos = \"ideal_gas\"")
+                          "give C4 and C5 equal to gamma - 1 instead, or set eos = "
+                          "\"ideal_gas\"")
         if self.pressure is not None and self.E0 is not None:
             raise problem("both pressure and E0 are given (each sets the other)",
                           "give one of them")

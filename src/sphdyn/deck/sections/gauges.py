@@ -42,8 +42,10 @@ class Gauge(Section):
     quantities: tuple[Literal[POINT_QUANTITIES], ...] = Field(
         ("displacement_x", "displacement_y", "displacement_z"),
         description="point: what is recorded.")
-    body: Optional[reference_to("body")] = Field(
-        None, description="Only the particles of this body (default: every particle "
+    body: Optional[reference_to("body", mesh_bodies=True)] = Field(
+        None, description="Only the particles of this body, a [[body]] or the "
+                          "particles of a [mesh.convert] (the mesh's name) or a "
+                          "[mesh.sublayer] (<mesh>_sublayer) (default: every particle "
                           "and node).")
     mesh: Optional[reference_to("mesh")] = Field(
         None, description="Only the nodes of this mesh (default: every particle "

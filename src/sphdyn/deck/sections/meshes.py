@@ -283,8 +283,10 @@ class Sublayer(Section):
         0.5, description="The particles' share of the bar's mass (0 < r < 1; the "
                          "elements carry 1 - r). Equal (0.5) by default, as the thesis "
                          "found best.")
-    body: Optional[reference_to("body")] = Field(
-        None, description="The concrete body the bar lies in (default: any): every "
+    body: Optional[reference_to("body", mesh_bodies=True)] = Field(
+        None, description="The concrete body the bar lies in (a [[body]] or a "
+                          "[mesh.convert]'s particles, named as the mesh; default: any "
+                          "[[body]]): every "
                           "node must have one of its particles within its support.")
     stiffness: Literal["material", "split", "axial", "none"] = Field(
         "material", description="material: the particles carry their material's "

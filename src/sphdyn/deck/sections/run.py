@@ -72,7 +72,8 @@ class Time(Section):
 
 class Domain(Section):
     """[domain]: guard box; a particle leaving it stops the run, or (outside =
-    "remove") leaves the calculation."""
+    "remove") leaves the calculation. Every body and mesh must start inside it
+    (``sphdyn check`` refuses one that does not)."""
 
     lo: Optional[Position] = Field(
         None, description="Lower corner (absent: from the bodies and margin).")

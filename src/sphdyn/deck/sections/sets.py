@@ -22,9 +22,10 @@ class ParticleSet(Section):
     """[[set]]: a named selection of particles or of mesh nodes."""
 
     name: name_of("set") = Field(description="Name of the set.")
-    body: Optional[reference_to("body")] = Field(
-        None, description="Restrict the set to this [[body]] (absent, and no mesh: "
-                          "all bodies).")
+    body: Optional[reference_to("body", mesh_bodies=True)] = Field(
+        None, description="Restrict the set to this [[body]], or to the particles of "
+                          "a [mesh.convert] (the mesh's name) or a [mesh.sublayer] "
+                          "(<mesh>_sublayer) (absent, and no mesh: all bodies).")
     mesh: Optional[reference_to("mesh")] = Field(
         None, description="A set of this [[mesh]]'s nodes instead of particles.")
     group: Optional[str] = Field(
