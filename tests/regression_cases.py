@@ -240,6 +240,15 @@ def tolerance(measured: float, scale: float) -> float:
     return max(SAFETY * measured, FLOOR * scale)
 
 
+def _table_json(table: dict) -> str:
+    """The tolerance table as JSON, one array per line."""
+    cases = []
+    for name, keys in sorted(table.items()):
+        rows = ",\n".join(f"  {json.dumps(k)}: {json.dumps(v)}" for k, v in keys.items())
+        cases.append(f" {json.dumps(name)}: {{\n{rows}\n }}")
+    return "{\n" + ",\n".join(cases) + "\n}\n"
+
+
 def calibrate(names: list[str]) -> None:
     """Run ``names`` in every variant, compare with the stored results and
     merge their tolerances into :data:`TOLERANCES` (absolute, per array)."""
@@ -266,7 +275,7 @@ def calibrate(names: list[str]) -> None:
             scale = scale if np.isfinite(scale) else 0.0
             table[name][key] = {"tolerance": tolerance(max(by.values()), scale),
                                 "scale": scale, **by}
-    TOLERANCES.write_text(json.dumps(dict(sorted(table.items())), indent=1) + "\n")
+    TOLERANCES.write_text(_table_json(table))
     for name in names:
         rel = {k: e["tolerance"] / e["scale"] for k, e in table[name].items() if e["scale"]}
         worst = max(rel, key=rel.get)

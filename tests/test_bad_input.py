@@ -241,6 +241,17 @@ def test_memory_limit_is_a_deck_key(tmp_path, capsys):
      '\n[domain]\nlo = [-0.01, -0.01]\nhi = [0.025, 0.02]\n',
      ["mesh[0] 'pad'", "mesh 'pad' lies partly outside", "3 of its 9 nodes",
       "up to 0.005 m outside"]),
+    # a mesh resting on the wall (its lowest nodes on the plane, 5 mm elements:
+    # the default contact thickness reaches 2.5 mm), or partly behind it: the
+    # contact launched its nodes in the first steps (issue 57)
+    ('\n[[mesh]]\nname = "pad"\nmaterial = "rubber"\n'
+     'block = { lo = [0.02, 0], hi = [0.03, 0.01], divisions = [2, 2] }\n',
+     ["wall[0].thickness_factor", "mesh 'pad' starts inside wall", "3 of its 9 nodes",
+      "within its contact thickness", "up to 0.0025 m deep", "thickness_factor = 0"]),
+    ('\n[[mesh]]\nname = "pad"\nmaterial = "rubber"\n'
+     'block = { lo = [0.02, -0.004], hi = [0.03, 0.006], divisions = [2, 2] }\n',
+     ["wall[0].point", "mesh 'pad' starts inside wall", "6 of its 9 nodes",
+      "3 lie behind the wall's plane", "up to 0.0065 m deep"]),
 ])
 def test_placement_that_would_die_mid_run_is_refused(extra, words, tmp_path, capsys):
     deck = _deck(tmp_path, _small() + extra)
@@ -249,6 +260,21 @@ def test_placement_that_would_die_mid_run_is_refused(extra, words, tmp_path, cap
     out = tmp_path / "never"
     rc, err = _exit_and_message(capsys, ["run", deck, "--out", str(out)])
     assert rc == 2 and not out.exists()
+
+
+def test_a_mesh_on_a_wall_without_contact_thickness_or_clear_of_it_is_accepted(tmp_path,
+                                                                              capsys):
+    """The mesh resting on the wall is accepted with the wall's thickness_factor
+    = 0 (contact at the plane), and with the default thickness when it starts
+    exactly the contact thickness (half its 5 mm elements) above the plane."""
+    pad = ('\n[[mesh]]\nname = "pad"\nmaterial = "rubber"\n'
+           'block = {{ lo = [0.02, {y}], hi = [0.03, {top}], divisions = [2, 2] }}\n')
+    on = _small() + pad.format(y=0, top=0.01)
+    deck = _deck(tmp_path, on.replace("normal = [0, 1, 0]",
+                                      "normal = [0, 1, 0]\nthickness_factor = 0"))
+    assert _exit_and_message(capsys, ["check", deck])[0] == 0
+    deck = _deck(tmp_path, _small() + pad.format(y=0.0025, top=0.0125))
+    assert _exit_and_message(capsys, ["check", deck])[0] == 0
 
 
 def test_touching_bodies_are_accepted():

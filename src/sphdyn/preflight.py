@@ -12,7 +12,8 @@
 * :func:`placement_problems` finds, on the built lattices, bodies that
   overlap, bodies that start through a wall or outside the [domain] box and
   bodies of a single particle (:func:`check_meshes_in_domain`: meshes outside
-  the box): decks that validate but would die mid-run.
+  the box or starting inside a wall's contact thickness): decks that
+  validate but would die mid-run or be launched at their first step.
 
 Both raise :class:`~sphdyn.deck.DeckError` (exit status 2 on the command line),
 one ``<path>: <what>. Fix: <what to write>`` line per problem.
@@ -607,9 +608,63 @@ def outside_problem(deck, where: str, what: str, x: np.ndarray,
         "follows the model, widened by [domain] margin)")
 
 
+def node_sizes(points: np.ndarray, cells: np.ndarray, kind: str, dim: int) -> np.ndarray:
+    """(N,) [m] the size a wall sees of each node of a solid mesh: the mean
+    of its elements' sizes ``V_e^(1/d)`` (as
+    :func:`~sphdyn.parts.fem.solid_part.node_contact_items`), with ``V_e``
+    the mean corner ``det J`` times ``2^d`` (exact for parallelepipeds);
+    0 for a node of no element."""
+    from .geometry.mesh import element_jacobians
+
+    vol = np.abs(element_jacobians(points, cells, kind).mean(axis=1)) * 2.0 ** dim
+    flat = cells.ravel()
+    n = points.shape[0]
+    count = np.bincount(flat, minlength=n)
+    size = np.bincount(flat, weights=np.repeat(vol ** (1.0 / dim), cells.shape[1]),
+                       minlength=n)
+    return np.divide(size, count, out=np.zeros(n), where=count > 0)
+
+
+def mesh_wall_problems(deck, meshes) -> list[str]:
+    """Solid meshes that start inside a wall's contact: nodes behind the
+    wall's plane or closer to it than its contact thickness
+    ``thickness_factor`` times the node's size (:func:`node_sizes`). The
+    contact would push them out in the first steps with the whole depth's
+    spring (issue 57: a mesh placed on a wall was launched)."""
+    problems = []
+    dim = deck.run.dimension
+    for w, wall in enumerate(deck.wall):
+        normal = np.asarray(wall.normal, float) / np.linalg.norm(wall.normal)
+        for mm in meshes:
+            if mm.element != "solid" or not mm.points.shape[0]:
+                continue
+            gap = (mm.points - np.asarray(wall.point, float)) @ normal
+            reach = wall.thickness_factor * node_sizes(mm.points, mm.cells, mm.kind, dim)
+            depth = reach - gap
+            size = float(reach.max()) / max(wall.thickness_factor, 1e-300)
+            count, deep = _count_and_depth(depth, _TOLERANCE * max(size, 1e-300))
+            if not count:
+                continue
+            behind = int((gap < -_TOLERANCE * size).sum())
+            where = (f"{behind} lie behind the wall's plane" if behind else
+                     "none behind the plane, but within its contact thickness "
+                     f"({wall.thickness_factor:g} x the elements' size)")
+            problems.append(format_problem(
+                f"wall[{w}].thickness_factor" if not behind else f"wall[{w}].point",
+                f"mesh '{mm.name}' starts inside wall '{wall.name}''s contact: {count} "
+                f"of its {mm.points.shape[0]} nodes are closer to the plane than the "
+                f"contact thickness ({where}; up to {deep:.3g} m deep), and would be "
+                "pushed out at once",
+                f"move mesh '{mm.name}' at least {deep:.3g} m further along the "
+                f"wall's normal, or give wall '{wall.name}' thickness_factor = 0 "
+                "(contact at the plane: a mesh resting on a support)"))
+    return problems
+
+
 def check_meshes_in_domain(deck, meshes) -> None:
     """DeckError for meshes (:class:`~sphdyn.mesh_model.MeshModel`) whose
-    nodes or converted particles lie outside the [domain] box."""
+    nodes or converted particles lie outside the [domain] box, or that start
+    inside a wall's contact (:func:`mesh_wall_problems`)."""
     problems = []
     for mm in meshes:
         x = mm.points if mm.converted is None else np.concatenate(
@@ -618,6 +673,7 @@ def check_meshes_in_domain(deck, meshes) -> None:
                                "nodes" if mm.converted is None else "nodes and particles")
         if line:
             problems.append(line)
+    problems += mesh_wall_problems(deck, meshes)
     if problems:
         raise DeckError(problems)
 

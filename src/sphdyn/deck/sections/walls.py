@@ -32,7 +32,11 @@ class Wall(Section):
         0.0, description="Coulomb friction coefficient.")
     thickness_factor: real("thickness factor", lo=0) = Field(
         0.5, description="Contact starts when a particle centre is closer "
-                         "than thickness_factor times its spacing.")
+                         "than thickness_factor times its spacing (a mesh node: "
+                         "times the mean size of its elements). A solid mesh "
+                         "starting closer than that is refused by check: move it, "
+                         "or give 0 (contact at the plane) for a mesh resting on "
+                         "the wall.")
     velocity: VelocityVector = Field(
         (0.0, 0.0, 0.0), description="Constant velocity of the wall (e.g. a "
         "platen of a compression test): the plane passes through point + "
