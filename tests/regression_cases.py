@@ -44,8 +44,11 @@ DATA = Path(__file__).resolve().parent / "data" / "regression"
 
 #: deck stem -> (steps, overrides). Coarse spacings keep every case at about
 #: 1,000 particles or fewer, so the whole set runs in well under 3 minutes.
+#: The energy guard is off: the coarse spacings of some cases are not models
+#: to trust (at 25 mm the blast slabs' particles start inside the supports'
+#: contact: 5.5 % of energy made in six steps), only fixed points to compare.
 COMMON = ["output.history_every=1", "output.vtk=false", "output.progress=false",
-          "output.checkpoint_every=0"]
+          "output.checkpoint_every=0", 'run.energy_error_action="off"']
 #: the blast decks at 25 mm (three particle layers, the gauges on the lowest
 #: at lattice points, the bars' elements as long as the spacing)
 BLAST_COARSE = ['body.slab.dx="25 mm"', 'body.charge.dx="6 mm"',

@@ -129,6 +129,9 @@ def test_bar_reactions_from_a_deck_equal_EA_d_over_L(tmp_path):
     assert (tmp_path / "bar/plots/reactions.png").is_file()
     info = json.loads((tmp_path / "bar/summary.json").read_text())
     assert info["meshes"] == {"bar": {"nodes": 44, "elements": 10}}
+    # a mesh-only run has no particles: its 44 nodes are counted as nodes
+    # (the summary said "particles": 44), the rate counts both as items
+    assert (info["particles"], info["nodes"], info["items"]) == (0, 44, 44)
 
 
 def test_frames_carry_the_masses_so_momentum_can_be_summed_from_them(tmp_path):

@@ -282,7 +282,10 @@ class Simulation:
             "sphdyn": __version__, "title": deck.run.title, "status": status,
             "signal": interrupted if status == "interrupted" else None,
             "diagnosis": None if failure is None else failure.diagnosis,
-            "particles": n, "dimension": deck.run.dimension, "time": s.t,
+            # items: particles and mesh nodes (the rate below counts both)
+            "particles": 0 if sph is None else sph.kin.n, "nodes": n - (
+                0 if sph is None else sph.kin.n), "items": n,
+            "dimension": deck.run.dimension, "time": s.t,
             "steps": s.step_count, "steps_this_run": steps,
             "wall_seconds": self.wall_seconds,
             "particle_steps_per_s": n * steps / max(self.wall_seconds, 1e-12),
