@@ -213,3 +213,35 @@ def test_the_guard_keys_are_validated(line, words):
         quarter(run=line)
     msg = str(exc.value)
     assert words in msg and "Fix" in msg
+
+
+def test_a_transient_past_the_limit_is_waited_out_a_lasting_gain_is_not(monkeypatch):
+    """The guard acts only when the error has stayed past the limit for
+    EnergyGuard.PERSIST steps: a 7 % spike over 20 steps (a penalty contact's
+    booking transient, tests/test_erosion.py) passes, the same 7 % held
+    stops the run at exactly PERSIST steps after it began, and a dip below
+    the limit starts the count again."""
+    from types import SimpleNamespace
+
+    from sphdyn import monitors
+    from sphdyn.io.history import History
+
+    monkeypatch.setattr(monitors, "energy_diagnosis", lambda s, *a: "made energy")
+    recorder = SimpleNamespace(_row=None)
+
+    def run(errors):
+        guard = monitors.EnergyGuard(recorder, History(), limit=0.05)
+        s = SimpleNamespace(step_count=0)
+        for k, err in enumerate(errors):
+            s.step_count = k
+            recorder._row = {"E_total": 100.0 + 100.0 * err, "E_kinetic": 100.0}
+            guard.after_kick(s)
+            guard.after_step(s)
+        return guard
+
+    p = monitors.EnergyGuard.PERSIST
+    run([0.0] * 10 + [0.07] * 20 + [0.0] * 500)  # the transient: no stop
+    run([0.0] * 10 + ([0.07] * (p - 1) + [0.0]) * 3)  # dips reset the count
+    assert run([0.0] * 10 + [0.07] * p)._since == 10  # held p steps: not yet
+    with pytest.raises(EnergyError, match="made energy"):
+        run([0.0] * 10 + [0.07] * (p + 1))  # step 10 + p stops it

@@ -421,10 +421,14 @@ def _impact(to, per_element=1, interaction_work=False, others=()):
 def test_impact_with_erosion_keeps_its_books(to):
     """The block hits the wall and elements erode: the total mass (nodes and
     particles) stays to round-off with conversion, and E_total (with
-    E_removed for plain erosion) stays within 5 % of the initial kinetic
-    energy: the wall's penalty contact alone gains 3 % in this impact before
-    anything erodes (measured), and each erosion moves the books by O(dt)
-    (energies taken at the coming half kick's estimate)."""
+    E_removed for plain erosion) ends within 6.5 % of the initial kinetic
+    energy. Measured (2026-11-28, the nodes' contact thickness half an
+    element since issue 57: the struck face meets the wall at once): the
+    wall's penalty contact alone, nothing eroding, peaks at +7.2 % for about
+    20 steps and ends at -0.3 %; with erosion into particles the run ends at
+    +1.5 %, with plain erosion (16 elements) at -5.5 %: each erosion moves
+    the books by O(dt) (energies taken at the coming half kick's
+    estimate)."""
     st, ev = _impact(to)
     m0 = st.parts[0].nodes.m.sum()
     e0 = st.kinetic_now()
@@ -439,7 +443,7 @@ def test_impact_with_erosion_keeps_its_books(to):
     else:
         assert st.parts[0].nodes.m.sum() + ev.mass_removed == pytest.approx(m0, rel=1e-12)
         assert rec["E_removed"] > 0.0
-    assert abs(rec["E_total"] - e0) < 0.05 * e0
+    assert abs(rec["E_total"] - e0) < 0.065 * e0
 
 
 def test_restart_across_a_conversion_is_bitwise():

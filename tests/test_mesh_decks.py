@@ -308,6 +308,7 @@ velocity = [0, "-5 m/s", 0]
 name = "floor"
 point = [0, 0, 0]
 normal = [0, 1, 0]
+thickness_factor = 0  # contact at the plane: the cube starts 1 mm above it
 [output]
 progress = false
 vtk = false

@@ -45,8 +45,9 @@ class Run(Section):
                           "E_total(0) over the largest energy term so far (kinetic, "
                           "internal, contact, external work; summary.json's "
                           "energy_error_max_rel, for a gain), checked at every history "
-                          "row. Past "
-                          "it the run does energy_error_action, naming the part that "
+                          "row. Past it for 100 steps (a stiff contact's booking "
+                          "transient passes) "
+                          "the run does energy_error_action, naming the part that "
                           "gained the most energy beyond the work done on it, its "
                           "element or particle of the largest specific internal "
                           "energy, and the interactions acting on it.")
