@@ -188,3 +188,25 @@ vtk = false
     assert main(["run", str(deck), "--out", str(tmp_path / "o"), "--max-steps", "1",
                  "--quiet"]) == 0
     assert lines[0] in capsys.readouterr().err
+
+
+def test_a_thin_gas_body_does_not_warn():
+    """A fluid (here a gas) has no shear or bending stiffness to lose: the 4-across
+    strip that warns as steel is not reported as gas."""
+    deck = loads_deck(f"""
+[run]
+dimension = 2
+t_end = "1 us"
+[[material]]
+name = "air"
+model = "gas"
+density = 1.2
+gamma = 1.4
+pressure = 1e5
+[[body]]
+name = "member"
+material = "air"
+dx = "2.5 mm"
+geometry = {STRIP}
+""")
+    assert thin_member_warnings(deck) == []

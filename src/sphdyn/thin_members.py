@@ -212,13 +212,19 @@ def thin_member_warnings(deck, model=None) -> list[str]:
     """Warnings (:func:`thin_member_warning`) for the deck's bodies and, given
     the built ``model``, its [mesh.convert] particles (thickness: the mesh's
     smallest extent, spacing: the elements' size). None in 1D (no free
-    lateral surfaces, no bending)."""
+    lateral surfaces, no bending), none for bodies of a fluid (gas,
+    explosive)."""
+    from .materials.registry import get_model
+
     dim = deck.run.dimension
     if dim == 1:
         return []
     sph = deck.sph
+    fluid = {m.name for m in deck.material if get_model(m.model).fluid}
     out = []
     for b in deck.body:
+        if b.material in fluid:  # a gas or an explosive has no stiffness to lose
+            continue
         kind = _kind(b.formulation or sph.formulation, sph.correction)
         out.append(thin_member_warning(b.name, *member_extents(b.geometry, dim), b.dx, kind))
     if model is not None:
