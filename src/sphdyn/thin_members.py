@@ -23,7 +23,11 @@ them,
 exact at n = 6 and 12, extrapolated outside (and capped at 100 %). The
 number of particles across at which the bending error is 5 % is
 :math:`n_5 = 6\,(e_b(6)/0.05)^{1/p_b}`. :func:`thin_member_warnings` applies
-it to every body of a deck (``sphdyn check`` and ``sphdyn run`` print them).
+it to every body of a deck (``sphdyn check`` and ``sphdyn run`` print them):
+n = the body's thickness across its thinnest direction
+(:func:`member_extents`) / dx; a member (longest extent at least
+:data:`SLENDER` times the thickness) is reported when its bending error
+exceeds 5 %, a compact body when its axial error does.
 """
 
 from __future__ import annotations
