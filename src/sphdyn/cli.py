@@ -107,12 +107,22 @@ def cmd_run(args) -> int:
     _writable_dir(out, "--out")
     with compile_notice(None if args.quiet else _note):
         sim = Simulation.from_deck(deck, out)
+    _warn_thin_members(deck, sim.model)
     if not args.quiet:
         print(f"sphdyn: {sim.particles.n} particles{_mesh_counts(sim.model)}, "
               f"{deck.run.dimension}D, "
               f"t_end = {deck.run.t_end:g} s, initial dt = {sim.stepper.dt0:.3e} s -> {out}")
     return _finish(sim.run(max_steps=args.max_steps, progress=not args.quiet and None,
                            threads=args.threads), out, args.quiet)
+
+
+def _warn_thin_members(deck, model) -> None:
+    """``warning: ...`` on stderr for each member too thin for its formulation
+    (:func:`sphdyn.thin_members.thin_member_warnings`); not an error."""
+    from .thin_members import thin_member_warnings
+
+    for text in thin_member_warnings(deck, model):
+        print(f"warning: {text}", file=sys.stderr, flush=True)
 
 
 def _note(text: str) -> None:
@@ -210,6 +220,7 @@ def cmd_check(args) -> int:
           f"{f', {len(deck.gauge)} gauges' if deck.gauge else ''}")
     print(f"  estimate: {estimate.summary()}; memory limit {show_bytes(limit)} "
           f"({source})")
+    _warn_thin_members(deck, model)
     if args.resolved:
         from .deck import dump_resolved
 
