@@ -209,7 +209,8 @@ def thin_member_warning(name: str, thickness: float, longest: float, dx: float,
     return (f"body '{name}' is {n:.3g} particles across its thinnest direction "
             f"({_mm(thickness)} / dx {_mm(dx)}): with {KIND_TEXT[kind]} it is about "
             f"{_pct(lo)}-{_pct(hi)} % too soft (axial to bending stiffness{where}; "
-            f"{what}; docs/tensile-instability.md). Fix (5 % or less): {fix}")
+            f"{what}; docs/tensile-instability.md), where it stretches or bends "
+            f"across that thickness. Fix (5 % or less): {fix}")
 
 
 def thin_member_warnings(deck, model=None) -> list[str]:
