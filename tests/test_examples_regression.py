@@ -87,6 +87,11 @@ step) within the few steps: the penetrations (CSCM FEM target struck at
 step within 5e-5), the blast slabs (CSCM cap kappa within 4.1e-4, stress
 2.7e-5), erosion_blocks_sph (1.1e-9) and the detonation front of
 gurney_1d (1.6e-7).
+2026-11-28 (issue 57): a mesh node's wall contact thickness is its
+elements' mean size (was its share of their volume): the three
+erosion_blocks decks, whose block meets the wall within their steps,
+rewritten (the contact starts 1 mm earlier); every other case bitwise. The
+tolerances (tolerances.json) written for every case.
 """
 
 import json
@@ -188,7 +193,8 @@ def test_every_stored_array_has_its_derived_tolerance():
         assert set(TABLE[name]) == floats, name
         for key, entry in TABLE[name].items():
             measured = max(entry[v] for v in VARIANTS)
-            assert entry["scale"] == float(np.nanmax(np.abs(want[key]))), (name, key)
+            scale = float(np.nanmax(np.abs(want[key]))) if want[key].size else 0.0
+            assert entry["scale"] == (scale if np.isfinite(scale) else 0.0), (name, key)
             assert entry["tolerance"] == tolerance(measured, entry["scale"]), (name, key)
 
 
