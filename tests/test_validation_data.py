@@ -1,0 +1,36 @@
+"""The measured data of validation/data/ (issue 53): every file names its
+source and where it was read, parses as CSV, and is listed in SOURCES.md.
+
+A file without its provenance lines, or with a row of another width than its
+header, fails here: the comparisons (docs/validation.md) may use only values
+whose source a reader can look up.
+"""
+
+import csv
+import io
+from pathlib import Path
+
+import pytest
+
+DATA = Path(__file__).parents[1] / "validation" / "data"
+FILES = sorted(DATA.glob("*.csv"))
+
+
+def test_there_is_data_and_a_sources_page():
+    assert len(FILES) >= 5 and (DATA / "SOURCES.md").is_file()
+    assert (Path(__file__).parents[1] / "docs" / "validation.md").is_file()
+
+
+@pytest.mark.parametrize("path", FILES, ids=[p.stem for p in FILES])
+def test_each_file_names_its_source_and_parses(path):
+    lines = path.read_text(encoding="utf-8").splitlines()
+    comments = [ln for ln in lines if ln.startswith("#")]
+    body = [ln for ln in lines if ln.strip() and not ln.startswith("#")]
+    heads = " ".join(c.split(":", 1)[0].lower() for c in comments)
+    assert "dataset" in heads and "source" in heads, f"{path.name}: no dataset/source line"
+    assert "read" in heads, f"{path.name}: no line saying where the values were read"
+    rows = list(csv.reader(io.StringIO("\n".join(body))))
+    assert len(rows) >= 2, f"{path.name}: a header and at least one row"
+    widths = {len(r) for r in rows}
+    assert widths == {len(rows[0])}, f"{path.name}: rows of widths {sorted(widths)}"
+    assert path.name in (DATA / "SOURCES.md").read_text(encoding="utf-8")
