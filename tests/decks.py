@@ -82,3 +82,25 @@ density = 7850.0
 E = "200 GPa"
 nu = 0.3
 """
+
+
+#: rollers on the symmetry planes x = 0 and y = 0 of a quarter model of the
+#: mesh "block" (node sets "x0" and "y0", each holding its normal direction)
+ROLLERS = """
+[[set]]
+name = "x0"
+mesh = "block"
+region = {shape = "box", lo = [-1e-4, -1, -1], hi = [1e-4, 1, 1]}
+[[set]]
+name = "y0"
+mesh = "block"
+region = {shape = "box", lo = [-1, -1e-4, -1], hi = [1, 1e-4, 1]}
+[[boundary]]
+set = "x0"
+type = "fixed"
+components = ["x"]
+[[boundary]]
+set = "y0"
+type = "fixed"
+components = ["y"]
+"""

@@ -22,6 +22,7 @@ import json
 import numpy as np
 import pytest
 
+from decks import ROLLERS
 from sphdyn.cli import main
 from sphdyn.deck import DeckError, loads_deck
 from sphdyn.guards import EnergyError
@@ -51,22 +52,7 @@ material = "metal"
 integration = "{integration}"
 block = {{lo = [0, 0, "2.6 mm"], hi = ["20 mm", "20 mm", "22.6 mm"], divisions = [4, 4, 4]}}
 velocity = [0, 0, "-200 m/s"]
-[[set]]
-name = "x0"
-mesh = "block"
-region = {{shape = "box", lo = [-1e-4, -1, -1], hi = [1e-4, 1, 1]}}
-[[set]]
-name = "y0"
-mesh = "block"
-region = {{shape = "box", lo = [-1, -1e-4, -1], hi = [1, 1e-4, 1]}}
-[[boundary]]
-set = "x0"
-type = "fixed"
-components = ["x"]
-[[boundary]]
-set = "y0"
-type = "fixed"
-components = ["y"]
+{rollers}
 [[wall]]
 name = "rigid"
 point = [0, 0, 0]
@@ -82,7 +68,7 @@ vtk = false
 
 
 def quarter(t_end="75 us", integration="selective_reduced", run=""):
-    return loads_deck(QUARTER.format(t_end=t_end, integration=integration, run=run))
+    return loads_deck(QUARTER.format(t_end=t_end, integration=integration, run=run, rollers=ROLLERS))
 
 
 def energies(outdir):
@@ -131,7 +117,8 @@ def test_the_guard_stops_a_run_that_makes_energy_in_a_part(tmp_path, monkeypatch
     row past the limit and summary.json the diagnosis."""
     double_the_work(monkeypatch)
     path = tmp_path / "quarter.toml"
-    path.write_text(QUARTER.format(t_end="75 us", integration="selective_reduced", run=""))
+    path.write_text(QUARTER.format(t_end="75 us", integration="selective_reduced", run="",
+                                   rollers=ROLLERS))
     assert main(["run", str(path), "--out", str(tmp_path / "out"), "-q",
                  "--threads", "1"]) == 1
     err = capsys.readouterr().err
@@ -177,12 +164,12 @@ class Pump(InteractionBase):
         return {}
 
 
-TWO_BLOCKS = QUARTER.replace("[[set]]", """[[mesh]]
+TWO_BLOCKS = QUARTER.replace("{rollers}", """[[mesh]]
 name = "free"
 material = "metal"
 block = {{lo = ["40 mm", 0, "10 mm"], hi = ["50 mm", "10 mm", "20 mm"], divisions = [1, 1, 1]}}
 velocity = [0, 0, "-20 m/s"]
-[[set]]""", 1)
+{rollers}""", 1)
 
 
 def test_the_guard_names_the_part_an_interaction_pumps_and_the_interaction(tmp_path):
@@ -191,7 +178,7 @@ def test_the_guard_names_the_part_an_interaction_pumps_and_the_interaction(tmp_p
     'free', not the struck block (whose contact's transient, 2 %, stays
     below the limit), and the pump among the interactions acting on it."""
     deck = loads_deck(TWO_BLOCKS.format(t_end="75 us", integration="selective_reduced",
-                                        run=""))
+                                        run="", rollers=ROLLERS))
     sim = Simulation.from_deck(deck, tmp_path)
     s = sim.stepper
     s.interactions.append(Pump(s.part("free")))

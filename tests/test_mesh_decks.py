@@ -34,6 +34,7 @@ import meshio
 import numpy as np
 import pytest
 
+from decks import ROLLERS
 from sphdyn.assembly import build_stepper
 from sphdyn.cli import main
 from sphdyn.deck import DeckError, loads_deck
@@ -493,24 +494,6 @@ progress = false
 vtk = false
 """
 
-ROLLERS = """
-[[set]]
-name = "x0"
-mesh = "block"
-region = {shape = "box", lo = [-1e-4, -1, -1], hi = [1e-4, 1, 1]}
-[[set]]
-name = "y0"
-mesh = "block"
-region = {shape = "box", lo = [-1, -1e-4, -1], hi = [1, 1e-4, 1]}
-[[boundary]]
-set = "x0"
-type = "fixed"
-components = ["x"]
-[[boundary]]
-set = "y0"
-type = "fixed"
-components = ["y"]
-"""
 
 
 def test_a_quarter_model_with_rollers_meets_a_wall_as_the_whole_model_does():
