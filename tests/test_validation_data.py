@@ -34,3 +34,25 @@ def test_each_file_names_its_source_and_parses(path):
     widths = {len(r) for r in rows}
     assert widths == {len(rows[0])}, f"{path.name}: rows of widths {sorted(widths)}"
     assert path.name in (DATA / "SOURCES.md").read_text(encoding="utf-8")
+
+
+def test_nothing_outside_mat159_is_on_by_default_and_decks_mark_it_calibrated():
+    """sphdyn's rate scaling of the CSCM damage thresholds is not MAT_159's:
+    off by default (it was on), and every example deck that switches it on
+    says CALIBRATED on that line (docs/validation.md, "Calibrated
+    parameters", gives the default's result beside the deck's)."""
+    import re
+
+    from sphdyn.materials.cscm.schema import CscmParams
+
+    assert CscmParams.model_fields["rate_thresholds"].default is False
+    examples = Path(__file__).parents[1] / "examples"
+    marked = 0
+    for deck in sorted(examples.glob("*.toml")):
+        for line in deck.read_text(encoding="utf-8").splitlines():
+            if re.match(r"\s*rate_thresholds\s*=\s*true", line):
+                assert "CALIBRATED" in line, f"{deck.name}: {line}"
+                marked += 1
+    assert marked == 10
+    page = (Path(__file__).parents[1] / "docs" / "validation.md").read_text(encoding="utf-8")
+    assert "## Calibrated parameters" in page and "studies/calibration_disc.py" in page

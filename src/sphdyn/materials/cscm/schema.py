@@ -144,9 +144,10 @@ class CscmParams(MaterialSection):
         False, description="ITRETRC: the cap may move back towards its initial "
                            "position (never inside it); see docs/cscm.md.")
     rate_thresholds: StrictBool = Field(
-        True, description="With rate_effects: the damage thresholds rise with "
-                          "the dynamic strength ratio (docs/cscm.md, choice "
-                          "[D]); false keeps them static.")
+        False, description="With rate_effects: the damage thresholds rise with "
+                           "the dynamic strength ratio (docs/cscm.md, choice "
+                           "[D]). Not part of MAT_159, so off by default; the "
+                           "decks that switch it on mark it as calibrated.")
     wave_speed: Literal["damaged", "undamaged"] = Field(
         "damaged", description="Wave speed of the time step and of the "
                                "viscosities (artificial, bulk, hourglass): "
