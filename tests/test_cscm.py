@@ -788,8 +788,10 @@ def test_deck_keys_reach_the_parameters():
     from sphdyn.model import build_model
 
     base = (Path(__file__).parent.parent / "examples/disc_impact.toml").read_text()
+    # (the deck sets rate_thresholds = true, marked calibrated; the default is false)
     text = base.replace('model = "cscm"', 'model = "cscm"\ncap_retraction = true\n'
-                        'recovery = 10.5\nrate_thresholds = false')
+                        'recovery = 10.5').replace("rate_thresholds = true",
+                                                   "rate_thresholds = false")
     g = build_model(loads_deck(text)).groups[0]
     assert g.params[mod.P_RETRACT] == 1.0
     assert g.params[mod.P_RECOV] == 0.5 and g.params[mod.P_RECOV_VOL] == 1.0
