@@ -16,13 +16,13 @@ DX = 1e-3
 S = 1.0e6
 
 
-def _indicator(x, h, sig, kernel="cubic_spline", dim=2, m=None):
+def _indicator(x, h, sig, kernel="cubic_spline", dim=2, m=None, tol=None):
     n = x.shape[0]
     kid = kernels.kernel_id(kernel)
     m = np.ones(n) if m is None else m
     nl = build_neighbours(x, h, kernels.support(kid), 0.0, dim)
     out = np.full(n, -1.0)
-    tol = REL_STRESS_TOL * stress_scale(sig, m)
+    tol = REL_STRESS_TOL * stress_scale(sig, m) if tol is None else tol
     swegle_indicator(x, m, h, sig, nl.offsets, nl.idx, kid, kernels.normalisation(kid, dim),
                      dim, 1.0, tol, out)
     return out
@@ -110,6 +110,27 @@ def test_round_off_stress_is_ignored_and_zero_mass_neighbours_skipped():
     s = _indicator(x, h, _uniform(n, sxx=S), m=m)
     assert s[0] == 0.0
     assert s[1:].max() == 1.0
+
+
+def test_round_off_stress_before_any_load_flags_nothing():
+    """Every stress at round-off (micropascals: a body in free flight whose
+    velocities differ in the last bit) and some pairs in tension: the
+    threshold is STRAIN_FLOOR x rho c^2 (here 1e-9 x 2400 x 3600^2 = 31 Pa),
+    not REL_STRESS_TOL of the round-off itself, so nothing is flagged; a
+    real tension of 1 kPa is."""
+    from sphdyn.parts.sph.swegle import STRAIN_FLOOR, stress_tolerance
+
+    x, h = _lattice(n_side=6)
+    n = x.shape[0]
+    m, rho, c = np.ones(n), np.full(n, 2400.0), np.full(n, 3600.0)
+    sig = _uniform(n, sxx=1e-6)
+    tol = stress_tolerance(sig, m, rho, c)
+    assert tol == pytest.approx(STRAIN_FLOOR * 2400.0 * 3600.0 ** 2, rel=1e-15)
+    assert REL_STRESS_TOL * stress_scale(sig, m) < 1e-8  # the relative test alone
+    assert _indicator(x, h, sig, tol=tol).max() == 0.0
+    assert _indicator(x, h, sig, tol=REL_STRESS_TOL * stress_scale(sig, m)).max() > 0.0
+    loaded = _uniform(n, sxx=1e3)
+    assert _indicator(x, h, loaded, tol=stress_tolerance(loaded, m, rho, c)).max() > 0.0
 
 
 DECK = """

@@ -44,7 +44,7 @@ from .artificial_stress import artificial_stress_forces, artificial_stress_tenso
 from .colouring import colour_pairs
 from .passes import (forces, gradient_scratch, stress_terms, update_density_and_h,
                      velocity_gradient, xsph_velocity)
-from .swegle import FLAG_FRACTION, REL_STRESS_TOL, count_unstable, stress_scale, swegle_indicator
+from .swegle import FLAG_FRACTION, count_unstable, stress_tolerance, swegle_indicator
 from .tl_scheme import TotalLagrangian
 
 
@@ -496,7 +496,7 @@ class SPHPart:
         """
         if self._swegle_at != self.step:
             p, nl, k = self.p, self.nl, self.kernel
-            tol = REL_STRESS_TOL * stress_scale(p.sig, p.m)
+            tol = stress_tolerance(p.sig, p.m, p.rho, p.c)
             swegle_indicator(p.x, p.m, p.h, p.sig, nl.offsets, nl.idx, k.kid, k.sigma,
                              self.dim, k.support_scale, tol, p.swegle)
             self.swegle_unstable = int(count_unstable(p.swegle, p.m, FLAG_FRACTION))

@@ -28,7 +28,11 @@ where :math:`N_i` counts the neighbours within the kernel support (zero-mass
 neighbours excluded), :math:`\sigma_{\mathrm{ref}} = \max_k \|\sigma_k\|_F`
 is the largest stress norm of the model and :math:`\tau` =
 :data:`REL_STRESS_TOL` ignores pairs whose normal stress is round-off
-compared with the loading. :math:`s_i = 0`: no pair of the particle is in
+compared with the loading. The threshold is at least
+:data:`STRAIN_FLOOR` times the largest modulus :math:`\rho c^2`
+(:func:`stress_tolerance`): before any load (a body in free flight, all
+stresses round-off) nothing is flagged, where the relative test alone
+flagged hundreds of particles of the disc at stresses of micropascals. :math:`s_i = 0`: no pair of the particle is in
 the unstable regime; :math:`s_i = 1`: all are. A particle is counted as
 *unstable* when :math:`s_i >` :data:`FLAG_FRACTION` (most of its pairs
 unstable). The criterion says nothing about the growth *rate*, which scales
@@ -47,13 +51,17 @@ from numba import njit, prange
 
 from ...kernels import d2wdq2, support_nb
 
-__all__ = ["REL_STRESS_TOL", "FLAG_FRACTION", "stress_scale", "swegle_indicator",
+__all__ = ["REL_STRESS_TOL", "FLAG_FRACTION", "STRAIN_FLOOR", "stress_scale",
+           "stress_tolerance", "swegle_indicator",
            "count_unstable"]
 
 #: Pairs with ``|sigma_n| <= REL_STRESS_TOL * max_k ||sigma_k||_F`` are not flagged.
 REL_STRESS_TOL = 1e-3
 #: A particle is unstable when more than this fraction of its pairs is flagged.
 FLAG_FRACTION = 0.5
+#: Pairs with ``|sigma_n| <= STRAIN_FLOOR * max_k rho_k c_k^2`` are not
+#: flagged either: a stress of a strain of 1e-9 is round-off, not a load.
+STRAIN_FLOOR = 1e-9
 
 
 @njit(cache=True, error_model="numpy")
@@ -70,6 +78,19 @@ def stress_scale(sig, m):
         if s > smax:
             smax = s
     return np.sqrt(smax)
+
+
+@njit(cache=True, error_model="numpy")
+def stress_tolerance(sig, m, rho, c):
+    """The indicator's stress threshold [Pa]: ``max(REL_STRESS_TOL *
+    max_k ||sigma_k||_F, STRAIN_FLOOR * max_k rho_k c_k^2)`` over particles
+    with ``m > 0``; ``sig`` (N, 3, 3) [Pa], ``m`` (N,) [kg], ``rho`` (N,)
+    [kg/m^3], ``c`` (N,) [m/s]."""
+    modulus = 0.0
+    for i in range(m.shape[0]):
+        if m[i] != 0.0 and rho[i] * c[i] * c[i] > modulus:
+            modulus = rho[i] * c[i] * c[i]
+    return max(REL_STRESS_TOL * stress_scale(sig, m), STRAIN_FLOOR * modulus)
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
