@@ -609,20 +609,18 @@ def outside_problem(deck, where: str, what: str, x: np.ndarray,
 
 
 def node_sizes(points: np.ndarray, cells: np.ndarray, kind: str, dim: int) -> np.ndarray:
-    """(N,) [m] the size a wall sees of each node of a solid mesh: the mean
-    of its elements' sizes ``V_e^(1/d)`` (as
-    :func:`~sphdyn.parts.fem.solid_part.node_contact_items`), with ``V_e``
-    the mean corner ``det J`` times ``2^d`` (exact for parallelepipeds);
-    0 for a node of no element."""
+    """(N,) [m] the size a wall sees of each node of a solid mesh
+    (:func:`~sphdyn.parts.fem.solid_part.node_contact_items`: the mean of
+    its elements' sizes ``V_e^(1/d)``), with ``V_e`` the mean corner
+    ``det J`` times ``2^d`` (exact for parallelepipeds); 0 for a node of no
+    element."""
     from .geometry.mesh import element_jacobians
+    from .parts.fem.solid_part import node_contact_items
 
     vol = np.abs(element_jacobians(points, cells, kind).mean(axis=1)) * 2.0 ** dim
-    flat = cells.ravel()
-    n = points.shape[0]
-    count = np.bincount(flat, minlength=n)
-    size = np.bincount(flat, weights=np.repeat(vol ** (1.0 / dim), cells.shape[1]),
-                       minlength=n)
-    return np.divide(size, count, out=np.zeros(n), where=count > 0)
+    zero = np.zeros(vol.shape[0])
+    vol0, _, _ = node_contact_items(cells, vol, zero, zero, points.shape[0], dim)
+    return vol0 ** (1.0 / dim)
 
 
 def mesh_wall_problems(deck, meshes) -> list[str]:
