@@ -52,7 +52,7 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 DECK = ROOT / "examples" / "disc_impact.toml"
 FIGURES = ROOT / "docs" / "figures"
-SPACINGS_MM = (5.0, 4.0, 10.0 / 3.0, 2.5, 2.0, 5.0 / 3.0)
+SPACINGS_MM = (5.0, 4.0, 10.0 / 3.0, 2.5, 2.0, 5.0 / 3.0, 10.0 / 7.0, 1.25)
 IMPACT_SPEED = 15.0            # m/s, the deck's body velocity
 DAMAGE_THRESHOLD = 0.9
 PLATEAU = (10e-6, 50e-6)       # s after first contact
@@ -88,6 +88,7 @@ def measure(out: Path, dx_mm: float) -> dict:
     t, force, impulse = h["time"], h[f"F_wall_{WALL}"], h[f"I_wall_{WALL}"]
     t_contact = t[np.flatnonzero(force > 0)[0]]
     i0, i1 = np.interp(t_contact + np.array(PLATEAU), t, impulse)
+    kinetic = h["E_kinetic"]
     frames = list_frames(out)
     _, _, fields, _ = read_frame(frames[-1])
     m = fields["mass"]
@@ -106,6 +107,9 @@ def measure(out: Path, dx_mm: float) -> dict:
         "end_force_kN": 1e-3 * float(force[-1]),
         "end_velocity_ms": float((m * fields["velocity"][:, 1]).sum() / mass),
         "end_velocity_momentum_ms": -IMPACT_SPEED + float(impulse[-1]) / mass,
+        "absorbed_energy_J": float(kinetic[0] - kinetic[-1]),
+        "internal_energy_J": float(h["E_internal"][-1]),
+        "viscous_energy_J": float(h["E_viscous"][-1]),
         **_damaged("_200us", early),
         **_damaged("_300us", fields),
         "_t": t, "_F": force,
@@ -127,6 +131,9 @@ QUANTITIES = (  # key, label
     ("impulse_Ns", "total impulse at 300 us [N s]"),
     ("end_force_kN", "wall force left at 300 us [kN]"),
     ("end_velocity_ms", "mean body velocity (rebound) at 300 us [m/s]"),
+    ("absorbed_energy_J", "energy absorbed by the disc, KE(0) - KE(300 us) [J]"),
+    ("internal_energy_J", "internal energy at 300 us [J]"),
+    ("viscous_energy_J", "artificial viscosity's dissipation at 300 us [J]"),
     ("damaged_volume_200us_cm3", "damaged volume at 200 us, damage > 0.9 [cm^3]"),
     ("damaged_fraction_200us_pct", "damaged volume fraction at 200 us [%]"),
     ("damaged_volume_300us_cm3", "damaged volume at 300 us, damage > 0.9 [cm^3]"),

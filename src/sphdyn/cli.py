@@ -319,6 +319,13 @@ def cmd_export(args) -> int:
     return 0
 
 
+def cmd_validate(args) -> int:
+    from .validation.runner import validate
+
+    return validate(args.cases, quick=args.quick, out=Path(args.out), root=Path(args.root),
+                    threads=args.threads, reuse=args.reuse, docs=args.docs)
+
+
 def cmd_info(args) -> int:
     import h5py
     import numba
@@ -628,6 +635,22 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("--frame", type=int, help="frame for CSV, Python style: 0 the "
                    "first, -1 the last (default)")
     e.set_defaults(func=cmd_export)
+
+    va = sub.add_parser("validate", help="run the validation cases against measured "
+                        "data (validation/), print the table; --docs writes "
+                        "docs/validation.md")
+    va.add_argument("cases", nargs="*", help="case names (default: all)")
+    va.add_argument("--quick", action="store_true", help="the coarse versions (minutes)")
+    va.add_argument("--out", default="out/validation", help="run folders and results.json")
+    va.add_argument("--root", default=".", help="the sphdyn source tree holding "
+                    "validation/ (default: the current directory)")
+    va.add_argument("--threads", type=_whole(1), default=None,
+                    help="Numba threads per run (default: automatic)")
+    va.add_argument("--reuse", action="store_true", help="measure completed runs again "
+                    "instead of rerunning them")
+    va.add_argument("--docs", action="store_true", help="write the table and figures "
+                    "into docs/validation.md (full versions only)")
+    va.set_defaults(func=cmd_validate)
 
     i = sub.add_parser("info", help="versions, threads, Numba cache")
     i.set_defaults(func=cmd_info)

@@ -166,7 +166,7 @@ def _computed_or(name: str, fallback: Callable[[Any], np.ndarray]) -> Getter:
 
 _BUILT_IN = (
     OutputField("position", "vector", "m", "Current position x.",
-                _array("x"), always=True),
+                _array("x"), always=True, probe=True),
     OutputField("velocity", "vector", "m/s", "Velocity v.",
                 _array("v"), default=True, probe=True),
     OutputField("speed", "scalar", "m/s", "Magnitude of the velocity |v|.",

@@ -1,0 +1,63 @@
+"""The picture a validation case shows beside its numbers: the target's
+mid-section at the run's end, coloured by damage, with the measured depth,
+crater and scab drawn over it (the experiment's outline on the model)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..io.frames import list_frames
+from ..io.hdf5 import read_frame, read_frame_meshes
+
+
+def section_figure(run: Path, case, refs, rows, path: Path) -> None:
+    """Mid-section (a layer one element thick at y >= 0) of the mesh
+    ``case.mesh`` in the last frame of ``run``, damage in colour, particles
+    as dots, and the measured ``dop``, ``crater`` and ``scab`` of ``refs``
+    (with their scatter) as black lines, sphdyn's as red ones; written to
+    ``path`` (PNG). Nothing is drawn for a case without a mesh."""
+    if not getattr(case, "mesh", ""):
+        return
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .cases import block_spacing, resolved_deck
+
+    deck = resolved_deck(run)
+    block = next(m for m in deck["mesh"] if m["name"] == case.mesh)["block"]
+    _, hy, _ = block_spacing(deck, case.mesh)
+    face, back = block["hi"][2], block["lo"][2]
+    last = list_frames(run)[-1]
+    mesh = read_frame_meshes(last)[case.mesh]
+    c = np.asarray(mesh.points)[mesh.cells].mean(axis=1)
+    keep = (c[:, 1] >= 0.0) & (c[:, 1] < hy)
+    t, _, fields, _ = read_frame(last)
+    x = fields["position"]
+    slab = (x[:, 1] >= 0.0) & (x[:, 1] < hy)
+    fig, ax = plt.subplots(figsize=(7.5, 5.2), layout="constrained")
+    art = ax.scatter(1e3 * c[keep, 0], 1e3 * c[keep, 2], c=mesh.cell_data["damage"][keep],
+                     s=6, marker="s", cmap="viridis", vmin=0, vmax=1)
+    ax.scatter(1e3 * x[slab, 0], 1e3 * x[slab, 2], s=2, c="0.3", label="particles")
+    fig.colorbar(art, ax=ax, label="damage")
+    by_key = {r["key"]: r for r in rows}
+    for key, z in (("crater", face), ("scab", back)):
+        if key in by_key:
+            r = by_key[key]
+            ax.plot([-r["measured"] / 2, r["measured"] / 2], [1e3 * z] * 2, "k-", lw=3,
+                    label=f"{key} measured")
+            ax.plot([-r["sphdyn"] / 2, r["sphdyn"] / 2], [1e3 * z + 1.5] * 2, "r-", lw=2,
+                    label=f"{key} sphdyn")
+    if "dop" in by_key:
+        r = by_key["dop"]
+        ax.axhspan(1e3 * face - r["high"], 1e3 * face - r["low"], color="0.85", zorder=0,
+                   label="depth, measured scatter")
+        ax.axhline(1e3 * face - r["measured"], color="k", ls="--", label="depth measured")
+        ax.axhline(1e3 * face - r["sphdyn"], color="r", ls=":", label="depth sphdyn")
+    ax.set(xlabel="x [mm]", ylabel="z [mm]", aspect="equal",
+           title=f"{case.name}: mid-section at {1e6 * t:.0f} us")
+    ax.legend(fontsize=7, loc="lower right")
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

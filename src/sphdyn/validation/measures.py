@@ -1,0 +1,69 @@
+"""What a validation case reads off a finished run, as an experimenter would
+measure it on the specimen.
+
+* :func:`depth_of_penetration`: the deepest point the projectile reached
+  below the target's face, from the history of a ``[[probe]]`` with
+  ``reduce = "min"`` of ``position_<axis>`` over the projectile's set:
+  ``DOP = z_face - min_t min_i z_i + dx / 2`` [m] (a particle's material
+  reaches half a spacing beyond its centre).
+* :func:`lost_face_diameter`: the diameter of the crater (front face) or the
+  scabbed area (rear face) of a solid mesh target, from its last frame. A
+  node of the face counts as lost when no live element holds it (its
+  elements eroded) or when it moved out of the face's plane by more than
+  one element size (a spall or scab piece flying off). The diameter is
+  ``2 (max r_lost + h / 2)`` with ``r`` the node's initial distance from the
+  shot line and ``h`` the element size in the face: the crater's edge lies
+  between the last lost node and the first kept one, so the reading error
+  is +-h/2.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..io.frames import list_frames
+from ..io.hdf5 import read_frame_meshes
+from ..io.history import History
+
+AXES = {"x": 0, "y": 1, "z": 2}
+
+
+def depth_of_penetration(run: Path, probe_set: str, face: float, dx: float,
+                         axis: str = "z") -> float:
+    """Deepest penetration [m] below a face at ``face`` [m] whose outward
+    normal is +``axis``, of the set ``probe_set`` of particles of spacing
+    ``dx`` [m] (module docstring); ``KeyError`` naming the missing column."""
+    column = f"probe_{probe_set}_position_{axis}"
+    h = History.from_csv(Path(run) / "history.csv").as_arrays()
+    if column not in h:
+        raise KeyError(f"{run}: history has no column {column!r}: the deck needs a "
+                       f"[[probe]] of set {probe_set!r}, position_{axis}, reduce = 'min'")
+    return float(face - np.nanmin(h[column]) + 0.5 * dx)
+
+
+def lost_face_diameter(run: Path, mesh: str, face: float, normal: float, h: float,
+                       centre=(0.0, 0.0), axis: str = "z") -> float:
+    """Diameter [m] of the lost area of the mesh face at ``axis = face`` [m]
+    (``normal`` = +1 or -1: the face's outward direction along ``axis``),
+    about the shot line through ``centre`` (its two other coordinates),
+    for a mesh of element size ``h`` [m] in the face (module docstring);
+    0 when no node of the face is lost."""
+    frames = list_frames(Path(run))
+    if not frames:
+        raise FileNotFoundError(f"{run}: no frames to measure")
+    m = read_frame_meshes(frames[-1])[mesh]
+    k = AXES[axis]
+    x = np.asarray(m.points, float)
+    x0 = x - np.asarray(m.point_data["displacement"], float)
+    on_face = np.abs(x0[:, k] - face) < 1e-3 * h
+    held = np.zeros(len(x), bool)
+    held[np.unique(m.cells)] = True
+    moved_out = normal * (x[:, k] - x0[:, k]) > h
+    lost = on_face & (~held | moved_out)
+    if not lost.any():
+        return 0.0
+    others = [i for i in range(3) if i != k]
+    r = np.hypot(x0[lost, others[0]] - centre[0], x0[lost, others[1]] - centre[1])
+    return float(2.0 * (r.max() + 0.5 * h))

@@ -1,0 +1,181 @@
+"""``sphdyn validate`` (issue 53): the verdicts, the measurements read off a
+run, the references read from validation/data, the page it writes and the
+command's errors. The quick cases' numbers are held by
+tests/test_validation_quick.py.
+"""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sphdyn.cli import main
+from sphdyn.geometry.mesh import block_mesh
+from sphdyn.io import MeshFrame
+from sphdyn.io.hdf5 import write_frame
+from sphdyn.validation import cases, data, measures, report
+from sphdyn.validation.cases import Reference
+
+ROOT = Path(__file__).parents[1]
+
+
+def _ref(value=50.0, low=45.0, high=60.0):
+    return Reference("dop", "depth", "mm", value, low, high, "test")
+
+
+@pytest.mark.parametrize("value, word", [
+    (59.0, "agrees"),    # 18 % above the value but inside the measured scatter 45-60
+    (45.5, "agrees"),    # inside the scatter, 9 % low
+    (44.0, "fair"),      # 12 % low and outside the scatter
+    (40.0, "fair"),      # -20 %
+    (37.4, "poor"),      # -25.2 %
+    (62.4, "fair"),      # +24.8 %
+    (62.6, "poor"),      # +25.2 %
+])
+def test_verdict_bands(value, word):
+    """agrees: inside the measured scatter or within 10 %; fair: within 25 %;
+    poor beyond (report module docstring)."""
+    diff, got = report.verdict(_ref(), value)
+    assert got == word
+    assert diff == pytest.approx(100 * (value / 50.0 - 1))
+
+
+def test_verdict_without_scatter_uses_the_ten_percent_band():
+    ref = _ref(100.0, 100.0, 100.0)
+    assert report.verdict(ref, 109.9)[1] == "agrees"
+    assert report.verdict(ref, 90.1)[1] == "agrees"
+    assert report.verdict(ref, 111.0)[1] == "fair"
+
+
+def test_compare_converts_to_the_reference_unit():
+    rows = report.compare([_ref()], {"dop": 0.0513})
+    assert rows[0]["sphdyn"] == pytest.approx(51.3)
+    assert rows[0]["verdict"] == "agrees"
+
+
+def test_leppanen_references_are_the_data_file_s(tmp_path):
+    """The reference values are read from the CSV, not typed in the code: a
+    copy of the data with other numbers gives other references."""
+    refs = {r.key: r for r in cases.CASES["leppanen2004_fragment"].references(
+        ROOT / "validation" / "data")}
+    f = data.read(ROOT / "validation" / "data" / cases.LEPPANEN)
+    shot = f.row(shot="fig8_shot")
+    assert refs["dop"].value == float(shot["dop_max_mm"])
+    assert refs["crater"].value == float(shot["crater_max_mm"])
+    assert refs["dop"].low <= refs["dop"].value <= refs["dop"].high
+    text = (ROOT / "validation" / "data" / cases.LEPPANEN).read_text(encoding="utf-8")
+    (tmp_path / cases.LEPPANEN).write_text(text.replace("1879,1879,54,54,93,93",
+                                                        "1879,1879,61,61,99,99"))
+    moved = {r.key: r for r in cases.CASES["leppanen2004_fragment"].references(tmp_path)}
+    assert (moved["dop"].value, moved["crater"].value) == (61.0, 99.0)
+
+
+def test_every_case_has_its_deck_and_its_data():
+    for case in cases.CASES.values():
+        assert (ROOT / case.deck).is_file(), case.deck
+        refs = case.references(ROOT / "validation" / "data")
+        assert refs and all(r.unit in cases.UNITS for r in refs)
+        assert main(["check", str(ROOT / case.deck)]) == 0
+
+
+def test_depth_of_penetration_from_the_probe_history(tmp_path):
+    """DOP = z_face - min over time of the set's lowest position + dx/2."""
+    (tmp_path / "history.csv").write_text(
+        "time,probe_fragment_position_z\n0,0.005\n1e-5,-0.030\n2e-5,-0.041\n3e-5,-0.039\n")
+    dop = measures.depth_of_penetration(tmp_path, "fragment", face=0.0, dx=0.001)
+    assert dop == pytest.approx(0.041 + 0.0005, rel=1e-12)
+    with pytest.raises(KeyError, match="reduce = 'min'"):
+        measures.depth_of_penetration(tmp_path, "other", face=0.0, dx=0.001)
+
+
+def _frame_with_crater(tmp_path, radius, lift_back=None):
+    """A 40 x 40 x 10 mm block of 1 mm hexahedra whose top-layer elements
+    with centres within ``radius`` of the z axis are eroded (left out of the
+    frame), and whose bottom face nodes within ``lift_back`` moved 1.5 mm
+    down (a scab)."""
+    mesh = block_mesh((-0.02, -0.02, -0.01), (0.02, 0.02, 0.0), (40, 40, 10), 3)
+    pts, cells = np.asarray(mesh.points, float), np.asarray(mesh.cells)
+    c = pts[cells].mean(axis=1)
+    eroded = (c[:, 2] > -0.001) & (np.hypot(c[:, 0], c[:, 1]) < radius)
+    disp = np.zeros_like(pts)
+    if lift_back is not None:
+        back = (np.abs(pts[:, 2] + 0.01) < 1e-9) & (np.hypot(pts[:, 0], pts[:, 1]) < lift_back)
+        disp[back, 2] = -0.0015
+    (tmp_path / "frames").mkdir(exist_ok=True)
+    write_frame(tmp_path / "frames" / "frame_000000.h5", 1e-4, 10,
+                {"position": np.zeros((1, 3))},
+                meshes={"block": MeshFrame(points=pts + disp, cells=cells[~eroded], kind="hex8",
+                                           point_data={"displacement": disp},
+                                           cell_data={"damage": np.zeros((~eroded).sum())})})
+    return eroded
+
+
+def test_crater_diameter_from_the_nodes_no_element_holds(tmp_path):
+    """Top-layer elements eroded within r = 5.2 mm: the nodes no live element
+    holds lie within 5 mm (whole elements of 1 mm), so the diameter is
+    2 (r_max + h/2) with r_max the farthest such node."""
+    _frame_with_crater(tmp_path, 0.0052)
+    d = measures.lost_face_diameter(tmp_path, "block", face=0.0, normal=1.0, h=0.001)
+    # orphan nodes: those whose four top elements (centres at +-0.5 mm) all eroded
+    nodes = np.array([(x, y) for x in np.arange(-20, 21) for y in np.arange(-20, 21)], float)
+    corners = [(0.5, 0.5), (0.5, -0.5), (-0.5, 0.5), (-0.5, -0.5)]
+    orphan = np.all([np.hypot(nodes[:, 0] + a, nodes[:, 1] + b) < 5.2 for a, b in corners],
+                    axis=0)
+    expected = 2e-3 * (np.hypot(*nodes[orphan].T).max() + 0.5)
+    assert d == pytest.approx(expected, rel=1e-12)
+    assert 0.0095 < d < 0.0115  # about the eroded 10.4 mm, within one element
+    assert measures.lost_face_diameter(tmp_path, "block", face=-0.01, normal=-1.0,
+                                       h=0.001) == 0.0  # the back face is whole
+
+
+def test_scab_diameter_from_the_nodes_moved_out(tmp_path):
+    """Back-face nodes within 6.5 mm moved 1.5 mm out (more than one element,
+    1 mm): the scab's diameter is 2 (r_max + h/2), r_max the farthest moved
+    node; read with the wrong normal (a move inwards) nothing counts."""
+    _frame_with_crater(tmp_path, 0.0, lift_back=0.0065)
+    d = measures.lost_face_diameter(tmp_path, "block", face=-0.01, normal=-1.0, h=0.001)
+    r_max = max(np.hypot(x, y) for x in range(-7, 8) for y in range(-7, 8)
+                if np.hypot(x, y) < 6.5)
+    assert d == pytest.approx(2e-3 * (r_max + 0.5), rel=1e-12)
+    assert measures.lost_face_diameter(tmp_path, "block", face=-0.01, normal=1.0,
+                                       h=0.001) == 0.0
+
+
+def test_page_block_is_replaced_between_its_markers(tmp_path):
+    page = tmp_path / "v.md"
+    page.write_text(f"intro\n{report.BEGIN}\nold\n{report.END}\nafter\n")
+    report.update_page(page, "new table")
+    assert page.read_text() == f"intro\n{report.BEGIN}\nnew table\n{report.END}\nafter\n"
+    (tmp_path / "w.md").write_text("no markers\n")
+    with pytest.raises(ValueError, match="no"):
+        report.update_page(tmp_path / "w.md", "x")
+
+
+def test_the_docs_page_has_the_generated_block():
+    text = (ROOT / "docs" / "validation.md").read_text(encoding="utf-8")
+    assert text.count(report.BEGIN) == 1 and text.count(report.END) == 1
+
+
+def test_table_marks_estimates_and_stopped_runs():
+    row = report.compare([Reference("dop", "depth", "mm", 10.0, 10.0, 10.0, "NDRC",
+                                    kind="estimate")], {"dop": 0.012})
+    text = report.table_markdown([
+        {"case": "a", "status": "completed", "rows": row},
+        {"case": "b", "status": "stopped", "rows": []}])
+    assert "10 (estimate) | 12 | +20 % | fair" in text
+    assert "| b | run stopped | | | | not compared |" in text
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["validate", "nope"], "unknown validation case(s) nope"),
+    (["validate", "--quick", "--docs"], "drop --quick"),
+])
+def test_validate_errors(argv, message, capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    assert main(argv) == 2
+    assert message in capsys.readouterr().err
+
+
+def test_validate_outside_the_source_tree_says_where(tmp_path, capsys):
+    assert main(["validate", "--root", str(tmp_path)]) == 2
+    assert "no validation/data/ folder" in capsys.readouterr().err
