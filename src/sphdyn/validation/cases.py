@@ -18,7 +18,8 @@ from pathlib import Path
 from typing import Callable
 
 from . import data
-from .measures import depth_of_penetration, lost_face_diameter
+from .figures import deflection_figure, section_figure
+from .measures import depth_of_penetration, largest_deflection, lost_face_diameter
 
 
 @dataclass(frozen=True)
@@ -47,12 +48,13 @@ class Case:
     quick: tuple[str, ...]
     references: Callable[[Path], list[Reference]]
     measure: Callable[[Path, dict], dict[str, float]]
+    overrides: tuple[str, ...] = ()
     mesh: str = ""
-    note: str = ""
+    figure: Callable[..., None] = section_figure
 
 
 #: display unit -> factor from SI
-UNITS = {"mm": 1e3, "m/s": 1.0, "kN": 1e-3, "J": 1.0}
+UNITS = {"mm": 1e3, "ms": 1e3, "m/s": 1.0, "kN": 1e-3, "J": 1.0}
 
 
 def resolved_deck(run: Path) -> dict:
@@ -100,6 +102,39 @@ def _leppanen_measure(run: Path, deck: dict) -> dict[str, float]:
             "crater": lost_face_diameter(run, "block", face=0.0, normal=1.0, h=hx)}
 
 
+# --------------------------------------------------------------------------
+# Lozano Mendoza & Makdesi Aphram (2017): drop weight on small RC beams
+# --------------------------------------------------------------------------
+
+LOZANO = "lozano2017_dropweight_rc_beams.csv"
+LOZANO_HISTORY = "lozano2017_dropweight_deflection_history.csv"
+
+
+def _series_rows(data_dir: Path, series: str) -> list[dict[str, str]]:
+    return [r for r in data.read(data_dir / LOZANO).rows if r["series"] == series]
+
+
+def _lozano_references(series: str):
+    def references(data_dir: Path) -> list[Reference]:
+        rows = _series_rows(data_dir, series)
+        where = (f"{LOZANO}: mean of the {len(rows)} beams of Series {series} "
+                 "(Tables 9.1/9.2, 9.5/9.6)")
+        scatter = f"beams {', '.join(r['beam_id'] for r in rows)}"
+        out = []
+        for key, label, column in (("umax", "largest mid-span deflection", "umax_mm"),
+                                   ("t_umax", "time of the largest deflection", "t_umax_ms")):
+            v = [data.number(r, column) for r in rows]
+            out.append(Reference(key, label, "mm" if key == "umax" else "ms",
+                                 sum(v) / len(v), min(v), max(v), where, scatter=scatter))
+        return out
+    return references
+
+
+def _lozano_measure(run: Path, deck: dict) -> dict[str, float]:
+    u, t = largest_deflection(run, "midspan", "rod")
+    return {"umax": u, "t_umax": t}
+
+
 CASES: dict[str, Case] = {}
 
 
@@ -120,3 +155,19 @@ register(Case(
     measure=_leppanen_measure,
     mesh="block",
 ))
+
+
+for _series, _height, _v in (("1", "2.5", None), ("2", "5.0", 9.8)):
+    register(Case(
+        name=f"lozano2017_dropweight_{_height}m",
+        title=(f"10.1 kg drop weight from {_height} m on a 100 x 100 mm RC beam "
+               "(Lozano Mendoza & Makdesi Aphram 2017)"),
+        deck="validation/cases/lozano2017_dropweight.toml",
+        overrides=() if _v is None else (f"body.rod.velocity.2={-_v!r}",),
+        quick=("body.beam.dx=0.01", "body.rod.dx=0.01",
+               "material.rod_steel.density=7470.4",  # 10.1 kg in 1352 particles
+               *(f"mesh.bar_{b}.line.element_length=0.01" for b in ("b1", "b2", "t1", "t2"))),
+        references=_lozano_references(_series),
+        measure=_lozano_measure,
+        figure=deflection_figure,
+    ))

@@ -12,11 +12,11 @@ from ..io.frames import list_frames
 from ..io.hdf5 import read_frame, read_frame_meshes
 
 
-def section_figure(run: Path, case, refs, rows, path: Path) -> None:
+def section_figure(run: Path, case, rows, path: Path, data_dir: Path) -> None:
     """Mid-section (a layer one element thick at y >= 0) of the mesh
     ``case.mesh`` in the last frame of ``run``, damage in colour, particles
-    as dots, and the measured ``dop``, ``crater`` and ``scab`` of ``refs``
-    (with their scatter) as black lines, sphdyn's as red ones; written to
+    as dots, and the measured ``dop``, ``crater`` and ``scab`` of ``rows``
+    (the compared rows, with their scatter) as black lines, sphdyn's as red ones; written to
     ``path`` (PNG). Nothing is drawn for a case without a mesh."""
     if not getattr(case, "mesh", ""):
         return
@@ -59,5 +59,39 @@ def section_figure(run: Path, case, refs, rows, path: Path) -> None:
     ax.set(xlabel="x [mm]", ylabel="z [mm]", aspect="equal",
            title=f"{case.name}: mid-section at {1e6 * t:.0f} us")
     ax.legend(fontsize=7, loc="lower right")
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def deflection_figure(run: Path, case, rows, path: Path, data_dir: Path) -> None:
+    """Mid-span deflection against time after the contact's start: sphdyn's
+    (the ``midspan`` probe) as a line, every beam of the case's series from
+    ``lozano2017_dropweight_deflection_history.csv`` as points (their
+    printed maxima filled); written to ``path`` (PNG)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from . import data
+    from .measures import deflection_history
+
+    t, u = deflection_history(run, "midspan", "rod")
+    height = case.name.rsplit("_", 1)[-1].rstrip("m")
+    table = data.read(data_dir / "lozano2017_dropweight_deflection_history.csv")
+    fig, ax = plt.subplots(figsize=(7.5, 4.6), layout="constrained")
+    beams = sorted({r["beam_id"] for r in table.rows if r["drop_height_m"] == height})
+    for k, beam in enumerate(beams):
+        pts = [r for r in table.rows if r["beam_id"] == beam]
+        tt = [data.number(r, "t_ms") for r in pts]
+        uu = [data.number(r, "u_mm") for r in pts]
+        ax.plot(tt, uu, "o", ms=4, mfc="none", color=f"C{k % 10}",
+                label=f"{beam} (measured)")
+        peak = [i for i, r in enumerate(pts) if r["is_max"] == "1"]
+        ax.plot([tt[i] for i in peak], [uu[i] for i in peak], "o", ms=5, color=f"C{k % 10}")
+    ax.plot(1e3 * t, 1e3 * u, "k-", lw=2, label="sphdyn")
+    ax.set(xlabel="time after impact [ms]", ylabel="mid-span deflection [mm]",
+           title=f"{case.name}: mid-span deflection")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
     fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -15,6 +15,11 @@ measure it on the specimen.
   shot line and ``h`` the element size in the face: the crater's edge lies
   between the last lost node and the first kept one, so the reading error
   is +-h/2.
+* :func:`largest_deflection`: the largest mid-span deflection and its time
+  after the impact, from the mean vertical displacement of a mid-span set
+  (a probe) and the impactor's mean velocity (a probe): the contact starts
+  at the first record where the impactor has lost more than
+  :data:`CONTACT_DROP` of its speed.
 """
 
 from __future__ import annotations
@@ -28,6 +33,8 @@ from ..io.hdf5 import read_frame_meshes
 from ..io.history import History
 
 AXES = {"x": 0, "y": 1, "z": 2}
+#: the impactor's relative loss of speed that marks the contact's start
+CONTACT_DROP = 0.002
 
 
 def depth_of_penetration(run: Path, probe_set: str, face: float, dx: float,
@@ -67,3 +74,28 @@ def lost_face_diameter(run: Path, mesh: str, face: float, normal: float, h: floa
     others = [i for i in range(3) if i != k]
     r = np.hypot(x0[lost, others[0]] - centre[0], x0[lost, others[1]] - centre[1])
     return float(2.0 * (r.max() + 0.5 * h))
+
+
+def deflection_history(run: Path, midspan: str, impactor: str, axis: str = "z"
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """(time after the contact's start [s], deflection [m], positive
+    downwards along -``axis``) from the probes ``probe_<midspan>_displacement_<axis>``
+    and ``probe_<impactor>_velocity_<axis>`` (module docstring); records
+    before the contact are dropped."""
+    h = History.from_csv(Path(run) / "history.csv").as_arrays()
+    t = h["time"]
+    v = np.abs(h[f"probe_{impactor}_velocity_{axis}"])
+    started = np.flatnonzero(v < (1.0 - CONTACT_DROP) * v[0])
+    if not started.size:
+        raise ValueError(f"{run}: the impactor {impactor!r} never slowed down: no contact")
+    i0 = started[0]
+    return t[i0:] - t[i0], -h[f"probe_{midspan}_displacement_{axis}"][i0:]
+
+
+def largest_deflection(run: Path, midspan: str, impactor: str, axis: str = "z"
+                       ) -> tuple[float, float]:
+    """(largest deflection [m], its time after the contact's start [s])
+    (:func:`deflection_history`)."""
+    t, u = deflection_history(run, midspan, impactor, axis)
+    k = int(np.argmax(u))
+    return float(u[k]), float(t[k])

@@ -16,7 +16,6 @@ import sys
 from pathlib import Path
 
 from .cases import CASES, Case, resolved_deck
-from .figures import section_figure
 from .report import compare
 
 
@@ -48,7 +47,7 @@ def run_case(case: Case, root: Path, out: Path, quick: bool, threads: int | None
     if not (reuse and completed(run)):
         cmd = [sys.executable, "-m", "sphdyn", "run", str(root / case.deck), "--out",
                str(run), "-q"]
-        for override in case.quick if quick else ():
+        for override in case.overrides + (case.quick if quick else ()):
             cmd += ["--set", override]
         if threads:
             cmd += ["--threads", str(threads)]
@@ -57,7 +56,7 @@ def run_case(case: Case, root: Path, out: Path, quick: bool, threads: int | None
     summary = json.loads(summary_path.read_text()) if summary_path.is_file() else \
         {"status": "failed", "diagnosis": "no summary.json: the run did not start"}
     result = {"case": case.name, "title": case.title, "quick": quick,
-              "deck": case.deck, "overrides": list(case.quick if quick else ()),
+              "deck": case.deck, "overrides": list(case.overrides + (case.quick if quick else ())),
               "status": summary["status"], "diagnosis": summary.get("diagnosis"),
               "wall_seconds": summary.get("wall_seconds"), "steps": summary.get("steps"),
               "items": summary.get("items"), "run": str(run),
@@ -66,7 +65,8 @@ def run_case(case: Case, root: Path, out: Path, quick: bool, threads: int | None
         refs = case.references(root / "validation" / "data")
         values = case.measure(run, resolved_deck(run))
         result["rows"] = compare(refs, values)
-        section_figure(run, case, refs, result["rows"], run / "validation.png")
+        case.figure(run, case, result["rows"], run / "validation.png",
+                    root / "validation" / "data")
     return result
 
 
