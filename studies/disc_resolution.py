@@ -148,18 +148,45 @@ def _relative_change_pct(coarse: float, fine: float) -> float:
     return 100.0 * (fine / coarse - 1.0)
 
 
+def richardson(h, f) -> tuple[float, float] | None:
+    """Richardson extrapolation from the three finest spacings: (f0, p) with
+    ``f = f0 + C h^p`` through the three points (h may be unevenly spaced:
+    p solves ``(f2 - f1) / (f3 - f2) = (h2^p - h1^p) / (h3^p - h2^p)``,
+    h1 < h2 < h3); None unless the values change monotonically and by less
+    at the finer step (converging), or p falls outside 0.25-8."""
+    from scipy.optimize import brentq
+
+    (h1, f1), (h2, f2), (h3, f3) = sorted(zip(h, f))[:3]
+    d21, d32 = f2 - f1, f3 - f2
+    if d21 == 0.0 or d32 == 0.0 or (d21 > 0) != (d32 > 0):
+        return None
+
+    def gap(p):
+        return (h2**p - h1**p) / (h3**p - h2**p) - d21 / d32
+
+    try:
+        p = brentq(gap, 0.25, 8.0)
+    except ValueError:  # no root: not converging at an order in range
+        return None
+    return f1 - d21 * h1**p / (h2**p - h1**p), p
+
+
 def table_rows(results: list[dict]) -> list[dict]:
-    """One row per quantity: its value per spacing and the relative change
-    between the two finest spacings."""
+    """One row per quantity: its value per spacing, the relative change
+    between the two finest spacings and the Richardson estimate (where the
+    three finest are monotone and converging)."""
     rows = []
+    h = [r["dx_mm"] for r in results]
     for key, label in QUANTITIES:
         values = [r[key] for r in results]
         change = _relative_change_pct(values[-2], values[-1]) if len(values) > 1 \
             else float("nan")
+        extrapolated = richardson(h, values) if len(values) > 2 else None
         rows.append({"quantity": label, **{f"dx={r['dx_mm']:.3g} mm": v
                                            for r, v in zip(results, values)},
                      "change_finest_pct": change,
-                     "converged": abs(change) < CONVERGED_PCT})
+                     "converged": abs(change) < CONVERGED_PCT,
+                     "richardson": extrapolated})
     return rows
 
 
@@ -181,12 +208,15 @@ def print_table(results: list[dict], rows: list[dict]) -> None:
         print(f"| {r['dx_mm']:.3g} | {r['particles']} | {r['steps']} | {r['seconds']:.0f} |")
     heads = [k for k in rows[0] if k.startswith("dx=")]
     print()
-    print("| quantity | " + " | ".join(heads) + " | change between the two finest | converged |")
-    print("|---|" + "---|" * len(heads) + "---|---|")
+    print("| quantity | " + " | ".join(heads) + " | change between the two finest | "
+          "converged | Richardson (order) |")
+    print("|---|" + "---|" * len(heads) + "---|---|---|")
     for row in rows:
         vals = " | ".join(f"{row[h]:.4g}" for h in heads)
+        rich = row["richardson"]
+        rich = f"{rich[0]:.4g} ({rich[1]:.2g})" if rich else "not monotone"
         print(f"| {row['quantity']} | {vals} | {row['change_finest_pct']:+.1f} % | "
-              f"{'yes' if row['converged'] else 'no'} |")
+              f"{'yes' if row['converged'] else 'no'} | {rich} |")
 
 
 def plot(results: list[dict], path: Path) -> None:

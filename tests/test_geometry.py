@@ -545,3 +545,84 @@ def test_tilted_cylinder_lattice_and_its_preflight_depth():
     tip = rotate_about(np.array([[0.25, 0.25, 0.2 + 0.034]]), c, "y", 30.0)
     assert depth_inside(g, tip, 3)[0] == pytest.approx(0.001, abs=1e-12)
     assert depth_inside(g, np.array([[0.25, 0.25, 0.234]]), 3)[0] < 0  # upright tip
+
+
+# --------------------------------------------------------------------------
+# ogive projectile
+# --------------------------------------------------------------------------
+def test_ogive_profile_is_tangent_to_the_shank_and_closes_at_the_tip():
+    """r(0) = 0, r(l_n) = a with zero slope (tangent ogive), a behind; the
+    nose length a sqrt(4 psi - 1); psi = 0.5 is a hemisphere of radius a."""
+    from sphdyn.geometry.lattice import ogive_nose_length, ogive_profile
+
+    a, psi = 0.01345, 2.0
+    ln = ogive_nose_length(a, psi)
+    assert ln == pytest.approx(a * np.sqrt(7.0), rel=1e-14)
+    assert ogive_profile(0.0, a, psi) == pytest.approx(0.0, abs=1e-15)
+    assert ogive_profile(ln, a, psi) == pytest.approx(a, rel=1e-14)
+    eps = 1e-7 * ln
+    slope = (ogive_profile(ln, a, psi) - ogive_profile(ln - eps, a, psi)) / eps
+    assert abs(slope) < 1e-5
+    assert ogive_profile(2 * ln, a, psi) == a and ogive_profile(-1e-3, a, psi) == 0.0
+    z = np.linspace(0, a, 11)
+    hemisphere = ogive_profile(z, a, 0.5)
+    assert hemisphere == pytest.approx(np.sqrt(a**2 - (a - z) ** 2), abs=1e-15)
+
+
+def test_ogive_volume_against_closed_forms():
+    """A hemispherical nose (psi = 0.5) on a shank: 2/3 pi a^3 + pi a^2 (L - a),
+    to round-off."""
+    from sphdyn.geometry.lattice import ogive_volume
+
+    a, length = 0.02, 0.1
+    exact = 2.0 / 3.0 * np.pi * a**3 + np.pi * a**2 * (length - a)
+    assert ogive_volume(a, length, 0.5) == pytest.approx(exact, rel=1e-13)
+
+
+@pytest.mark.parametrize("nose", ["-z", "+x", "-y"])
+def test_ogive_lattice_fills_the_projectile(nose):
+    """The particles fill the projectile's volume to within 3 % at 10 across
+    (the staircase of a round section), lie behind the tip along the nose
+    direction, within the profile, and the nose narrows towards the tip."""
+    from sphdyn.geometry.lattice import ogive_lattice, ogive_profile, ogive_volume
+
+    a, length, psi, dx = 0.01345, 0.2424, 2.0, 0.00269
+    tip = np.array([0.1, -0.2, 0.3])
+    x = ogive_lattice(tip, a, length, psi, dx, 3, nose=nose)
+    assert len(x) * dx**3 == pytest.approx(ogive_volume(a, length, psi), rel=0.03)
+    ax, sign = "xyz".index(nose[1]), (1.0 if nose[0] == "+" else -1.0)
+    zeta = sign * (tip[ax] - x[:, ax])
+    assert zeta.min() > 0 and zeta.max() < length
+    r = np.hypot(*(x[:, k] - tip[k] for k in range(3) if k != ax))
+    assert np.all(r <= ogive_profile(zeta, a, psi) + 1e-12)
+    near_tip, shank = r[zeta < 0.01], r[zeta > 0.05]
+    assert near_tip.max() < 0.6 * shank.max()
+
+
+def test_ogive_deck_shape_and_its_errors():
+    from sphdyn.deck import DeckError, loads_deck
+
+    base = """
+[run]
+dimension = {dim}
+t_end = "1 us"
+[[material]]
+name = "steel"
+model = "elastic"
+density = "7850 kg/m^3"
+E = "200 GPa"
+nu = 0.3
+[[body]]
+name = "p"
+material = "steel"
+dx = "2.69 mm"
+geometry = {{ shape = "ogive", tip = [0, 0, 0], radius = "13.45 mm", length = "{length}", crh = {crh} }}
+"""
+    deck = loads_deck(base.format(dim=3, length="242.4 mm", crh=2))
+    assert deck.body[0].geometry.nose == "-z"
+    with pytest.raises(DeckError, match="longer than the projectile"):
+        loads_deck(base.format(dim=3, length="30 mm", crh=2))
+    with pytest.raises(DeckError, match="crh"):
+        loads_deck(base.format(dim=3, length="242.4 mm", crh=0.3))
+    with pytest.raises(DeckError, match="3D shape"):
+        loads_deck(base.format(dim=2, length="242.4 mm", crh=2))

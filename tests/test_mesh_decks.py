@@ -561,3 +561,33 @@ point = [0.45, 0.05, 0.05]
         bar_deck(source=source, extra=extra.replace('body = "bar"', 'body = "rod"', 1))
     with pytest.raises(DeckError, match="there is no body named 'bar'"):
         bar_deck(extra=extra)  # without [mesh.convert] the mesh makes no particles
+
+
+def test_empty_particle_set_is_refused(tmp_path, capsys):
+    """A [[set]] whose region holds no particle centre (here a 5 mm slice
+    between two rows of particles 10 mm apart) is refused before the run: a
+    probe on it recorded NaN for the whole run, a boundary on it did nothing."""
+    text = """
+[run]
+dimension = 2
+t_end = "1 us"
+[[material]]
+name = "steel"
+model = "elastic"
+density = "7850 kg/m^3"
+E = "200 GPa"
+nu = 0.3
+[[body]]
+name = "plate"
+material = "steel"
+dx = "10 mm"
+geometry = { shape = "box", lo = [0, 0, 0], hi = ["100 mm", "20 mm", 0] }
+[[set]]
+name = "mid"
+body = "plate"
+region = { shape = "box", lo = ["46 mm", -1, -1], hi = ["54 mm", 1, 1] }
+[[probe]]
+set = "mid"
+quantities = ["displacement_y"]
+"""
+    _bad(tmp_path, text, "set[0] 'mid'", ["holds no particle of body 'plate'"], capsys)

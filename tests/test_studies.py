@@ -42,3 +42,18 @@ def test_zero_crossings_of_a_sine():
     t = np.linspace(0.0, 2.3, 2001)
     tz = fb.zero_crossings(t, np.sin(2 * math.pi * t))
     assert tz == pytest.approx([0.5, 1.0, 1.5, 2.0], abs=1e-5)
+
+
+def test_richardson_of_the_disc_study():
+    """Richardson's extrapolation recovers f0 and the order of
+    f = f0 + C h^p exactly (to round-off) on uneven spacings, and refuses
+    values that are not monotone or that diverge."""
+    import disc_resolution as dr
+
+    for p in (1.0, 1.5, 2.0):
+        h = [1.25, 10 / 7, 5 / 3, 2.0]
+        f0, order = dr.richardson(h, [7.0 - 0.4 * x**p for x in h])
+        assert f0 == pytest.approx(7.0, rel=1e-9) and order == pytest.approx(p, rel=1e-6)
+    assert dr.richardson([1, 2, 3], [1.0, 2.0, 1.0]) is None  # not monotone
+    assert dr.richardson([1, 2, 3], [1.0, 1.1, 3.0]) is not None  # converging
+    assert dr.richardson([1, 2, 3], [1.0, 3.0, 3.1]) is None  # diverging with refinement

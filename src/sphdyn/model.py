@@ -313,6 +313,13 @@ def build_model(deck) -> Model:
         region = None if s.region is None else s.region.model_dump()
         sel = select(particles.x[cand], region, dim)
         sets[s.name] = cand[sel].astype(np.int64)
+        if not sets[s.name].size:
+            where = f"body '{s.body}'" if s.body is not None else "the model"
+            raise DeckError([format_problem(
+                f"set[{k}] '{s.name}'", f"the set holds no particle of {where}",
+                "enlarge the region (particles are selected by their initial "
+                "centres, which lie half a spacing inside a body's faces; a box "
+                "must contain them, edges included), or check the body")])
     for k, load in enumerate(deck.load):  # refused here, so that check refuses them
         if load.pressure is not None:
             pressure_faces(meshes, mesh_sets, load.set, f"load[{k}].set")

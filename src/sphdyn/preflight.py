@@ -29,7 +29,7 @@ import numpy as np
 
 from .deck import DeckError
 from .deck.errors import format_problem
-from .geometry.lattice import polygon_area, rotate_about
+from .geometry.lattice import ogive_profile, ogive_volume, polygon_area, rotate_about
 
 #: Bytes of per-particle state and work arrays (besides history variables and
 #: neighbour lists): about 850 measured for block3d at 1M particles
@@ -115,6 +115,8 @@ def shape_volume(geometry, dim: int) -> float:
         return ball_volume(g.radius, dim)
     if g.shape == "prism":
         return prism_volume(g, dim)
+    if g.shape == "ogive":
+        return ogive_volume(g.radius, g.length, g.crh)
     outer = g.radius if g.shape == "cylinder" else g.outer_radius
     inner = 0.0 if g.shape == "cylinder" else g.inner_radius
     area = ball_volume(outer, 2) - ball_volume(inner, 2)
@@ -138,6 +140,13 @@ def depth_inside(geometry, x: np.ndarray, dim: int) -> np.ndarray:
     if g.shape == "box":
         lo, hi = np.asarray(g.lo)[:dim], np.asarray(g.hi)[:dim]
         return np.min(np.minimum(x[:, :dim] - lo, hi - x[:, :dim]), axis=1)
+    if g.shape == "ogive":  # distance to the axis' profile, the tip and the tail
+        ax, sign = "xyz".index(g.nose[1]), (1.0 if g.nose[0] == "+" else -1.0)
+        zeta = sign * (g.tip[ax] - x[:, ax])
+        rel = x - np.asarray(g.tip)
+        r = np.hypot(*(rel[:, a] for a in range(3) if a != ax))
+        return np.minimum(np.minimum(ogive_profile(zeta, g.radius, g.crh) - r, zeta),
+                          g.length - zeta)
     if getattr(g, "tilt", None):  # into the upright cylinder's frame
         x = rotate_about(x, g.centre, g.tilt_axis, -g.tilt)
     rel = x - np.asarray(g.centre)

@@ -119,7 +119,8 @@ def member_extents(geometry, dim: int) -> tuple[float, float]:
     """(thickness, longest extent) [m] of a body geometry.
 
     The thickness is taken across its thinnest direction: box: its smallest
-    side in the run's ``dim`` dimensions; sphere: its diameter; cylinder:
+    side in the run's ``dim`` dimensions; sphere: its diameter; ogive: its
+    shank's diameter (its length the longest extent); cylinder:
     its diameter (and its length in 3D, the smaller); ring: its wall, outer
     - inner radius (the diameter if inner = 0; and the length in 3D); prism:
     the polygon's smallest wall thickness (:func:`_polygon_thickness`; and
@@ -132,6 +133,8 @@ def member_extents(geometry, dim: int) -> tuple[float, float]:
         return float(min(sides)), float(max(sides))
     if g.shape == "sphere":
         return 2.0 * g.radius, 2.0 * g.radius
+    if g.shape == "ogive":
+        return 2.0 * g.radius, max(2.0 * g.radius, g.length)
     if g.shape == "cylinder":
         across = span = 2.0 * g.radius
     elif g.shape == "ring":

@@ -37,6 +37,10 @@ __all__ = [
     "rotate_about",
     "sphere_lattice",
     "prism_lattice",
+    "ogive_lattice",
+    "ogive_nose_length",
+    "ogive_profile",
+    "ogive_volume",
     "polygon_area",
     "polygon_contains",
     "lattice_from_shape",
@@ -424,6 +428,92 @@ def prism_lattice(points, dx: float, dim: int, axis="z", base: float = 0.0,
     return x[keep]
 
 
+NOSES = ("+x", "-x", "+y", "-y", "+z", "-z")
+
+
+def ogive_nose_length(radius: float, crh: float) -> float:
+    """Length [m] of a tangent-ogive nose of shank radius ``radius`` [m] and
+    calibre-radius-head ``crh`` (psi = s / (2 a), s the ogive's arc radius):
+    ``l_n = a sqrt(4 psi - 1)`` (Forrestal et al. 1994's geometry)."""
+    return float(radius) * np.sqrt(4.0 * float(crh) - 1.0)
+
+
+def ogive_profile(zeta, radius: float, crh: float) -> np.ndarray:
+    """Radius [m] of a tangent-ogive projectile at distance ``zeta`` [m] from
+    its tip (array): ``r = sqrt(s^2 - (l_n - zeta)^2) - (s - a)`` on the nose
+    (0 <= zeta <= l_n: 0 at the tip, ``a`` where the arc meets the shank
+    tangentially), ``a`` behind it, with ``s = 2 psi a``; 0 ahead of the tip."""
+    a, s = float(radius), 2.0 * float(crh) * float(radius)
+    ln = ogive_nose_length(a, crh)
+    z = np.asarray(zeta, float)
+    nose = np.sqrt(np.maximum(s * s - (ln - np.clip(z, 0.0, ln)) ** 2, 0.0)) - (s - a)
+    return np.where(z < 0.0, 0.0, np.where(z < ln, np.maximum(nose, 0.0), a))
+
+
+def ogive_volume(radius: float, length: float, crh: float) -> float:
+    """Volume [m^3] of the tangent-ogive projectile: the nose's
+    ``pi int_0^l_n r(zeta)^2 dzeta`` (Gauss-Legendre, 64 points: exact to
+    round-off for this smooth profile) and a cylinder behind it."""
+    ln = ogive_nose_length(radius, crh)
+    t, w = np.polynomial.legendre.leggauss(64)
+    z = 0.5 * ln * (t + 1.0)
+    nose = np.pi * 0.5 * ln * float(np.sum(w * ogive_profile(z, radius, crh) ** 2))
+    return nose + np.pi * float(radius) ** 2 * (float(length) - ln)
+
+
+def ogive_lattice(tip, radius: float, length: float, crh: float, dx: float, dim: int,
+                  *, nose: str = "-z") -> np.ndarray:
+    """Particles filling a projectile: a circular cylinder with a tangent-ogive
+    nose (3D only), the shape of Forrestal et al.'s penetration tests.
+
+    The grid is :func:`cylinder_lattice`'s (``round(2 radius / dx)`` points
+    across, ``round(length / dx)`` layers) over the projectile's length; a
+    point is kept when its distance from the axis is at most
+    :func:`ogive_profile` at its distance from the tip.
+
+    Parameters
+    ----------
+    tip : array_like, (3,)
+        The nose's tip [m].
+    radius : float
+        Shank radius a [m].
+    length : float
+        Overall length from the tip to the tail [m], at least the nose's
+        ``a sqrt(4 crh - 1)``.
+    crh : float
+        Calibre-radius-head psi >= 0.5 (0.5: a hemispherical nose).
+    dx : float
+        Particle spacing [m].
+    dim : 3
+    nose : {"+x", "-x", "+y", "-y", "+z", "-z"}
+        The direction the nose points (the direction of flight).
+
+    Returns
+    -------
+    x : (n, 3) float64
+        Positions [m]; nominal volume per particle ``dx**3``.
+    """
+    if int(dim) != 3:
+        raise ValueError("an ogive projectile is a 3D shape")
+    if nose not in NOSES:
+        raise ValueError(f"nose must be one of {', '.join(NOSES)}, got {nose!r}")
+    a, length, crh = _positive("radius", radius), _positive("length", length), float(crh)
+    if not (np.isfinite(crh) and crh >= 0.5):
+        raise ValueError(f"crh must be at least 0.5 (a hemispherical nose), got {crh!r}")
+    if ogive_nose_length(a, crh) > length * (1.0 + _RTOL):
+        raise ValueError(f"the nose ({ogive_nose_length(a, crh):g} m long) is longer than "
+                         f"the projectile ({length:g} m)")
+    ax, sign = _axis_index(nose[1]), (1.0 if nose[0] == "+" else -1.0)
+    t = _point(tip, 3, "tip")
+    centre = t.copy()
+    centre[ax] -= sign * 0.5 * length
+    x = _radial_lattice(centre, -np.inf, a, length, nose[1], dx, 3, "centre")
+    zeta = sign * (t[ax] - x[:, ax])
+    perp = [k for k in range(3) if k != ax]
+    r = np.hypot(x[:, perp[0]] - t[perp[0]], x[:, perp[1]] - t[perp[1]])
+    return x[r <= ogive_profile(zeta, a, crh) * (1.0 + _RTOL) + _RTOL * dx]
+
+
 # --------------------------------------------------------------------------
 # dispatch
 # --------------------------------------------------------------------------
@@ -433,6 +523,7 @@ SHAPES = {
     "ring": ring_lattice,
     "sphere": sphere_lattice,
     "prism": prism_lattice,
+    "ogive": ogive_lattice,
 }
 
 

@@ -163,7 +163,42 @@ class Prism(PrismKeys):
     shape: Literal["prism"] = Field(description="Kind of shape.")
 
 
-Geometry = Annotated[Union[Box, Cylinder, Ring, Sphere, Prism],
+def _in_3d(value):
+    if dimension() in (1, 2):
+        raise problem("an ogive projectile is a 3D shape",
+                      "set run.dimension = 3, or use a cylinder or sphere")
+    return value
+
+
+class Ogive(Section):
+    """A projectile: a circular cylinder with a tangent-ogive nose (3D), as in
+    Forrestal et al.'s penetration tests."""
+
+    shape: Literal["ogive"] = Field(description="Kind of shape.")
+    tip: Annotated[Position, AfterValidator(_in_3d)] = Field(
+        description="The nose's tip.")
+    radius: PositiveLength = Field(description="Shank radius a.")
+    length: PositiveLength = Field(description="Overall length, tip to tail.")
+    crh: real("calibre-radius-head", lo=0.5) = Field(
+        description="Calibre-radius-head psi = s/(2a), s the radius of the nose's "
+        "arc (0.5: a hemispherical nose); the nose is a sqrt(4 psi - 1) long.")
+    nose: Literal["+x", "-x", "+y", "-y", "+z", "-z"] = Field(
+        "-z", description="The direction the nose points (the flight direction).")
+
+    @field_validator("crh")
+    @classmethod
+    def _nose_fits(cls, crh, info: ValidationInfo):
+        a, length = info.data.get("radius"), info.data.get("length")
+        if a is not None and length is not None:
+            nose = a * float(np.sqrt(4.0 * crh - 1.0))
+            if nose > length * (1.0 + 1e-9):
+                raise problem(f"the nose ({show_number(nose)} m long for crh = {crh:g}) "
+                              f"is longer than the projectile ({show_number(length)} m)",
+                              "give a longer length or a smaller crh")
+        return crh
+
+
+Geometry = Annotated[Union[Box, Cylinder, Ring, Sphere, Prism, Ogive],
                      Field(discriminator="shape")]
 
 

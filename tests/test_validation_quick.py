@@ -1,0 +1,120 @@
+"""The quick validation cases (``sphdyn validate --quick``) as regression of
+their compared numbers (issue 53).
+
+Each quick case runs (about CASE_MINUTES on 2 cores) and its compared
+numbers must stay within the tolerance of the values stored in
+tests/data/validation_quick.json, which ``python tests/test_validation_quick.py
+--store [RUNS_DIR]`` rewrites after a deliberate change (say why in the
+commit; the runs go to RUNS_DIR/a and RUNS_DIR/b, and completed ones there
+are measured again, not rerun).
+
+The tolerance of each number is stored beside it and comes from the same
+evidence as the example regression's (docs/testing.md, "The regression
+tolerances"): the case rerun with its striking velocity moved by one ulp
+(``--store`` does both runs); the difference between the two is how far
+round-off alone moves the number on one machine, and a processor that
+rounds differently moves it about as far. The tolerance is ``SAFETY`` times
+that difference, and at least the measurement's own reading resolution
+(``FLOOR``: half an element for a crater or depth read off a mesh, one
+history interval for a time), so a case whose round-off moves nothing is
+not held bit for bit where the measurement itself is coarser.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).parents[1]
+STORE = ROOT / "tests" / "data" / "validation_quick.json"
+SAFETY = 3.0
+#: the reading resolution of each quantity in its display unit, per case:
+#: half the quick target's 4 mm elements (crater, depth), one 20-step
+#: history interval of the quick beam (about 0.02 ms) for a time, 1 % of a
+#: deflection
+FLOOR = {"dop": 2.0, "crater": 2.0, "umax": None, "t_umax": 0.02}
+UMAX_FLOOR_REL = 0.01
+#: the perturbation: the impactor's velocity override moved by one ulp
+PERTURB = {
+    "leppanen2004_fragment": "body.fragment.velocity.2=-1879.0000000000002",
+    "lozano2017_dropweight_2.5m": "body.rod.velocity.2=-6.900000000000001",
+    "lozano2017_dropweight_5.0m": "body.rod.velocity.2=-9.800000000000002",
+}
+
+
+def _floor(key: str, value: float) -> float:
+    return UMAX_FLOOR_REL * abs(value) if key == "umax" else FLOOR[key]
+
+
+def _run(names, out: Path, perturb: bool = False, reuse: bool = False):
+    """Run quick cases into ``out`` (with the one-ulp perturbation if
+    ``perturb``); {case: {key: value}}."""
+    from dataclasses import replace
+
+    from sphdyn.validation.cases import CASES
+    from sphdyn.validation.runner import run_case
+
+    results = {}
+    for name in names:
+        case = CASES[name]
+        if perturb:
+            case = replace(case, quick=case.quick + (PERTURB[name],))
+        res = run_case(case, ROOT, out, quick=True, threads=None, reuse=reuse)
+        assert res["status"] == "completed", (name, res.get("diagnosis"))
+        results[name] = {row["key"]: row["sphdyn"] for row in res["rows"]}
+    return results
+
+
+def store(runs: Path) -> None:
+    """Run each quick case and its one-ulp perturbed twin into ``runs``
+    (completed runs there are measured again, not rerun); write the values
+    and tolerances to :data:`STORE`."""
+    from sphdyn.validation.cases import CASES
+
+    names = list(CASES)
+    base = _run(names, runs / "a", reuse=True)
+    moved = _run(names, runs / "b", perturb=True, reuse=True)
+    table = {}
+    for name in names:
+        table[name] = {}
+        for key, value in base[name].items():
+            spread = abs(moved[name][key] - value)
+            table[name][key] = {"value": value, "perturbed": moved[name][key],
+                                "tolerance": max(SAFETY * spread, _floor(key, value))}
+    STORE.write_text(json.dumps(table, indent=1, sort_keys=True) + "\n")
+    print(json.dumps(table, indent=1))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", sorted(json.loads(STORE.read_text()))
+                         if STORE.is_file() else [])
+def test_quick_case_holds_its_numbers(name, tmp_path):
+    stored = json.loads(STORE.read_text())[name]
+    got = _run([name], tmp_path)[name]
+    for key, entry in stored.items():
+        assert math.isfinite(got[key])
+        assert abs(got[key] - entry["value"]) <= entry["tolerance"], \
+            f"{name} {key}: {got[key]:.4g}, stored {entry['value']:.4g} +- {entry['tolerance']:.3g}"
+
+
+def test_every_case_has_stored_quick_numbers():
+    from sphdyn.validation.cases import CASES
+
+    stored = json.loads(STORE.read_text())
+    assert sorted(stored) == sorted(CASES)
+    for name, entries in stored.items():
+        keys = {r.key for r in CASES[name].references(ROOT / "validation" / "data")}
+        assert set(entries) == keys, name
+        for e in entries.values():
+            assert e["tolerance"] > 0 and math.isfinite(e["value"])
+
+
+if __name__ == "__main__":
+    # python tests/test_validation_quick.py --store [RUNS_DIR]
+    if "--store" in sys.argv:
+        rest = sys.argv[sys.argv.index("--store") + 1:]
+        store(Path(rest[0]) if rest else ROOT / "out" / "validation_quick_store")
