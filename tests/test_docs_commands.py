@@ -62,6 +62,12 @@ SKIP = {
     # the full drop-weight model: 280,000 particles, about a minute and 0.8 GB to
     # build; tests/test_run.py runs the case on the coarse deck
     "sphdyn bench hvi --steps 20": "builds the 280,000-particle drop-weight model",
+    # the validation cases: tests/test_validation_quick.py runs the quick ones
+    # and holds their numbers; the full ones take hours
+    "sphdyn validate --quick": "runs the quick validation cases (about 25 minutes)",
+    "sphdyn validate --docs": "runs the full validation cases (hours)",
+    "sphdyn plot out/validation/lozano2017_dropweight_2.5m-quick --snapshots damage":
+        "needs the quick validation run (tests/test_validation_quick.py makes it)",
     # starts an MPI job of 34 ranks
     "mpirun -np 34 dask-mpi --scheduler-file sched.json --nthreads 1 &":
         "starts an MPI job",

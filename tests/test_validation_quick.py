@@ -41,8 +41,8 @@ UMAX_FLOOR_REL = 0.01
 #: the perturbation: the impactor's velocity override moved by one ulp
 PERTURB = {
     "leppanen2004_fragment": "body.fragment.velocity.2=-1879.0000000000002",
-    "lozano2017_dropweight_2.5m": "body.rod.velocity.2=-6.900000000000001",
-    "lozano2017_dropweight_5.0m": "body.rod.velocity.2=-9.800000000000002",
+    "lozano2017_dropweight_2.5m": "mesh.rod.velocity.2=-6.900000000000001",
+    "lozano2017_dropweight_5.0m": "mesh.rod.velocity.2=-9.800000000000002",
 }
 
 

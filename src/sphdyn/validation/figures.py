@@ -65,7 +65,8 @@ def section_figure(run: Path, case, rows, path: Path, data_dir: Path) -> None:
 
 def deflection_figure(run: Path, case, rows, path: Path, data_dir: Path) -> None:
     """Mid-span deflection against time after the contact's start: sphdyn's
-    (the ``midspan`` probe) as a line, every beam of the case's series from
+    (the ``midspan`` probe; the start from the ``rod`` mesh's contact force)
+    as a line, every beam of the case's series from
     ``lozano2017_dropweight_deflection_history.csv`` as points (their
     printed maxima filled); written to ``path`` (PNG)."""
     import matplotlib

@@ -17,9 +17,8 @@ measure it on the specimen.
   is +-h/2.
 * :func:`largest_deflection`: the largest mid-span deflection and its time
   after the impact, from the mean vertical displacement of a mid-span set
-  (a probe) and the impactor's mean velocity (a probe): the contact starts
-  at the first record where the impactor has lost more than
-  :data:`CONTACT_DROP` of its speed.
+  (a probe); the impact starts at the first history record with a contact
+  force on the impactor's mesh.
 """
 
 from __future__ import annotations
@@ -33,8 +32,6 @@ from ..io.hdf5 import read_frame_meshes
 from ..io.history import History
 
 AXES = {"x": 0, "y": 1, "z": 2}
-#: the impactor's relative loss of speed that marks the contact's start
-CONTACT_DROP = 0.002
 
 
 def depth_of_penetration(run: Path, probe_set: str, face: float, dx: float,
@@ -79,15 +76,15 @@ def lost_face_diameter(run: Path, mesh: str, face: float, normal: float, h: floa
 def deflection_history(run: Path, midspan: str, impactor: str, axis: str = "z"
                        ) -> tuple[np.ndarray, np.ndarray]:
     """(time after the contact's start [s], deflection [m], positive
-    downwards along -``axis``) from the probes ``probe_<midspan>_displacement_<axis>``
-    and ``probe_<impactor>_velocity_<axis>`` (module docstring); records
-    before the contact are dropped."""
+    downwards along -``axis``) from the probe ``probe_<midspan>_displacement_<axis>``
+    and the impactor mesh's contact force ``F_<impactor>_contact``: the
+    contact starts at the first record where that force is positive;
+    records before it are dropped."""
     h = History.from_csv(Path(run) / "history.csv").as_arrays()
-    t = h["time"]
-    v = np.abs(h[f"probe_{impactor}_velocity_{axis}"])
-    started = np.flatnonzero(v < (1.0 - CONTACT_DROP) * v[0])
+    t, force = h["time"], h[f"F_{impactor}_contact"]
+    started = np.flatnonzero(force > 0.0)
     if not started.size:
-        raise ValueError(f"{run}: the impactor {impactor!r} never slowed down: no contact")
+        raise ValueError(f"{run}: the impactor {impactor!r} never touched: no contact force")
     i0 = started[0]
     return t[i0:] - t[i0], -h[f"probe_{midspan}_displacement_{axis}"][i0:]
 
