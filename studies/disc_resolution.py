@@ -5,8 +5,8 @@ rigid base at 15 m/s is run unchanged except for the particle spacing
 (``--set body.disc.dx=...``, spacings that divide the 20 mm depth and the
 100 mm diameter) and run to 300 us instead of 200 us (``run.t_end``: at
 200 us the disc is still on the base, so neither its rebound nor the total
-impulse is known there), with ``sphdyn run`` in a subprocess, one at a time,
-on one thread. From each run:
+impulse is known there), with ``sphdyn run`` in a subprocess, one at a time
+(``--threads``, default 1). From each run:
 
 * peak wall force: raw (``peak_F_wall_base`` of summary.json) and the peak
   of the mean over ``output.force_window`` = 5 us
@@ -19,14 +19,17 @@ on one thread. From each run:
 * mean body velocity at 300 us (the rebound velocity once the contact is
   over): sum m v_y / sum m over the last frame (checked against
   -15 m/s + I / M, momentum balance with the wall the only external force);
+* the energy the disc absorbed, KE(0) - KE(300 us), and the internal and
+  artificial-viscosity energies at 300 us (history columns);
 * damaged volume at 200 us (the deck's end time, the figure in
   docs/examples.md) and at 300 us: sum of m / rho over the particles with
   damage > 0.9 (the threshold the docs use for "failed"), and its fraction
   of the body's volume.
 
-The table gives each quantity per spacing and the relative change between
-the two finest spacings; a quantity is called converged when that change is
-below ``CONVERGED_PCT``. Run ``PYTHONPATH=src python studies/disc_resolution.py``
+The table gives each quantity per spacing, the relative change between
+the two finest spacings (a quantity is called converged when that change is
+below ``CONVERGED_PCT``) and a Richardson estimate from the three finest
+(:func:`richardson`). Run ``PYTHONPATH=src python studies/disc_resolution.py``
 (``--dx 5,4,2.5`` to choose spacings in mm, ``--reuse`` to read finished
 runs from ``--runs``); it writes ``docs/figures/disc_resolution.csv`` and
 ``docs/figures/disc_resolution.png`` and prints the table.
@@ -202,7 +205,7 @@ def write_csv(results: list[dict], path: Path) -> None:
 
 def print_table(results: list[dict], rows: list[dict]) -> None:
     """Markdown tables: the runs, then the quantities with their change."""
-    print("| dx [mm] | particles | steps | wall s (1 thread) |")
+    print("| dx [mm] | particles | steps | wall s |")
     print("|---|---|---|---|")
     for r in results:
         print(f"| {r['dx_mm']:.3g} | {r['particles']} | {r['steps']} | {r['seconds']:.0f} |")

@@ -39,6 +39,7 @@ def test_probe_values_are_the_particle_arrays():
     for k, c in enumerate("xyz"):
         expect[f"velocity_{c}"] = p.v[:, k]
         expect[f"displacement_{c}"] = p.x[:, k] - p.x0[:, k]
+        expect[f"position_{c}"] = p.x[:, k]
     for c, (a, b) in {"xx": (0, 0), "yy": (1, 1), "zz": (2, 2), "xy": (0, 1),
                       "yz": (1, 2), "xz": (0, 2)}.items():
         expect[f"stress_{c}"] = p.sig[:, a, b]

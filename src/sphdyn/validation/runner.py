@@ -22,7 +22,7 @@ from .report import compare
 def root_problem(root: Path, names: list[str]) -> str | None:
     """Why ``root`` cannot run the cases ``names`` (None if it can)."""
     if not (root / "validation" / "data").is_dir():
-        return (f"{root} has no validation/data/ folder. Fix: run from the sphdyn "
+        return (f"{root.resolve()} has no validation/data/ folder. Fix: run from the sphdyn "
                 "source tree (git clone) or give --root PATH_TO_IT")
     for name in names:
         deck = root / CASES[name].deck
@@ -130,7 +130,8 @@ def validate(names: list[str], quick: bool, out: Path, root: Path, threads: int 
             print(f"  {row['quantity']}: measured {row['measured']:.3g}, sphdyn "
                   f"{row['sphdyn']:.3g} ({row['difference_pct']:+.0f} %, {row['verdict']})")
         if res["status"] != "completed":
-            print(f"  run {res['status']}: {res.get('diagnosis')}")
+            print(f"  run {res['status']}: not compared (its diagnosis is above and in "
+                  f"{res['run']}/summary.json)")
     write_results(results, out)
     print(table_markdown(results))
     print(out / "validation.md")
