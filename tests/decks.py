@@ -104,3 +104,19 @@ set = "y0"
 type = "fixed"
 components = ["y"]
 """
+
+
+def elastic_steel(dimension: int, t_end: str = "1 us") -> str:
+    """A [run] of ``dimension`` and ``t_end`` and an elastic steel named
+    "steel" (7850 kg/m^3, E 200 GPa, nu 0.3): the head of a test deck."""
+    return f"""
+[run]
+dimension = {dimension}
+t_end = "{t_end}"
+[[material]]
+name = "steel"
+model = "elastic"
+density = 7850
+E = "200 GPa"
+nu = 0.3
+"""

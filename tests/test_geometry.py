@@ -600,29 +600,23 @@ def test_ogive_lattice_fills_the_projectile(nose):
 
 
 def test_ogive_deck_shape_and_its_errors():
+    from decks import elastic_steel
+
     from sphdyn.deck import DeckError, loads_deck
 
-    base = """
-[run]
-dimension = {dim}
-t_end = "1 us"
-[[material]]
-name = "steel"
-model = "elastic"
-density = "7850 kg/m^3"
-E = "200 GPa"
-nu = 0.3
+    def deck(dim=3, length="242.4 mm", crh=2):
+        return loads_deck(elastic_steel(dim) + f"""
 [[body]]
 name = "p"
 material = "steel"
 dx = "2.69 mm"
 geometry = {{ shape = "ogive", tip = [0, 0, 0], radius = "13.45 mm", length = "{length}", crh = {crh} }}
-"""
-    deck = loads_deck(base.format(dim=3, length="242.4 mm", crh=2))
-    assert deck.body[0].geometry.nose == "-z"
+""")
+
+    assert deck().body[0].geometry.nose == "-z"
     with pytest.raises(DeckError, match="longer than the projectile"):
-        loads_deck(base.format(dim=3, length="30 mm", crh=2))
+        deck(length="30 mm")
     with pytest.raises(DeckError, match="crh"):
-        loads_deck(base.format(dim=3, length="242.4 mm", crh=0.3))
+        deck(crh=0.3)
     with pytest.raises(DeckError, match="3D shape"):
-        loads_deck(base.format(dim=2, length="242.4 mm", crh=2))
+        deck(dim=2)

@@ -567,16 +567,9 @@ def test_empty_particle_set_is_refused(tmp_path, capsys):
     """A [[set]] whose region holds no particle centre (here a 5 mm slice
     between two rows of particles 10 mm apart) is refused before the run: a
     probe on it recorded NaN for the whole run, a boundary on it did nothing."""
-    text = """
-[run]
-dimension = 2
-t_end = "1 us"
-[[material]]
-name = "steel"
-model = "elastic"
-density = "7850 kg/m^3"
-E = "200 GPa"
-nu = 0.3
+    from decks import elastic_steel
+
+    text = elastic_steel(2) + """
 [[body]]
 name = "plate"
 material = "steel"

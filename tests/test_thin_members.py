@@ -14,6 +14,7 @@ from sphdyn.thin_members import (F_TIMOSHENKO, FREQUENCY, PLATEAU_ERROR_PCT, acr
                                  measured_errors, member_extents, stiffness_error,
                                  thin_member_warnings)
 
+from decks import elastic_steel
 from test_mesh_decks import BLOCK, bar_deck
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -67,18 +68,9 @@ def test_published_five_percent_crossings():
 
 
 def _deck(geometry: str, dx: str, formulation: str = "", correction: bool = False):
-    return loads_deck(f"""
-[run]
-dimension = 2
-t_end = "1 us"
+    return loads_deck(elastic_steel(2) + f"""
 [sph]
 correction = {str(correction).lower()}
-[[material]]
-name = "steel"
-model = "elastic"
-density = 7850
-E = "200 GPa"
-nu = 0.3
 [[body]]
 name = "member"
 material = "steel"
@@ -161,16 +153,7 @@ def test_check_and_run_warn_on_stderr_and_succeed(tmp_path, capsys):
     """(d) check prints the warning on stderr and exits 0; run prints the same
     warning before running (one step) and completes."""
     deck = tmp_path / "strip.toml"
-    deck.write_text(f"""
-[run]
-dimension = 2
-t_end = "1 us"
-[[material]]
-name = "steel"
-model = "elastic"
-density = 7850
-E = "200 GPa"
-nu = 0.3
+    deck.write_text(elastic_steel(2) + f"""
 [[body]]
 name = "strip"
 material = "steel"
