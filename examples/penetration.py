@@ -20,11 +20,9 @@ target's face: the largest magnitude of the projectile's mean
 z-displacement (its probe) less the 2 mm start gap.
 
 The modified NDRC formula (Kennedy 1976; UFC 3-340-02 and Li et al. 2005
-quote it) for a rigid projectile of mass M, diameter d, nose factor N*
-(0.72 flat) at V into concrete of strength f'c, in its own units (M lb,
-d in, f'c psi, V ft/s):
-G = 3.8e-5 N* M / (d sqrt(f'c)) (V / d)^1.8, x/d = 2 sqrt(G) for G <= 1,
-x/d = G + 1 above.
+quote it) for a rigid projectile: :func:`sphdyn.validation.estimates.ndrc_depth`
+(its equations there), with the deck's projectile, f'c and a flat nose
+(N* = 0.72).
 
     python examples/penetration.py [--reuse]
 """
@@ -49,13 +47,11 @@ DIAMETER, FC, NOSE = 0.020, 40e6, 0.72  # m, Pa, flat nose N*
 SWEEP_OUTPUT = ["output.vtk=false", 'output.every="80 us"']
 
 
-def ndrc_depth(v: float, mass: float = MASS, d: float = DIAMETER, fc: float = FC,
-               nose: float = NOSE) -> float:
-    """Modified NDRC penetration depth [m] of a rigid projectile (module docstring)."""
-    lb, inch, psi, fps = mass / 0.45359237, d / 0.0254, fc / 6894.757, v / 0.3048
-    g = 3.8e-5 * nose * lb / (inch * np.sqrt(psi)) * (fps / inch) ** 1.8
-    ratio = 2.0 * np.sqrt(g) if g <= 1.0 else g + 1.0
-    return ratio * d
+def ndrc_depth(v: float) -> float:
+    """Modified NDRC depth [m] of the decks' projectile at ``v`` [m/s]."""
+    from sphdyn.validation.estimates import ndrc_depth as depth
+
+    return depth(v, MASS, DIAMETER, FC, NOSE)
 
 
 def sweep(model: str, reuse: bool) -> Path:

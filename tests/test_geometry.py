@@ -599,6 +599,31 @@ def test_ogive_lattice_fills_the_projectile(nose):
     assert near_tip.max() < 0.6 * shank.max()
 
 
+def test_ogive_preflight_depth_and_volume():
+    """preflight's depth inside an ogive: positive at every lattice particle,
+    the nearest of the radial distance to the profile, the distance to the
+    tip and to the tail (on the axis half-way down the shank: a; 1 mm behind
+    the tip: the profile's radius there, 0.86 mm < 1 mm), negative ahead of
+    the tip and beyond the shank; its volume the closed form's."""
+    from types import SimpleNamespace
+
+    from sphdyn.geometry.lattice import ogive_lattice, ogive_profile, ogive_volume
+    from sphdyn.preflight import depth_inside, shape_volume
+
+    a, length, psi = 0.01345, 0.2424, 2.0
+    g = SimpleNamespace(shape="ogive", tip=(0.0, 0.0, 0.0), radius=a, length=length,
+                        crh=psi, nose="-z")
+    x = ogive_lattice(g.tip, a, length, psi, 0.00269, 3, nose="-z")
+    assert np.all(depth_inside(g, x, 3) > 0)
+    probe = np.array([[0, 0, 0.15], [0, 0, 0.001], [0, 0, -0.001], [2 * a, 0, 0.15],
+                      [0, 0, length + 0.001]])
+    d = depth_inside(g, probe, 3)
+    assert d[:2] == pytest.approx([a, float(ogive_profile(0.001, a, psi))], rel=1e-12)
+    assert d[1] < 0.001
+    assert np.all(d[2:] < 0)
+    assert shape_volume(g, 3) == ogive_volume(a, length, psi)
+
+
 def test_ogive_deck_shape_and_its_errors():
     from decks import elastic_steel
 

@@ -123,7 +123,8 @@ def test_total_lagrangian_at_8_across_does_not_warn_and_updated_lagrangian_does(
 
 def test_extents_of_the_shapes():
     """Thickness and longest extent: a 3D disc by its length, a ring by its
-    wall, an L-shaped prism by its legs' width (not its 0.5 m bounding box)."""
+    wall, an L-shaped prism by its legs' width (not its 0.5 m bounding box),
+    an ogive by its shank."""
     class G:
         def __init__(self, **kw):
             self.__dict__.update(kw)
@@ -136,6 +137,9 @@ def test_extents_of_the_shapes():
         pytest.approx((0.25, 0.5))
     assert member_extents(G(shape="prism", points=ell[::-1], length=0.05), 3) == \
         pytest.approx((0.05, 0.5))
+    # an ogive projectile: its shank's diameter across, its length along
+    assert member_extents(G(shape="ogive", radius=0.01345, length=0.2424), 3) == \
+        (0.0269, 0.2424)
 
 
 def test_converted_mesh_is_judged_by_its_elements():

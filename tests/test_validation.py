@@ -179,3 +179,21 @@ def test_validate_errors(argv, message, capsys, monkeypatch):
 def test_validate_outside_the_source_tree_says_where(tmp_path, capsys):
     assert main(["validate", "--root", str(tmp_path)]) == 2
     assert "no validation/data/ folder" in capsys.readouterr().err
+
+
+def test_ndrc_depth_in_its_own_units_and_both_branches():
+    """The modified NDRC depth (estimates.ndrc_depth) for a 1 lb, 1 in
+    projectile into 10,000 psi concrete at 1000 ft/s, N* = 0.72: G =
+    3.8e-5 x 0.72 x 1 / (1 x 100) x 1000^1.8 = 0.0687, x = 2 sqrt(G) in; the
+    two branches meet at G = 1 (x/d = 2) and above it x/d = G + 1 (G four
+    times larger at 2^(1/1.8) times the velocity)."""
+    from sphdyn.validation.estimates import ndrc_depth
+
+    lb, inch, psi, fps = 0.45359237, 0.0254, 6894.757, 0.3048
+    g = 3.8e-5 * 0.72 / 100.0 * 1000.0 ** 1.8
+    assert ndrc_depth(1000 * fps, lb, inch, 1e4 * psi, 0.72) == \
+        pytest.approx(2.0 * g**0.5 * inch, rel=1e-12)
+    v1 = 1000.0 * (1.0 / g) ** (1 / 1.8) * fps  # G = 1
+    assert ndrc_depth(v1, lb, inch, 1e4 * psi, 0.72) == pytest.approx(2.0 * inch, rel=1e-9)
+    assert ndrc_depth(v1 * 4 ** (1 / 1.8), lb, inch, 1e4 * psi, 0.72) == \
+        pytest.approx(5.0 * inch, rel=1e-9)

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import tomllib
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import Callable
 
@@ -174,5 +175,5 @@ for _series, _height, _v, _t in (("1", "2.5", None, 0.009), ("2", "5.0", 9.8, 0.
                *(f"mesh.bar_{b}.line.element_length=0.01" for b in ("b1", "b2", "t1", "t2"))),
         references=_lozano_references(_series),
         measure=_lozano_measure,
-        figure=deflection_figure,
+        figure=partial(deflection_figure, history=LOZANO_HISTORY, drop_height=_height),
     ))

@@ -30,14 +30,6 @@ class DataFile:
             raise KeyError(f"{self.path.name}: {len(found)} rows match {match}")
         return found[0]
 
-    def source(self) -> str:
-        """The ``# dataset:`` line's text (what the data are)."""
-        for line in self.provenance:
-            key, _, text = line.lstrip("# ").partition(":")
-            if key.strip().lower() == "dataset":
-                return text.strip()
-        return self.path.name
-
 
 def read(path: Path) -> DataFile:
     """The data file at ``path`` (``FileNotFoundError`` if missing)."""

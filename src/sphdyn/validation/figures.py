@@ -63,12 +63,13 @@ def section_figure(run: Path, case, rows, path: Path, data_dir: Path) -> None:
     plt.close(fig)
 
 
-def deflection_figure(run: Path, case, rows, path: Path, data_dir: Path) -> None:
+def deflection_figure(run: Path, case, rows, path: Path, data_dir: Path, *,
+                      history: str, drop_height: str) -> None:
     """Mid-span deflection against time after the contact's start: sphdyn's
     (the ``midspan`` probe; the start from the ``rod`` mesh's contact force)
-    as a line, every beam of the case's series from
-    ``lozano2017_dropweight_deflection_history.csv`` as points (their
-    printed maxima filled); written to ``path`` (PNG)."""
+    as a line, every beam dropped on from ``drop_height`` [m, as written in
+    the data] in the data file ``history`` as points (their printed maxima
+    filled); written to ``path`` (PNG)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -77,10 +78,9 @@ def deflection_figure(run: Path, case, rows, path: Path, data_dir: Path) -> None
     from .measures import deflection_history
 
     t, u = deflection_history(run, "midspan", "rod")
-    height = case.name.rsplit("_", 1)[-1].rstrip("m")
-    table = data.read(data_dir / "lozano2017_dropweight_deflection_history.csv")
+    table = data.read(data_dir / history)
     fig, ax = plt.subplots(figsize=(7.5, 4.6), layout="constrained")
-    beams = sorted({r["beam_id"] for r in table.rows if r["drop_height_m"] == height})
+    beams = sorted({r["beam_id"] for r in table.rows if r["drop_height_m"] == drop_height})
     for k, beam in enumerate(beams):
         pts = [r for r in table.rows if r["beam_id"] == beam]
         tt = [data.number(r, "t_ms") for r in pts]

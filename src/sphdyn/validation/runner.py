@@ -44,10 +44,11 @@ def run_case(case: Case, root: Path, out: Path, quick: bool, threads: int | None
              reuse: bool) -> dict:
     """Run (unless ``reuse`` finds it done), measure and compare one case."""
     run = run_dir(out, case, quick)
+    overrides = case.overrides + (case.quick if quick else ())
     if not (reuse and completed(run)):
         cmd = [sys.executable, "-m", "sphdyn", "run", str(root / case.deck), "--out",
                str(run), "-q"]
-        for override in case.overrides + (case.quick if quick else ()):
+        for override in overrides:
             cmd += ["--set", override]
         if threads:
             cmd += ["--threads", str(threads)]
@@ -56,7 +57,7 @@ def run_case(case: Case, root: Path, out: Path, quick: bool, threads: int | None
     summary = json.loads(summary_path.read_text()) if summary_path.is_file() else \
         {"status": "failed", "diagnosis": "no summary.json: the run did not start"}
     result = {"case": case.name, "title": case.title, "quick": quick,
-              "deck": case.deck, "overrides": list(case.overrides + (case.quick if quick else ())),
+              "deck": case.deck, "overrides": list(overrides),
               "status": summary["status"], "diagnosis": summary.get("diagnosis"),
               "wall_seconds": summary.get("wall_seconds"), "steps": summary.get("steps"),
               "items": summary.get("items"), "run": str(run),

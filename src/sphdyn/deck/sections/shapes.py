@@ -5,7 +5,7 @@ from typing import Annotated, Literal, Optional, Union
 import numpy as np
 from pydantic import AfterValidator, Field, ValidationInfo, field_validator
 
-from ...geometry.lattice import polygon_area
+from ...geometry.lattice import ogive_nose_length, polygon_area
 from ..messages import problem, show_number
 from ..scope import dimension
 from ..units import LENGTH
@@ -190,7 +190,7 @@ class Ogive(Section):
     def _nose_fits(cls, crh, info: ValidationInfo):
         a, length = info.data.get("radius"), info.data.get("length")
         if a is not None and length is not None:
-            nose = a * float(np.sqrt(4.0 * crh - 1.0))
+            nose = ogive_nose_length(a, crh)
             if nose > length * (1.0 + 1e-9):
                 raise problem(f"the nose ({show_number(nose)} m long for crh = {crh:g}) "
                               f"is longer than the projectile ({show_number(length)} m)",
