@@ -82,6 +82,27 @@ def run_one(dx_mm: float, out: Path, threads: int) -> None:
     subprocess.run(cmd, check=True, env=os.environ.copy())
 
 
+def facet(dx_mm: float) -> dict:
+    """The flat facet the square lattice leaves at the point of the rim that
+    strikes: particles per layer in the lowest row, its width [mm] (their
+    span plus one spacing), and the force of its first contact [kN],
+    ``rho c v w t`` (a flat face of width w and depth t striking at v; c the
+    longitudinal wave speed sqrt((K + 4G/3)/rho) of the deck's concrete)."""
+    from sphdyn.deck import load_deck
+    from sphdyn.geometry import lattice_from_shape
+
+    deck = load_deck(DECK)
+    body, mat = deck.body[0], deck.material[0]
+    x = lattice_from_shape(body.geometry.model_dump(), dx_mm * 1e-3, 3)
+    low = x[np.abs(x[:, 1] - x[:, 1].min()) < 1e-9]
+    layers = np.unique(np.round(low[:, 2] / (dx_mm * 1e-3), 6)).size
+    width = np.ptp(low[:, 0]) + dx_mm * 1e-3
+    c = np.sqrt((mat.K + 4.0 * mat.G / 3.0) / mat.density)
+    return {"facet_particles": int(len(low) // layers), "facet_mm": 1e3 * width,
+            "facet_force_kN": 1e-3 * mat.density * c * IMPACT_SPEED * width
+            * body.geometry.length, "wave_speed_ms": float(c)}
+
+
 def measure(out: Path, dx_mm: float) -> dict:
     """The study's quantities of the finished run at spacing ``dx_mm`` in ``out``."""
     summary = json.loads((out / "summary.json").read_text())
@@ -110,6 +131,7 @@ def measure(out: Path, dx_mm: float) -> dict:
         "end_force_kN": 1e-3 * float(force[-1]),
         "end_velocity_ms": float((m * fields["velocity"][:, 1]).sum() / mass),
         "end_velocity_momentum_ms": -IMPACT_SPEED + float(impulse[-1]) / mass,
+        **facet(dx_mm),
         "absorbed_energy_J": float(kinetic[0] - kinetic[-1]),
         "internal_energy_J": float(h["E_internal"][-1]),
         "viscous_energy_J": float(h["E_viscous"][-1]),
@@ -128,6 +150,9 @@ def _damaged(suffix: str, fields: dict) -> dict:
 
 
 QUANTITIES = (  # key, label
+    ("facet_particles", "particles per layer in the lattice's lowest row"),
+    ("facet_mm", "width of that flat facet [mm]"),
+    ("facet_force_kN", "its first-contact force rho c v w t [kN]"),
     ("peak_force_kN", "peak wall force, raw [kN]"),
     ("peak_force_5us_kN", "peak wall force, 5 us mean [kN]"),
     ("plateau_force_kN", "force plateau, 10-50 us after contact [kN]"),
@@ -239,7 +264,7 @@ def plot(results: list[dict], path: Path) -> None:
     ax_f.legend(fontsize=8)
     dx = np.array([r["dx_mm"] for r in results])
     for key, label in QUANTITIES:
-        if "fraction" in key or key == "end_force_kN":
+        if "fraction" in key or key == "end_force_kN" or key.startswith("facet"):
             continue
         v = np.array([r[key] for r in results])
         ax_q.plot(dx, v / v[-1], "o-", label=label)
