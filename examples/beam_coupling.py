@@ -11,7 +11,14 @@ output in out/beam_*/ with --reuse) and writes
   static force is the held value after 0.1 s);
 * a table (stdout, markdown): end force at 0.5 m and its difference to pure
   FEM, the inflection point (where the centre line has moved half the end
-  displacement), the largest deviation of the centre line from pure FEM.
+  displacement), the largest deviation of the centre line from pure FEM;
+* a second table, the interfaces' smoothness as numbers (issue 53): along
+  the top row of items (elements and particles, the row the thesis's
+  Fig. 4.1 shows the stress of), the von Mises stress profile against pure
+  FEM's within three element sizes of each interface (x = 1.5 and 3.5 m):
+  its largest difference (the jump) and the RMS of the difference of the
+  second differences (the item-to-item oscillation), both in per cent of
+  pure FEM's largest stress on that row (:func:`interface_errors`).
 
     python examples/beam_coupling.py [--reuse] [--models fem,penalty,...]
 """
@@ -64,6 +71,60 @@ def centre_line(fields, meshes, x_bins: np.ndarray) -> np.ndarray:
     idx = np.digitize(x, x_bins)
     return np.array([u[idx == k].mean() if np.any(idx == k) else np.nan
                      for k in range(1, len(x_bins))])
+
+
+#: the interfaces of the FEM-SPH-FEM models and the element size [m]
+INTERFACES = (1.5, 3.5)
+ELEMENT = 5.0 / 160
+
+
+def top_row_profile(fields, meshes, x_bins: np.ndarray, element: float = ELEMENT
+                    ) -> np.ndarray:
+    """Von Mises stress [Pa] of the items of the top row (initial y within
+    half an element of the top centroids' ``0.125 - element/2``) in the layer
+    above the mid-plane (``0 < z0 < element``), averaged per bin of initial
+    x (an element and a hybrid particle at one centroid count once each);
+    NaN where a bin has none."""
+    y_row = 0.125 - 0.5 * element
+    xs, vm = [], []
+    for m in meshes.values():
+        x0 = m.points - m.point_data["displacement"]
+        c = x0[m.cells].mean(axis=1)
+        sel = (np.abs(c[:, 1] - y_row) < 0.5 * element) & (c[:, 2] > 0) & (c[:, 2] < element)
+        xs.append(c[sel, 0])
+        vm.append(np.asarray(m.cell_data["von_mises"])[sel])
+    if len(fields.get("position", ())):
+        x0 = fields["position"] - fields["displacement"]
+        sel = ((np.abs(x0[:, 1] - y_row) < 0.5 * element) & (x0[:, 2] > 0)
+               & (x0[:, 2] < element))
+        xs.append(x0[sel, 0])
+        vm.append(fields["von_mises"][sel])
+    x, v = np.concatenate(xs), np.concatenate(vm)
+    idx = np.digitize(x, x_bins)
+    return np.array([v[idx == k].mean() if np.any(idx == k) else np.nan
+                     for k in range(1, len(x_bins))])
+
+
+def interface_errors(profile: np.ndarray, reference: np.ndarray, x: np.ndarray,
+                     interfaces=INTERFACES, half_width: float = 3 * ELEMENT
+                     ) -> list[tuple[float, float]]:
+    """Per interface, (jump, oscillation) of a stress profile against the
+    reference's (both on the bin centres ``x`` [m]), in per cent of the
+    reference's largest value: the jump is the largest ``|s - s_ref|`` within
+    ``half_width`` of the interface, the oscillation the RMS of ``D2 s -
+    D2 s_ref`` there, ``D2 s_k = s_(k+1) - 2 s_k + s_(k-1)`` (a field that
+    alternates item by item has a large second difference, a smooth one
+    almost none)."""
+    scale = np.nanmax(np.abs(reference)) / 100.0
+    d2 = np.full_like(profile, np.nan)
+    d2[1:-1] = (profile[2:] - 2 * profile[1:-1] + profile[:-2]) - \
+        (reference[2:] - 2 * reference[1:-1] + reference[:-2])
+    out = []
+    for xi in interfaces:
+        near = np.abs(x - xi) <= half_width
+        out.append((float(np.nanmax(np.abs(profile[near] - reference[near]))) / scale,
+                    float(np.sqrt(np.nanmean(d2[near] ** 2))) / scale))
+    return out
 
 
 def draw(ax, fields, meshes, vmax: float):
@@ -158,6 +219,18 @@ def main(argv=None) -> int:
                else np.nan)
         print(f"| {LABELS[m]} | {f / 1e3:.1f} | {100 * (f / f_ref - 1):+.1f} % | "
               f"{x_inf:.3f} | {dev:.1f} |")
+    if "fem" in frames:
+        bins = np.arange(161) * ELEMENT
+        centres = 0.5 * (bins[1:] + bins[:-1])
+        ref = top_row_profile(*frames["fem"], bins)
+        print()
+        print("| model | jump at x = 1.5 m [%] | oscillation at 1.5 m [%] | "
+              "jump at x = 3.5 m [%] | oscillation at 3.5 m [%] |")
+        print("|---|---|---|---|---|")
+        for m in models:
+            errs = interface_errors(top_row_profile(*frames[m], bins), ref, centres)
+            print(f"| {LABELS[m]} | " + " | ".join(f"{j:.1f} | {o:.1f}" for j, o in errs)
+                  + " |")
     return 0
 
 

@@ -130,3 +130,35 @@ def test_coupled_beam_at_half_a_metre_carries_the_pure_fem_force(coupling):
     assert cpl_mid == pytest.approx(-0.25, rel=0.01)
     assert abs(cpl["E_total"]) < 1e-3 * cpl["E_internal"]
     assert cpl["KE_IE_ratio"] < 1e-6
+
+
+def test_interface_smoothness_numbers_of_the_coupling_figure():
+    """examples/beam_coupling.py's interface numbers (issue 53: the
+    couplings' smoothness as a number): on a synthetic top-row profile that
+    equals the reference except for a 5 % step over the two bins right of
+    the interface at 1.5 m and an item-by-item alternation of +-1 % next to
+    the one at 3.5 m, the jump is 5 % at 1.5 m; the alternation's second
+    differences are +-4 % (1 - 2(-1) + 1), so its oscillation is 4 % and its
+    jump 1 %."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("beam_coupling",
+                                                  ROOT / "examples/beam_coupling.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    bins = np.arange(161) * mod.ELEMENT
+    x = 0.5 * (bins[1:] + bins[:-1])
+    ref = np.full(160, 100e6)                     # the largest reference stress: 100 MPa
+    prof = ref.copy()
+    k15 = int(np.searchsorted(x, 1.5))
+    prof[k15:k15 + 2] += 5e6
+    near35 = np.abs(x - 3.5) <= 4 * mod.ELEMENT
+    prof[near35] += 1e6 * (-1.0) ** np.arange(near35.sum())
+    (j1, o1), (j2, o2) = mod.interface_errors(prof, ref, x)
+    assert j1 == pytest.approx(5.0, rel=1e-12)
+    assert (j2, o2) == (pytest.approx(1.0, rel=1e-12), pytest.approx(4.0, rel=1e-12))
+    # the two-bin step's own second differences: +5, -5, -5, +5 in four of
+    # the six bins within three element sizes (centres 15.6, 46.9 and 78.1 mm
+    # on each side), against 0
+    assert o1 == pytest.approx(np.sqrt(4 * 25 / 6), rel=1e-12)
+    assert mod.interface_errors(ref, ref, x) == [(0.0, 0.0), (0.0, 0.0)]

@@ -10,15 +10,15 @@ from sphdyn.state import Particles
 
 def _particles(n=4, seed=1):
     rng = np.random.default_rng(seed)
-    p = Particles.allocate(n, dim=3, n_history=2)
-    p.hist_names = ["plastic_strain", "kappa"]
+    p = Particles.allocate(n, dim=3, n_history=4)
+    p.hist_names = ["plastic_strain", "kappa", "damage_brittle", "damage_ductile"]
     for name in ("x", "x0", "v"):
         getattr(p, name)[:] = rng.normal(size=(n, 3))
     for name in ("rho", "h", "e", "damage", "m"):
         getattr(p, name)[:] = rng.random(n)
     s = rng.normal(size=(n, 3, 3))
     p.sig[:] = s + s.transpose(0, 2, 1)
-    p.hist[:] = rng.random((n, 2))
+    p.hist[:] = rng.random((n, 4))
     return p
 
 
@@ -35,6 +35,7 @@ def test_probe_values_are_the_particle_arrays():
         "pressure": fields.pressure(p.sig), "von_mises": fields.von_mises(p.sig),
         "density": p.rho, "damage": p.damage, "internal_energy": p.e,
         "smoothing_length": p.h, "plastic_strain": p.hist[:, 0],
+        "damage_brittle": p.hist[:, 2], "damage_ductile": p.hist[:, 3],
     }
     for k, c in enumerate("xyz"):
         expect[f"velocity_{c}"] = p.v[:, k]

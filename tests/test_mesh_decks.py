@@ -204,6 +204,33 @@ def test_abaqus_file_with_groups_gives_the_block_and_the_groups_materials(tmp_pa
     assert np.array_equal(a.part("bar").nodes.x, b.part("bar").nodes.x)
 
 
+def test_a_mesh_file_in_millimetres_moved_by_translate_lands_where_it_should(tmp_path):
+    """length_unit scales the file's coordinates, then translate shifts them:
+    the bar written in millimetres 5 mm below its place ends exactly where
+    the file in metres puts it (x = 1 mm and 0.5 mm are exact in binary
+    after the scaling only to round-off: compared to 1e-15 m)."""
+    ref = block_mesh((0, 0, 0), (1, 0.1, 0.1), (10, 1, 1), 3)
+    lines = ["*NODE"] + [f"{i + 1}, " + ", ".join(repr(float(v)) for v in 1e3 * p
+                                                   - np.array([0.0, 0.0, 5.0]))
+                         for i, p in enumerate(ref.points)]
+    lines += ["*ELEMENT, TYPE=C3D8R, ELSET=ALL"]
+    lines += [f"{k + 1}, " + ", ".join(str(n + 1) for n in c) for k, c in enumerate(ref.cells)]
+    (tmp_path / "mm.inp").write_text("\n".join(lines) + "\n")
+    deck = bar_deck(source='file = "mm.inp"\nlength_unit = "1 mm"\n'
+                           'translate = [0, 0, "5 mm"]', base_dir=tmp_path)
+    part = build_stepper(deck).part("bar")
+    assert np.allclose(part.nodes.x, ref.points, rtol=0, atol=1e-15)
+    # without the shift the nodes are 5 mm low
+    deck = bar_deck(source='file = "mm.inp"\nlength_unit = "1 mm"', base_dir=tmp_path)
+    assert np.allclose(build_stepper(deck).part("bar").nodes.x[:, 2], ref.points[:, 2] - 5e-3,
+                       rtol=0, atol=1e-15)
+
+
+def test_translate_belongs_to_mesh_files():
+    with pytest.raises(DeckError, match="translate moves a mesh file"):
+        bar_deck(source=BLOCK + '\ntranslate = [0, 0, "1 mm"]')
+
+
 CANTILEVER = """
 [run]
 dimension = 3

@@ -461,3 +461,37 @@ def test_a_run_stopped_by_max_steps_ends_with_its_last_state_in_the_frames(tmp_p
     assert times.count(times[-1]) == 1 and times[-1] == pytest.approx(1e-3, rel=1e-12)
     assert read_pvd(tmp_path / "part/particles.pvd") == read_pvd(
         tmp_path / "full/particles.pvd")
+
+
+
+def test_cscm_damage_modes_are_frame_fields_and_probe_quantities(tmp_path):
+    """The CSCM's brittle and ductile damage (LS-DYNA NPLOT 2 and 3) as
+    output fields and probe quantities: the last frame holds the particles'
+    history columns exactly, the probe their largest value (the disc 0.2 ms
+    after its impact, when both have grown)."""
+    path = Path(__file__).parents[1] / "examples/disc_impact.toml"
+    text = path.read_text() + """
+[[set]]
+name = "whole"
+[[probe]]
+set = "whole"
+quantities = ["damage_brittle", "damage_ductile"]
+reduce = "max"
+"""
+    deck = loads_deck(text, base_dir=path.parent, overrides=[
+        'output.fields=["damage", "damage_brittle", "damage_ductile"]', "output.vtk=false",
+        "output.progress=false", "run.t_end=2e-4", "output.every=2e-4"])
+    sim = Simulation.from_deck(deck, tmp_path / "disc")
+    sim.run()
+    p = sim.particles
+    _, _, fields, _ = read_frame(sorted((tmp_path / "disc/frames").glob("*.h5"))[-1])
+    h = read_history_csv(tmp_path / "disc/history.csv")
+    for name in ("damage_brittle", "damage_ductile"):
+        column = p.hist[:, p.hist_names.index(name)]
+        assert column.max() > 0.0, name
+        assert np.array_equal(fields[name], column), name
+        assert h[f"probe_whole_{name}"][-1] == column.max(), name
+    # the applied damage is the larger of the two (nothing is recovered here
+    # where the pressure is tensile) or the ductile one (where compressive)
+    assert np.all(p.damage <= np.maximum(fields["damage_brittle"],
+                                         fields["damage_ductile"]) + 1e-15)

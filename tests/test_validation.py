@@ -88,6 +88,27 @@ def test_depth_of_penetration_from_the_probe_history(tmp_path):
         measures.depth_of_penetration(tmp_path, "other", face=0.0, dx=0.001)
 
 
+def test_peak_load_averages_the_contact_force_over_its_windows(tmp_path):
+    """Records every 0.1 ms over 2.5 ms, windows of 1 ms: the first two
+    windows' means are the loads, the last partial window is dropped, and
+    a spike inside a window counts by its share."""
+    t = np.arange(25) * 1e-4
+    force = np.where(t < 1e-3 - 1e-9, 1000.0, 3000.0)
+    force[12] = 13000.0                    # one spike in the second window
+    force[22] = 1e6                        # in the dropped partial window
+    u = 0.01 * t                            # displacement_z = -u
+    rows = "\n".join(f"{a:.17g},{b:.17g},{-c:.17g}" for a, b, c in zip(t, force, u))
+    (tmp_path / "history.csv").write_text(
+        "time,F_loader_contact,probe_mid_displacement_z\n" + rows + "\n")
+    d, f = measures.load_deflection(tmp_path, "loader", "mid", window=1e-3)
+    assert f == pytest.approx([1000.0, 3000.0 + 10000.0 / 10], rel=1e-12)
+    assert d == pytest.approx([0.01 * 4.5e-4, 0.01 * 14.5e-4], rel=1e-9)
+    peak, at = measures.peak_load(tmp_path, "loader", "mid", window=1e-3)
+    assert (peak, at) == (pytest.approx(4000.0, rel=1e-12), pytest.approx(1.45e-5, rel=1e-9))
+    with pytest.raises(ValueError, match="shorter than one window"):
+        measures.load_deflection(tmp_path, "loader", "mid", window=1.0)
+
+
 def _frame_with_crater(tmp_path, radius, lift_back=None):
     """A 40 x 40 x 10 mm block of 1 mm hexahedra whose top-layer elements
     with centres within ``radius`` of the z axis are eroded (left out of the

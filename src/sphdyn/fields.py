@@ -193,6 +193,15 @@ _BUILT_IN = (
     OutputField("plastic_strain", "history", "-", "Equivalent plastic strain "
                 "(history of j2 materials).",
                 lambda p, c: history_column(p, "plastic_strain"), probe=True),
+    # the CSCM's two damage modes apart (LS-DYNA MAT_159's NPLOT = 2 and 3);
+    # ``damage`` is the applied one (their maximum, brittle recovered in
+    # compression)
+    OutputField("damage_brittle", "history", "-", "Brittle (tensile) damage in [0, 1] "
+                "(history of cscm materials).",
+                lambda p, c: history_column(p, "damage_brittle"), probe=True),
+    OutputField("damage_ductile", "history", "-", "Ductile (compressive) damage in [0, 1] "
+                "(history of cscm materials).",
+                lambda p, c: history_column(p, "damage_ductile"), probe=True),
     OutputField("bc", "scalar", "-", "Boundary-condition flag (int8).", _array("bc")),
     OutputField("body", "scalar", "-", "Body index (int32).", _array("body")),
     OutputField("material", "scalar", "-", "Material index (int32).", _array("mat")),

@@ -108,6 +108,7 @@ def _read(spec, where: str, dim: int) -> MeshData:
             f"{SOLID_KIND[dim]} elements")]) from None
     if spec.length_unit != 1.0:
         mesh.points *= spec.length_unit
+    mesh.points += np.asarray(spec.translate, dtype=float)[:mesh.points.shape[1]]
     return mesh
 
 

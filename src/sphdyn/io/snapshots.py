@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..fields import FIELDS
 from .plots import save_figure, time_unit
 from .frames import frames_of_run
 from .hdf5 import read_frame, read_frame_header
@@ -40,13 +41,9 @@ _TENSOR = ("xx", "xy", "xz", "yx", "yy", "yz", "zx", "zy", "zz")
 _TENSOR_RE = re.compile(r"^(.+)_(xx|xy|xz|yx|yy|yz|zx|zy|zz)$")
 _VECTOR_RE = re.compile(r"^(.+)_([xyz])$")
 
-#: SI unit of each output field (components and magnitudes share it).
-_UNITS = {
-    "position": "m", "velocity": "m/s", "speed": "m/s", "displacement": "m",
-    "stress": "Pa", "pressure": "Pa", "von_mises": "Pa",
-    "density": "kg/m^3", "mass": "kg", "smoothing_length": "m",
-    "damage": "-", "internal_energy": "J/kg", "plastic_strain": "-",
-}
+#: SI unit of each output field (components and magnitudes share it), from
+#: the field registry
+_UNITS = {name: f.unit for name, f in FIELDS.items()}
 
 _DAMAGE_COLOURS = ((0.72, 0.72, 0.72), (0.0, 0.0, 0.0))  # intact grey, failed black
 

@@ -96,3 +96,31 @@ def deflection_figure(run: Path, case, rows, path: Path, data_dir: Path, *,
     ax.legend(fontsize=7, ncol=2)
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def load_figure(run: Path, case, rows, path: Path, data_dir: Path, *, loader: str,
+                midspan: str, window: float) -> None:
+    """Load against mid-span deflection of a quasi-static test
+    (:func:`~sphdyn.validation.measures.load_deflection`: the ``loader``
+    mesh's contact force averaged over ``window`` [s]), with the measured
+    peak load's scatter of ``rows`` as a band; written to ``path`` (PNG)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .measures import load_deflection
+
+    u, f = load_deflection(run, loader, midspan, window)
+    fig, ax = plt.subplots(figsize=(7.5, 4.6), layout="constrained")
+    for r in rows:
+        if r["key"] == "peak_load":
+            ax.axhspan(r["low"], r["high"], color="0.85", label="peak load, measured scatter")
+            ax.axhline(r["measured"], color="k", ls="--", label="peak load, measured mean")
+    ax.plot(1e3 * u, 1e-3 * f, "k-", lw=2, label=f"sphdyn (load averaged over "
+                                                  f"{1e3 * window:g} ms)")
+    ax.set(xlabel="mid-span deflection [mm]", ylabel="load [kN]",
+           title=f"{case.name}: load against deflection")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

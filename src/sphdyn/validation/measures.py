@@ -19,6 +19,12 @@ measure it on the specimen.
   after the impact, from the mean vertical displacement of a mid-span set
   (a probe); the impact starts at the first history record with a contact
   force on the impactor's mesh.
+* :func:`load_deflection` and :func:`peak_load`: a quasi-static test's load
+  against mid-span deflection, the load being the contact force on the
+  loading mesh averaged over windows of fixed length (the contact of a
+  particle surface is a train of spikes; the testing machine's load cell
+  averages it over its own response time), and its peak with the
+  deflection there.
 """
 
 from __future__ import annotations
@@ -96,3 +102,33 @@ def largest_deflection(run: Path, midspan: str, impactor: str, axis: str = "z"
     t, u = deflection_history(run, midspan, impactor, axis)
     k = int(np.argmax(u))
     return float(u[k]), float(t[k])
+
+
+def load_deflection(run: Path, loader: str, midspan: str, window: float, axis: str = "z"
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """(deflection [m], load [N]) of a quasi-static test: the contact force
+    ``F_<loader>_contact`` and the mid-span probe's displacement (positive
+    along -``axis``), each averaged over consecutive windows of ``window``
+    [s] of the history's records (a window's mean of the records in it; a
+    last partial window is dropped)."""
+    h = History.from_csv(Path(run) / "history.csv").as_arrays()
+    t = h["time"]
+    force = h[f"F_{loader}_contact"]
+    u = -h[f"probe_{midspan}_displacement_{axis}"]
+    k = np.floor((t - t[0]) / window).astype(np.int64)
+    full = k < k[-1]
+    if not full.any():
+        raise ValueError(f"{run}: the history is shorter than one window of {window} s")
+    k, force, u = k[full], force[full], u[full]
+    counts = np.bincount(k)
+    ok = counts > 0
+    return (np.bincount(k, u)[ok] / counts[ok], np.bincount(k, force)[ok] / counts[ok])
+
+
+def peak_load(run: Path, loader: str, midspan: str, window: float, axis: str = "z"
+              ) -> tuple[float, float]:
+    """(largest window-averaged load [N], the deflection there [m])
+    (:func:`load_deflection`)."""
+    u, f = load_deflection(run, loader, midspan, window, axis)
+    k = int(np.argmax(f))
+    return float(f[k]), float(u[k])

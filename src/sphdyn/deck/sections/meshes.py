@@ -355,6 +355,10 @@ class Mesh(Section):
     length_unit: quantity(LENGTH, "length unit", lo=0, lo_open=True) = Field(
         1.0, description="Length of one file coordinate unit (\"1 mm\" for a file "
                          "in millimetres).")
+    translate: Position = Field(
+        (0.0, 0.0, 0.0), description="Shift of a file's nodes, after length_unit "
+                                     "(LS-DYNA's *PART_MOVE): places a mesh file "
+                                     "in the model without rewriting it.")
     group: tuple[MeshGroup, ...] = Field(
         (), description="Materials of the file's element groups.")
     element: Optional[Literal["beam", "truss"]] = Field(
@@ -437,6 +441,10 @@ class Mesh(Section):
         if self.sublayer is not None and self.embed is not None:
             raise problem("a bar is either in SPH concrete ([mesh.sublayer]) or in "
                           "solid elements (embed)", "keep one of them")
+        if self.file is None and any(self.translate):
+            raise problem("translate moves a mesh file's nodes",
+                          "give a generated mesh its coordinates directly, or remove "
+                          "translate")
         if self.group and self.file is None:
             raise problem("[[mesh.group]] names groups of a mesh file",
                           "remove [[mesh.group]] or read the mesh from a file")
