@@ -142,12 +142,14 @@ def shell_commands(doc: Path) -> list[str]:
 
 @pytest.fixture
 def scratch(tmp_path, monkeypatch):
-    """A scratch working directory with examples/ linked in; every simulation
-    capped at MAX_STEPS; ensembles run their samples in this process."""
+    """A scratch working directory with examples/ and validation/ linked in;
+    every simulation capped at MAX_STEPS; ensembles run their samples in this
+    process."""
     from sphdyn.ensemble import run as ensemble_run
     from sphdyn.simulation import Simulation
 
     (tmp_path / "examples").symlink_to(ROOT / "examples")
+    (tmp_path / "validation").symlink_to(ROOT / "validation")
     monkeypatch.chdir(tmp_path)
     real_run = Simulation.run
 
