@@ -148,7 +148,7 @@ def test_interface_smoothness_numbers_of_the_coupling_figure():
     spec.loader.exec_module(mod)
     bins = np.arange(161) * mod.ELEMENT
     x = 0.5 * (bins[1:] + bins[:-1])
-    ref = np.full(160, 100e6)                     # the largest reference stress: 100 MPa
+    ref = np.full(160, 100e6)                     # the reference: 100 MPa everywhere
     prof = ref.copy()
     k15 = int(np.searchsorted(x, 1.5))
     prof[k15:k15 + 2] += 5e6
