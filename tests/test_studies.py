@@ -57,3 +57,23 @@ def test_richardson_of_the_disc_study():
     assert dr.richardson([1, 2, 3], [1.0, 2.0, 1.0]) is None  # not monotone
     assert dr.richardson([1, 2, 3], [1.0, 1.1, 3.0]) is not None  # converging
     assert dr.richardson([1, 2, 3], [1.0, 3.0, 3.1]) is None  # diverging with refinement
+
+
+def test_facet_of_the_disc_study():
+    """The disc study's lattice facet at the point of impact (docs/examples.md,
+    "Resolution study"): at the deck's 2.5 mm the lowest row holds 8
+    particles per layer, a facet 8 dx = 20 mm wide, whose first contact
+    pushes rho c v w t with c = sqrt((K + 4G/3)/rho) of the deck's concrete,
+    v = 15 m/s and t the disc's 20 mm thickness."""
+    import disc_resolution as dr
+    from sphdyn.deck import load_deck
+
+    got = dr.facet(2.5)
+    mat = load_deck(dr.DECK).material[0]
+    c = math.sqrt((mat.K + 4.0 * mat.G / 3.0) / mat.density)
+    assert (got["facet_particles"], got["facet_mm"]) == (8, pytest.approx(20.0, rel=1e-12))
+    assert got["wave_speed_ms"] == pytest.approx(c, rel=1e-12)
+    assert got["facet_force_kN"] == pytest.approx(
+        1e-3 * mat.density * c * 15.0 * 0.020 * 0.020, rel=1e-12)
+    fine = dr.facet(1.25)  # the finest spacing: 12 particles, 15 mm (docs' table)
+    assert (fine["facet_particles"], fine["facet_mm"]) == (12, pytest.approx(15.0, rel=1e-12))

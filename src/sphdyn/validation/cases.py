@@ -116,19 +116,23 @@ def _series_rows(data_dir: Path, series: str) -> list[dict[str, str]]:
     return [r for r in data.read(data_dir / LOZANO).rows if r["series"] == series]
 
 
+def _series_reference(rows: list[dict[str, str]], series: str, tables: str, key: str,
+                      label: str, unit: str, column: str) -> Reference:
+    """The mean of ``column`` over a series' beams, their range as the scatter."""
+    v = [data.number(r, column) for r in rows]
+    return Reference(key, label, unit, sum(v) / len(v), min(v), max(v),
+                     f"{LOZANO}: mean of the {len(rows)} beams of Series {series} ({tables})",
+                     scatter=f"beams {', '.join(r['beam_id'] for r in rows)}")
+
+
 def _lozano_references(series: str):
     def references(data_dir: Path) -> list[Reference]:
         rows = _series_rows(data_dir, series)
-        where = (f"{LOZANO}: mean of the {len(rows)} beams of Series {series} "
-                 "(Tables 9.1/9.2, 9.5/9.6)")
-        scatter = f"beams {', '.join(r['beam_id'] for r in rows)}"
-        out = []
-        for key, label, column in (("umax", "largest mid-span deflection", "umax_mm"),
-                                   ("t_umax", "time of the largest deflection", "t_umax_ms")):
-            v = [data.number(r, column) for r in rows]
-            out.append(Reference(key, label, "mm" if key == "umax" else "ms",
-                                 sum(v) / len(v), min(v), max(v), where, scatter=scatter))
-        return out
+        return [_series_reference(rows, series, "Tables 9.1/9.2, 9.5/9.6", key, label, unit,
+                                  column)
+                for key, label, unit, column in (
+                    ("umax", "largest mid-span deflection", "mm", "umax_mm"),
+                    ("t_umax", "time of the largest deflection", "ms", "t_umax_ms"))]
     return references
 
 
@@ -146,12 +150,8 @@ STATIC_WINDOW = 1e-3
 
 
 def _lozano_static_references(data_dir: Path) -> list[Reference]:
-    rows = _series_rows(data_dir, "3")
-    v = [data.number(r, "F_static_max_kN") for r in rows]
-    return [Reference("peak_load", "peak load of the static test", "kN",
-                      sum(v) / len(v), min(v), max(v),
-                      f"{LOZANO}: mean of the {len(rows)} beams of Series 3 (Table 9.7)",
-                      scatter=f"beams {', '.join(r['beam_id'] for r in rows)}")]
+    return [_series_reference(_series_rows(data_dir, "3"), "3", "Table 9.7", "peak_load",
+                              "peak load of the static test", "kN", "F_static_max_kN")]
 
 
 def _lozano_static_measure(run: Path, deck: dict) -> dict[str, float]:
