@@ -77,3 +77,24 @@ def test_facet_of_the_disc_study():
         1e-3 * mat.density * c * 15.0 * 0.020 * 0.020, rel=1e-12)
     fine = dr.facet(1.25)  # the finest spacing: 12 particles, 15 mm (docs' table)
     assert (fine["facet_particles"], fine["facet_mm"]) == (12, pytest.approx(15.0, rel=1e-12))
+
+
+def test_lozano_section_study_reads_the_static_deck(capsys):
+    """studies/lozano_section.py takes the section from the static deck
+    (100 x 100 mm, 42.2 MPa, two bars at 83 mm and two at 22 mm below the
+    top, f0.2 575 MPa and fu 686 MPa from its hardening) and prints the
+    loads in the order the theory fixes: first yield < crushing strain <
+    bars at 35 per mille < the upper bound, the last below the tests'
+    14.0 kN (docs/validation.md)."""
+    import re
+
+    import lozano_section
+
+    b, h, fc, bars, steel = lozano_section.section(
+        __import__("sphdyn.deck", fromlist=["load_deck"]).load_deck(lozano_section.DECK))
+    assert (b, h, fc) == pytest.approx((0.1, 0.1, 42.2e6))
+    assert sorted(round(d, 6) for d, _ in bars) == [0.022, 0.022, 0.083, 0.083]
+    assert steel["fu"] == pytest.approx(686e6, rel=2e-3)
+    lozano_section.main()
+    loads = [float(x) for x in re.findall(r"P = +([0-9.]+) kN", capsys.readouterr().out)]
+    assert len(loads) == 4 and loads == sorted(loads) and loads[-1] < 14.0

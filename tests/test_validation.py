@@ -183,13 +183,41 @@ def test_table_marks_estimates_and_stopped_runs():
     text = report.table_markdown([
         {"case": "a", "status": "completed", "rows": row},
         {"case": "b", "status": "stopped", "rows": []}])
-    assert "10 (estimate) | 12 | +20 % | fair" in text
-    assert "| b | run stopped | | | | not compared |" in text
+    assert "10 (estimate) | 12 | +20 % | fair |  |" in text
+    assert "| b | run stopped | | | | not compared | |" in text
+
+
+def test_table_shows_another_codes_answer_beside_sphdyns():
+    """A reference with a peer value (another code on the same test) gets
+    it and its difference from the measurement in the last column, and its
+    label in the sources."""
+    row = report.compare([Reference("umax", "deflection", "mm", 10.0, 9.0, 11.0, "tab",
+                                    peer=12.3, peer_label="LS-DYNA (Table 11.6)")],
+                         {"umax": 0.015})
+    res = [{"case": "a", "title": "A", "status": "completed", "rows": row}]
+    assert "| 15 | +50 % | poor | 12.3 (+23 %) |" in report.table_markdown(res)
+    assert "another code: LS-DYNA (Table 11.6)" in report.sources_markdown(res)
+
+
+def test_lozano_cases_carry_the_authors_ls_dyna_answers():
+    """The Lozano references' peers are the authors' LS-DYNA hexahedron
+    model's (lozano2017_reference_predictions.csv: Tables 11.3, 11.6, 11.18)."""
+    from sphdyn.validation.cases import CASES
+
+    data = ROOT / "validation" / "data"
+    peers = {name: {r.key: r.peer for r in CASES[name].references(data)}
+             for name in ("lozano2017_dropweight_2.5m", "lozano2017_dropweight_5.0m",
+                          "lozano2017_static")}
+    assert peers == {"lozano2017_dropweight_2.5m": {"umax": 12.3, "t_umax": 6.9},
+                     "lozano2017_dropweight_5.0m": {"umax": 24.6, "t_umax": 9.2},
+                     "lozano2017_static": {"peak_load": 13.0}}
 
 
 @pytest.mark.parametrize("argv, message", [
     (["validate", "nope"], "unknown validation case(s) nope"),
     (["validate", "--quick", "--docs"], "drop --quick"),
+    (["validate", "--docs", "--set", "run.t_end=1"], "drop --set"),
+    (["validate", "--set", "run.t_end"], "is not KEY=VALUE"),
 ])
 def test_validate_errors(argv, message, capsys, monkeypatch):
     monkeypatch.chdir(ROOT)
@@ -218,3 +246,119 @@ def test_ndrc_depth_in_its_own_units_and_both_branches():
     assert ndrc_depth(v1, lb, inch, 1e4 * psi, 0.72) == pytest.approx(2.0 * inch, rel=1e-9)
     assert ndrc_depth(v1 * 4 ** (1 / 1.8), lb, inch, 1e4 * psi, 0.72) == \
         pytest.approx(5.0 * inch, rel=1e-9)
+
+
+def test_concrete_and_steel_curves_of_the_section_estimate():
+    """EN 1992-1-1 Eq. 3.17 with n = 2: fc at eps_c2, 3/4 fc at half of it
+    (1 - (1/2)^2), no tension, fc beyond eps_c2; the steel line
+    through fy at fy/E and fu at eps_u, odd in the strain."""
+    from sphdyn.validation.estimates import bilinear_steel, parabola_rectangle
+
+    s = parabola_rectangle([2e-3, 1e-3, -1e-3, 3.5e-3, 3.6e-3], 40e6)
+    assert s == pytest.approx([40e6, 30e6, 0.0, 40e6, 40e6], rel=1e-14)
+    st = dict(E=200e9, fy=500e6, fu=600e6, eps_u=0.1)
+    s = bilinear_steel([1e-3, 2.5e-3, 0.1, -0.1, 0.0025 + 0.0975 / 2], **st)
+    assert s == pytest.approx([200e6, 500e6, 600e6, -600e6, 550e6], rel=1e-12)
+
+
+def test_section_moment_at_the_crushing_strain_matches_the_stress_block():
+    """With the top fibre at eps_cu2 = 3.5 per mille and eps_c2 = 2 per
+    mille, the parabola-rectangle's resultant is alpha fc b c with alpha =
+    17/21 (rectangle over 3c/7, parabola's 2/3 over 4c/7) acting at beta c
+    below the top, beta = (99/294) / (17/21) = 0.41597 (the code's 0.810 and
+    0.416). One yielded bar (fu = fy) at depth d: c = As fy / (alpha fc b),
+    M = As fy (d - beta c). (Perfectly plastic bars still give one root:
+    the concrete's force grows with c at any curvature.) 2000 midpoint layers: error ~1e-6 (the kink at
+    eps_c2); tolerance 1e-5."""
+    from sphdyn.validation.estimates import rc_section_moment
+
+    b, h, d, fc, area = 0.1, 0.1, 0.083, 40e6, 60e-6
+    st = dict(E=200e9, fy=500e6, fu=500e6, eps_u=0.2)
+    alpha, beta = 17 / 21, (99 / 294) / (17 / 21)
+    c = area * 500e6 / (alpha * fc * b)
+    m, c_found = rc_section_moment(3.5e-3 / c, b, h, fc, [(d, area)], st)
+    assert c_found == pytest.approx(c, rel=1e-5)
+    assert m == pytest.approx(area * 500e6 * (d - beta * c), rel=1e-5)
+
+
+def test_section_moment_is_the_cracked_elastic_section_at_small_curvature():
+    """At a tiny curvature the parabola's initial tangent Ec = 2 fc / eps_c2
+    makes a linear cracked section: with n = Es / Ec and rho = As / (b d),
+    c = k d, k = sqrt((n rho)^2 + 2 n rho) - n rho, and M = As Es kappa
+    (d - c)(d - c/3). Nonlinearity at kappa = 1e-6/m: strain 2e-8 against
+    eps_c2 = 2e-3, relative 1e-5; tolerance 1e-4."""
+    from sphdyn.validation.estimates import rc_section_moment
+
+    b, h, d, fc, area, es = 0.1, 0.1, 0.083, 40e6, 60e-6, 200e9
+    st = dict(E=es, fy=500e6, fu=600e6, eps_u=0.1)
+    n, rho = es / (2 * fc / 2e-3), area / (b * d)
+    c = d * ((n * rho) ** 2 + 2 * n * rho) ** 0.5 - d * n * rho
+    kappa = 1e-6
+    m, c_found = rc_section_moment(kappa, b, h, fc, [(d, area)], st)
+    assert c_found == pytest.approx(c, rel=1e-4)
+    assert m == pytest.approx(area * es * kappa * (d - c) * (d - c / 3), rel=1e-4)
+
+
+def test_section_estimate_reproduces_the_lozano_hand_calculation():
+    """The authors' own cross-section analysis of the beams (Lozano Mendoza
+    & Makdesi Aphram 2017, Appendix I pp. I-7/I-8 and Table 9.15 p. 125, in
+    validation/data/lozano2017_reference_predictions.csv) uses the same
+    model as ``rc_section_moment`` (parabola-rectangle at eps_cu = 3.5 per
+    mille, fcm 42.2 MPa, 2 + 2 bars of 6 mm, hardening steel to 686 MPa at
+    10.8 %, E 196 GPa, F = 4 M / L, L = 1 m): its printed neutral axis
+    (14.288 mm) and load (10.737 kN) for fy 575 MPa and d / d' = 80 / 20 mm
+    to their printed digits, and the table's four loads to its rounding
+    (0.05 kN; the adjusted depths as Appendix I: d = h - phi/2 - 14 mm = 83
+    mm, d' = phi/2 + 18.9 mm = 21.9 mm)."""
+    import math
+
+    from scipy.optimize import brentq
+
+    from sphdyn.validation.estimates import rc_section_moment
+
+    area = 2 * math.pi * 0.003 ** 2
+
+    def ultimate(fy, d, d_top):
+        st = dict(E=196e9, fy=fy, fu=686e6, eps_u=0.108)
+        bars = [(d_top, area), (d, area)]
+        k = brentq(lambda k: k * rc_section_moment(k, 0.1, 0.1, 42.2e6, bars, st)[1] - 3.5e-3,
+                   1e-3, 5.0, xtol=1e-14)
+        m, c = rc_section_moment(k, 0.1, 0.1, 42.2e6, bars, st)
+        return 4.0 * m / 1.0, c
+
+    f, c = ultimate(575e6, 0.080, 0.020)
+    assert c == pytest.approx(14.288e-3, abs=0.0005e-3)
+    assert f == pytest.approx(10.737e3, abs=0.5)
+    table = {(575e6, 0.080, 0.020): 10.7e3, (575e6, 0.083, 0.0219): 11.3e3,
+             (686e6, 0.080, 0.020): 12.1e3, (686e6, 0.083, 0.0219): 12.8e3}
+    for (fy, d, d_top), printed in table.items():
+        assert ultimate(fy, d, d_top)[0] == pytest.approx(printed, abs=50.0)
+
+
+def test_validate_set_overrides_reach_every_run_after_the_cases_own(tmp_path, monkeypatch):
+    """``sphdyn validate --set K=V`` (a sensitivity study) passes K=V to each
+    case's ``sphdyn run`` after the case's own and quick overrides, so the
+    user's value wins; the run (stubbed here) is not compared when it
+    leaves no summary."""
+    from sphdyn.validation import runner
+    from sphdyn.validation.cases import CASES
+
+    calls = []
+    monkeypatch.setattr(runner.subprocess, "run", lambda cmd, **kw: calls.append(cmd))
+    case = CASES["lozano2017_dropweight_5.0m"]
+    res = runner.run_case(case, ROOT, tmp_path, True, None, False,
+                          ("material.concrete.rate_effects=false", "run.t_end=0.002"))
+    sets = [calls[0][i + 1] for i, a in enumerate(calls[0]) if a == "--set"]
+    assert sets == [*case.overrides, *case.quick, "material.concrete.rate_effects=false",
+                    "run.t_end=0.002"]
+    assert res["status"] == "failed" and res["rows"] == []
+
+
+def test_figures_find_another_codes_answer_in_the_rows():
+    """The figures mark another code's answer (figures._peer) from the
+    compared rows: the value of the row with that key, None without one."""
+    from sphdyn.validation.figures import _peer
+
+    rows = [{"key": "umax", "peer": 12.3}, {"key": "t_umax", "peer": None}]
+    assert _peer(rows, "umax") == 12.3
+    assert _peer(rows, "t_umax") is None and _peer(rows, "peak_load") is None

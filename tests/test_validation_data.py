@@ -56,3 +56,42 @@ def test_nothing_outside_mat159_is_on_by_default_and_decks_mark_it_calibrated():
     assert marked == 10
     page = (Path(__file__).parents[1] / "docs" / "validation.md").read_text(encoding="utf-8")
     assert "## Calibrated parameters" in page and "studies/calibration_disc.py" in page
+
+
+def test_validation_decks_mark_every_departure_from_the_mat159_fits():
+    """A validation deck that replaces one of MAT_159's fitted parameters
+    (a name of sphdyn.materials.cscm.PARAM_NAMES, or K, G) says why within
+    the comment block above it: MEASURED (a property of the tested
+    material, with its source) or CALIBRATED (chosen to match a result),
+    as docs/validation.md, "Calibrated parameters", describes. The
+    Lozano decks' fracture energies are such a block."""
+    import re
+
+    from sphdyn.materials.cscm import PARAM_NAMES
+
+    cases = Path(__file__).parents[1] / "validation" / "cases"
+    names = set(PARAM_NAMES) | {"K", "G"}
+    replaced = 0
+    for deck in sorted(cases.glob("*.toml")):
+        lines = deck.read_text(encoding="utf-8").splitlines()
+        in_cscm = False
+        for i, line in enumerate(lines):
+            if line.lstrip().startswith("["):
+                in_cscm = False  # a new table; a CSCM material says so below
+            if re.match(r'\s*model\s*=\s*"cscm"', line):
+                in_cscm = True
+            m = re.match(r"\s*(\w+)\s*=", line)
+            if not (in_cscm and m and m.group(1) in names):
+                continue
+            replaced += 1
+            j = i
+            while j > 0 and re.match(r"\s*\w+\s*=", lines[j - 1]) and \
+                    re.match(r"\s*(\w+)", lines[j - 1]).group(1) in names:
+                j -= 1  # a block of replaced parameters shares one comment
+            above = []
+            while j > 0 and lines[j - 1].lstrip().startswith("#"):
+                above.append(lines[j - 1])
+                j -= 1
+            text = " ".join(above) + line
+            assert "MEASURED" in text or "CALIBRATED" in text, f"{deck.name}: {line}"
+    assert replaced >= 6  # the two Lozano decks' GFT, GFS, GFC

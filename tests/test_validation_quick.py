@@ -2,7 +2,7 @@
 their compared numbers (issue 53).
 
 Each quick case runs (leppanen2004_fragment about 1 minute on 2 cores, the
-two lozano2017_dropweight cases about 4 and 5, lozano2017_static about 9)
+two lozano2017_dropweight cases about 4 and 5, lozano2017_static about 6)
 and its compared
 numbers must stay within the tolerance of the values stored in
 tests/data/validation_quick.json, which ``python tests/test_validation_quick.py

@@ -323,7 +323,8 @@ def cmd_validate(args) -> int:
     from .validation.runner import validate
 
     return validate(args.cases, quick=args.quick, out=Path(args.out), root=Path(args.root),
-                    threads=args.threads, reuse=args.reuse, docs=args.docs)
+                    threads=args.threads, reuse=args.reuse, docs=args.docs,
+                    sets=tuple(args.set))
 
 
 def cmd_info(args) -> int:
@@ -650,6 +651,10 @@ def build_parser() -> argparse.ArgumentParser:
                     "instead of rerunning them")
     va.add_argument("--docs", action="store_true", help="write the table and figures "
                     "into docs/validation.md (full versions only)")
+    va.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="override a deck value in every case run, after the case's "
+                    "own (a sensitivity study; use its own --out), e.g. --set "
+                    "material.concrete.rate_effects=false")
     va.set_defaults(func=cmd_validate)
 
     i = sub.add_parser("info", help="versions, threads, Numba cache")

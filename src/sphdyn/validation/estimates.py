@@ -25,3 +25,85 @@ def ndrc_depth(velocity: float, mass: float, diameter: float, fc: float,
     g = 3.8e-5 * nose * lb / (inch * math.sqrt(psi)) * (fps / inch) ** 1.8
     ratio = 2.0 * math.sqrt(g) if g <= 1.0 else g + 1.0
     return ratio * diameter
+
+
+def parabola_rectangle(strain, fc: float, eps_c2: float = 2.0e-3, n: float = 2.0):
+    """Concrete compressive stress [Pa] of the parabola-rectangle diagram
+    (EN 1992-1-1, 3.1.7, Eq. 3.17), compression positive::
+
+        sigma = fc [1 - (1 - eps / eps_c2)^n]   for 0 <= eps <= eps_c2
+        sigma = fc                              for eps > eps_c2
+
+    zero in tension (a cracked section). The code ends the diagram at the
+    crushing strain eps_cu2 (3.5 per mille for fck <= 50 MPa); here it goes
+    on at fc, and the caller reads the top fibre's strain to know whether a
+    state lies beyond it (a crushed zone held at zero stress would make the
+    neutral axis of ``rc_section_moment`` ambiguous). ``strain`` an array
+    [-], ``fc`` the (mean) cylinder strength; the defaults are the code's
+    values for fck <= 50 MPa.
+    """
+    import numpy as np
+
+    eps = np.asarray(strain, dtype=float)
+    return np.where(eps > 0.0, fc * (1.0 - (1.0 - np.clip(eps, 0.0, eps_c2) / eps_c2) ** n), 0.0)
+
+
+def bilinear_steel(strain, E: float, fy: float, fu: float, eps_u: float):
+    """Reinforcing steel stress [Pa], tension positive: elastic to the
+    yield strain fy / E, then the straight line to the tensile strength
+    ``fu`` at the ultimate strain ``eps_u`` (as EN 1992-1-1 Fig. 3.8's
+    inclined branch drawn through the measured fy, fu and eps_u); the same
+    in compression; held at fu beyond eps_u."""
+    import numpy as np
+
+    eps = np.asarray(strain, dtype=float)
+    eps_y = fy / E
+    a = np.abs(eps)
+    plastic = fy + (fu - fy) * (np.minimum(a, eps_u) - eps_y) / (eps_u - eps_y)
+    return np.sign(eps) * np.where(a <= eps_y, E * a, plastic)
+
+
+def rc_section_moment(curvature: float, width: float, height: float, fc: float,
+                      bars: list[tuple[float, float]], steel: dict,
+                      layers: int = 2000, **concrete) -> tuple[float, float]:
+    """Bending moment [N m] and neutral-axis depth [m] of a rectangular RC
+    section at a curvature [1/m], sagging (compression on top): plane
+    sections, the strain at depth y below the top face
+    ``eps(y) = curvature (c - y)`` (compression positive), the neutral-axis
+    depth c found from the axial balance
+
+        int_0^h sigma_c(eps(y)) b dy - sum_i A_i sigma_s(-eps(y_i)) = 0
+        (sigma_s tension positive),
+
+    the concrete by ``parabola_rectangle`` (no tension: a cracked section),
+    the bars (``bars``: (depth of the bar's centre below the top [m], area
+    [m^2]) each) by ``bilinear_steel`` with ``steel`` = dict(E, fy, fu,
+    eps_u) and the concrete they displace neglected. The moment is taken
+    about the top face. ``layers`` midpoint slices integrate the concrete
+    (the error is of order (h / layers)^2). ``concrete`` passes eps_c2,
+    n to ``parabola_rectangle``. With the concrete force growing and the
+    bars' tension falling as c grows, the balance has one root.
+    """
+    import numpy as np
+    from scipy.optimize import brentq
+
+    y = (np.arange(layers) + 0.5) * height / layers
+    dy = height / layers
+    depth = np.array([b[0] for b in bars])
+    area = np.array([b[1] for b in bars])
+
+    def forces(c):
+        sc = parabola_rectangle(curvature * (c - y), fc, **concrete) * width * dy
+        ss = bilinear_steel(curvature * (depth - c), **steel) * area  # tension +
+        return sc, ss
+
+    def axial(c):
+        sc, ss = forces(c)
+        return sc.sum() - ss.sum()
+
+    c = brentq(axial, 1e-9 * height, height, xtol=1e-14 * height)
+    sc, ss = forces(c)
+    # moment about the top face of the compressive resultant and the bars'
+    # tension: M = sum T_i y_i - sum C_j y_j (sagging positive)
+    moment = float(np.dot(ss, depth) - np.dot(sc, y))
+    return moment, c

@@ -63,13 +63,21 @@ def section_figure(run: Path, case, rows, path: Path, data_dir: Path) -> None:
     plt.close(fig)
 
 
+def _peer(rows, key: str) -> float | None:
+    """Another code's answer for ``key`` among the compared ``rows`` (None
+    where its authors published none)."""
+    return next((r["peer"] for r in rows if r["key"] == key and r.get("peer") is not None),
+                None)
+
+
 def deflection_figure(run: Path, case, rows, path: Path, data_dir: Path, *,
                       history: str, drop_height: str) -> None:
     """Mid-span deflection against time after the contact's start: sphdyn's
     (the ``midspan`` probe; the start from the ``rod`` mesh's contact force)
     as a line, every beam dropped on from ``drop_height`` [m, as written in
     the data] in the data file ``history`` as points (their printed maxima
-    filled); written to ``path`` (PNG)."""
+    filled), and another code's largest deflection and its time where the
+    compared ``rows`` carry one (a star); written to ``path`` (PNG)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -90,6 +98,10 @@ def deflection_figure(run: Path, case, rows, path: Path, data_dir: Path, *,
         peak = [i for i, r in enumerate(pts) if r["is_max"] == "1"]
         ax.plot([tt[i] for i in peak], [uu[i] for i in peak], "o", ms=5, color=f"C{k % 10}")
     ax.plot(1e3 * t, 1e3 * u, "k-", lw=2, label="sphdyn")
+    u_peer, t_peer = _peer(rows, "umax"), _peer(rows, "t_umax")
+    if u_peer is not None and t_peer is not None:
+        ax.plot([t_peer], [u_peer], "*", ms=11, color="0.35",
+                label="largest, the authors' LS-DYNA")
     ax.set(xlabel="time after impact [ms]", ylabel="mid-span deflection [mm]",
            title=f"{case.name}: mid-span deflection")
     ax.grid(alpha=0.3)
@@ -103,7 +115,8 @@ def load_figure(run: Path, case, rows, path: Path, data_dir: Path, *, loader: st
     """Load against mid-span deflection of a quasi-static test
     (:func:`~sphdyn.validation.measures.load_deflection`: the ``loader``
     mesh's contact force averaged over ``window`` [s]), with the measured
-    peak load's scatter of ``rows`` as a band; written to ``path`` (PNG)."""
+    peak load's scatter of ``rows`` as a band and another code's peak load
+    (dotted) where the rows carry one; written to ``path`` (PNG)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -116,6 +129,9 @@ def load_figure(run: Path, case, rows, path: Path, data_dir: Path, *, loader: st
         if r["key"] == "peak_load":
             ax.axhspan(r["low"], r["high"], color="0.85", label="peak load, measured scatter")
             ax.axhline(r["measured"], color="k", ls="--", label="peak load, measured mean")
+    if _peer(rows, "peak_load") is not None:
+        ax.axhline(_peer(rows, "peak_load"), color="0.35", ls=":",
+                   label="peak load, the authors' LS-DYNA")
     ax.plot(1e3 * u, 1e-3 * f, "k-", lw=2, label=f"sphdyn (load averaged over "
                                                   f"{1e3 * window:g} ms)")
     ax.set(xlabel="mid-span deflection [mm]", ylabel="load [kN]",

@@ -6,7 +6,9 @@ measured value; **fair** within 25 %; **poor** beyond. The 10 % band is of
 the order of the scatter of repeated shots in the data (Leppänen's eight
 shots: depth 52-57 mm, crater 74-93 mm); the 25 % band is a project choice
 for "right in kind, not in number". An estimate (no scatter) is judged by
-the same bands and marked as an estimate.
+the same bands and marked as an estimate. Where the experiment's authors
+published another code's answer on the same test (``Reference.peer``), the
+table shows it and its difference from the measurement beside sphdyn's.
 """
 
 from __future__ import annotations
@@ -43,7 +45,8 @@ def compare(refs: list[Reference], measured_si: dict[str, float]) -> list[dict]:
         rows.append({"key": ref.key, "quantity": f"{ref.label} [{ref.unit}]",
                      "measured": ref.value, "low": ref.low, "high": ref.high,
                      "kind": ref.kind, "source": ref.source, "scatter": ref.scatter,
-                     "sphdyn": value, "difference_pct": diff, "verdict": word})
+                     "sphdyn": value, "difference_pct": diff, "verdict": word,
+                     "peer": ref.peer, "peer_label": ref.peer_label})
     return rows
 
 
@@ -53,11 +56,12 @@ def _g(x: float) -> str:
 
 def table_markdown(results: list[dict]) -> str:
     """The validation table of ``results`` (one dict per case run)."""
-    lines = ["| case | quantity | measured (scatter) | sphdyn | difference | verdict |",
-             "|---|---|---|---|---|---|"]
+    lines = ["| case | quantity | measured (scatter) | sphdyn | difference | verdict "
+             "| another code (difference) |",
+             "|---|---|---|---|---|---|---|"]
     for res in results:
         if res["status"] != "completed":
-            lines.append(f"| {res['case']} | run {res['status']} | | | | not compared |")
+            lines.append(f"| {res['case']} | run {res['status']} | | | | not compared | |")
             continue
         for row in res["rows"]:
             ref = _g(row["measured"])
@@ -65,8 +69,11 @@ def table_markdown(results: list[dict]) -> str:
                 ref = f"{ref} (estimate)"
             elif row["low"] != row["high"]:
                 ref = f"{ref} ({_g(row['low'])}-{_g(row['high'])})"
+            peer = row.get("peer")
+            other = "" if peer is None else \
+                f"{_g(peer)} ({100.0 * (peer / row['measured'] - 1.0):+.0f} %)"
             lines.append(f"| {res['case']} | {row['quantity']} | {ref} | {_g(row['sphdyn'])} | "
-                         f"{row['difference_pct']:+.0f} % | {row['verdict']} |")
+                         f"{row['difference_pct']:+.0f} % | {row['verdict']} | {other} |")
     return "\n".join(lines)
 
 
@@ -77,6 +84,8 @@ def sources_markdown(results: list[dict]) -> str:
         seen = []
         for row in res.get("rows", []):
             text = row["source"] + (f"; scatter: {row['scatter']}" if row["scatter"] else "")
+            if row.get("peer") is not None:
+                text += f"; another code: {row['peer_label']}"
             if text not in seen:
                 seen.append(text)
         if seen:

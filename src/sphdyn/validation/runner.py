@@ -41,10 +41,11 @@ def completed(run: Path) -> bool:
 
 
 def run_case(case: Case, root: Path, out: Path, quick: bool, threads: int | None,
-             reuse: bool) -> dict:
-    """Run (unless ``reuse`` finds it done), measure and compare one case."""
+             reuse: bool, sets: tuple[str, ...] = ()) -> dict:
+    """Run (unless ``reuse`` finds it done), measure and compare one case;
+    ``sets`` are the user's overrides, applied after the case's own."""
     run = run_dir(out, case, quick)
-    overrides = case.overrides + (case.quick if quick else ())
+    overrides = case.overrides + (case.quick if quick else ()) + tuple(sets)
     if not (reuse and completed(run)):
         cmd = [sys.executable, "-m", "sphdyn", "run", str(root / case.deck), "--out",
                str(run), "-q"]
@@ -104,9 +105,10 @@ def page_block(results: list[dict], root: Path, figures: dict[str, str]) -> str:
 
 
 def validate(names: list[str], quick: bool, out: Path, root: Path, threads: int | None,
-             reuse: bool, docs: bool) -> int:
+             reuse: bool, docs: bool, sets: tuple[str, ...] = ()) -> int:
     """The ``sphdyn validate`` command (module docstring); exit status 0 when
-    every case ran to its end, 1 otherwise."""
+    every case ran to its end, 1 otherwise. ``sets`` (``--set``) override
+    deck values in every case: a sensitivity study, kept off the docs page."""
     import shutil
 
     from .report import table_markdown, update_page, write_results
@@ -119,13 +121,21 @@ def validate(names: list[str], quick: bool, out: Path, root: Path, threads: int 
     if docs and quick:
         raise ValueError("--docs writes docs/validation.md, which shows the full cases. "
                          "Fix: drop --quick (or --docs)")
+    if docs and sets:
+        raise ValueError("--docs writes docs/validation.md, which shows the cases as they "
+                         "are. Fix: drop --set (a sensitivity study prints its own table "
+                         "and writes OUT/validation.md)")
+    bad = [s for s in sets if "=" not in s]
+    if bad:
+        raise ValueError(f"--set {bad[0]!r} is not KEY=VALUE. Fix: e.g. --set "
+                         "material.concrete.rate_effects=false")
     problem = root_problem(root, names)
     if problem:
         raise ValueError(problem)
     results = []
     for name in names:
         print(f"validate: {name}{' (quick)' if quick else ''} ...", flush=True)
-        res = run_case(CASES[name], root, out, quick, threads, reuse)
+        res = run_case(CASES[name], root, out, quick, threads, reuse, sets)
         results.append(res)
         for row in res["rows"]:
             print(f"  {row['quantity']}: measured {row['measured']:.3g}, sphdyn "
