@@ -98,3 +98,22 @@ def test_lozano_section_study_reads_the_static_deck(capsys):
     lozano_section.main()
     loads = [float(x) for x in re.findall(r"P = +([0-9.]+) kN", capsys.readouterr().out)]
     assert len(loads) == 4 and loads == sorted(loads) and loads[-1] < 14.0
+
+
+def test_l_specimen_sensitivity_needs_a_tag_and_names_its_runs(monkeypatch, tmp_path):
+    """examples/l_specimen.py --set (a sensitivity study) refuses to run
+    without --tag, so it cannot overwrite the deck's runs or its docs
+    figure, and a tagged run goes to out/l_specimen_TAG_<spacing> with the
+    override after the spacing."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "examples"))
+    import l_specimen
+
+    monkeypatch.setattr(sys, "argv", ["l_specimen.py", "--set", "run.t_end=1e-6"])
+    with pytest.raises(SystemExit):
+        l_specimen.main()
+    seen = {}
+    monkeypatch.setattr("sphdyn.simulation.run_deck",
+                        lambda deck, out, sets, **kw: seen.update(out=out, sets=sets))
+    out = l_specimen.run("fine", 0.00625, False, ("run.t_end=1e-6",), "probe")
+    assert out.name == "l_specimen_probe_fine" and seen["out"] == out
+    assert seen["sets"] == ["body.L.dx=0.00625", "run.t_end=1e-6"]
