@@ -7,6 +7,9 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+from scipy.optimize import brentq
+
 
 def ndrc_depth(velocity: float, mass: float, diameter: float, fc: float,
                nose: float) -> float:
@@ -42,8 +45,6 @@ def parabola_rectangle(strain, fc: float, eps_c2: float = 2.0e-3, n: float = 2.0
     [-], ``fc`` the (mean) cylinder strength; the defaults are the code's
     values for fck <= 50 MPa.
     """
-    import numpy as np
-
     eps = np.asarray(strain, dtype=float)
     return np.where(eps > 0.0, fc * (1.0 - (1.0 - np.clip(eps, 0.0, eps_c2) / eps_c2) ** n), 0.0)
 
@@ -54,8 +55,6 @@ def bilinear_steel(strain, E: float, fy: float, fu: float, eps_u: float):
     ``fu`` at the ultimate strain ``eps_u`` (as EN 1992-1-1 Fig. 3.8's
     inclined branch drawn through the measured fy, fu and eps_u); the same
     in compression; held at fu beyond eps_u."""
-    import numpy as np
-
     eps = np.asarray(strain, dtype=float)
     eps_y = fy / E
     a = np.abs(eps)
@@ -84,9 +83,6 @@ def rc_section_moment(curvature: float, width: float, height: float, fc: float,
     n to ``parabola_rectangle``. With the concrete force growing and the
     bars' tension falling as c grows, the balance has one root.
     """
-    import numpy as np
-    from scipy.optimize import brentq
-
     y = (np.arange(layers) + 0.5) * height / layers
     dy = height / layers
     depth = np.array([b[0] for b in bars])
