@@ -217,7 +217,9 @@ def test_lozano_cases_carry_the_authors_ls_dyna_answers():
     (["validate", "nope"], "unknown validation case(s) nope"),
     (["validate", "--quick", "--docs"], "drop --quick"),
     (["validate", "--docs", "--set", "run.t_end=1"], "drop --set"),
-    (["validate", "--set", "run.t_end"], "is not KEY=VALUE"),
+    (["validate", "--set", "run.t_end"], "is not of the form key=value"),
+    (["validate", "lozano2017_static", "--set", "material.concrete.nope=1"],
+     "case 'lozano2017_static': material[0].nope: unknown key"),
 ])
 def test_validate_errors(argv, message, capsys, monkeypatch):
     monkeypatch.chdir(ROOT)

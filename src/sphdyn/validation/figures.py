@@ -129,9 +129,9 @@ def load_figure(run: Path, case, rows, path: Path, data_dir: Path, *, loader: st
         if r["key"] == "peak_load":
             ax.axhspan(r["low"], r["high"], color="0.85", label="peak load, measured scatter")
             ax.axhline(r["measured"], color="k", ls="--", label="peak load, measured mean")
-    if _peer(rows, "peak_load") is not None:
-        ax.axhline(_peer(rows, "peak_load"), color="0.35", ls=":",
-                   label="peak load, the authors' LS-DYNA")
+    peer = _peer(rows, "peak_load")
+    if peer is not None:
+        ax.axhline(peer, color="0.35", ls=":", label="peak load, the authors' LS-DYNA")
     ax.plot(1e3 * u, 1e-3 * f, "k-", lw=2, label=f"sphdyn (load averaged over "
                                                   f"{1e3 * window:g} ms)")
     ax.set(xlabel="mid-span deflection [mm]", ylabel="load [kN]",

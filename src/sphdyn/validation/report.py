@@ -23,10 +23,15 @@ AGREES_PCT, FAIR_PCT = 10.0, 25.0
 BEGIN, END = "<!-- sphdyn validate: begin -->", "<!-- sphdyn validate: end -->"
 
 
+def difference_pct(value: float, measured: float) -> float:
+    """How far ``value`` is from ``measured``, in per cent of it (NaN for 0)."""
+    return 100.0 * (value / measured - 1.0) if measured else float("nan")
+
+
 def verdict(ref: Reference, value: float) -> tuple[float, str]:
     """(difference [%] of ``value`` from ``ref.value``, verdict word);
     ``value`` in the reference's display unit."""
-    diff = 100.0 * (value / ref.value - 1.0) if ref.value else float("nan")
+    diff = difference_pct(value, ref.value)
     if ref.low <= value <= ref.high or abs(diff) <= AGREES_PCT:
         word = "agrees"
     elif abs(diff) <= FAIR_PCT:
@@ -71,7 +76,7 @@ def table_markdown(results: list[dict]) -> str:
                 ref = f"{ref} ({_g(row['low'])}-{_g(row['high'])})"
             peer = row.get("peer")
             other = "" if peer is None else \
-                f"{_g(peer)} ({100.0 * (peer / row['measured'] - 1.0):+.0f} %)"
+                f"{_g(peer)} ({difference_pct(peer, row['measured']):+.0f} %)"
             lines.append(f"| {res['case']} | {row['quantity']} | {ref} | {_g(row['sphdyn'])} | "
                          f"{row['difference_pct']:+.0f} % | {row['verdict']} | {other} |")
     return "\n".join(lines)

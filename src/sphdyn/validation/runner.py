@@ -15,6 +15,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+from ..deck import DeckError, load_deck
 from .cases import CASES, Case, resolved_deck
 from .report import compare
 
@@ -35,6 +36,11 @@ def run_dir(out: Path, case: Case, quick: bool) -> Path:
     return out / (case.name + ("-quick" if quick else ""))
 
 
+def case_overrides(case: Case, quick: bool) -> tuple[str, ...]:
+    """The case's own deck overrides, and its quick ones for ``quick``."""
+    return case.overrides + (case.quick if quick else ())
+
+
 def completed(run: Path) -> bool:
     summary = run / "summary.json"
     return summary.is_file() and json.loads(summary.read_text())["status"] == "completed"
@@ -45,7 +51,7 @@ def run_case(case: Case, root: Path, out: Path, quick: bool, threads: int | None
     """Run (unless ``reuse`` finds it done), measure and compare one case;
     ``sets`` are the user's overrides, applied after the case's own."""
     run = run_dir(out, case, quick)
-    overrides = case.overrides + (case.quick if quick else ()) + tuple(sets)
+    overrides = case_overrides(case, quick) + tuple(sets)
     if not (reuse and completed(run)):
         cmd = [sys.executable, "-m", "sphdyn", "run", str(root / case.deck), "--out",
                str(run), "-q"]
@@ -125,13 +131,15 @@ def validate(names: list[str], quick: bool, out: Path, root: Path, threads: int 
         raise ValueError("--docs writes docs/validation.md, which shows the cases as they "
                          "are. Fix: drop --set (a sensitivity study prints its own table "
                          "and writes OUT/validation.md)")
-    bad = [s for s in sets if "=" not in s]
-    if bad:
-        raise ValueError(f"--set {bad[0]!r} is not KEY=VALUE. Fix: e.g. --set "
-                         "material.concrete.rate_effects=false")
     problem = root_problem(root, names)
     if problem:
         raise ValueError(problem)
+    for name in names:  # every case's deck with its overrides, before anything runs
+        case = CASES[name]
+        try:
+            load_deck(root / case.deck, [*case_overrides(case, quick), *sets])
+        except DeckError as exc:
+            raise ValueError(f"case {name!r}: {exc}") from None
     results = []
     for name in names:
         print(f"validate: {name}{' (quick)' if quick else ''} ...", flush=True)
