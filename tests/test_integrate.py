@@ -66,15 +66,15 @@ def test_cfl_time_step_picks_the_controlling_particle():
     v = np.zeros((3, 3))
     v[0, 0] = 1000.0
     one, zero = np.ones(3), np.zeros(3)
-    dt, k = cfl_time_step(h, c, v, zero, zero, one, 1.0, 0.3)
+    dt, k = cfl_time_step(h, c, v, zero, zero, one, one, 1.0, 0.3)
     assert k == 2 and np.isclose(dt, 0.3 * 1e-3 / 3000.0)
     # a material's factor, and a fluid's viscous signal speed (weight 1.2)
-    dt, k = cfl_time_step(h, c, v, zero, zero, np.array([1.0, 0.1, 1.0]), 1.0, 0.3)
+    dt, k = cfl_time_step(h, c, v, zero, zero, np.array([1.0, 0.1, 1.0]), one, 1.0, 0.3)
     assert k == 1 and np.isclose(dt, 0.3 * 0.1 * 2e-3 / 1000.0)
     signal = np.array([0.0, 0.0, 4000.0])
-    dt, k = cfl_time_step(h, c, v, signal, np.array([0.0, 0.0, 1.2]), one, 1.0, 0.3)
+    dt, k = cfl_time_step(h, c, v, signal, np.array([0.0, 0.0, 1.2]), one, one, 1.0, 0.3)
     assert k == 2 and np.isclose(dt, 0.3 * 1e-3 / (3000.0 + 1.2 * 4000.0))
-    dt, k = cfl_time_step(h, c, v, signal, zero, one, 1.0, 0.3)  # a solid ignores it
+    dt, k = cfl_time_step(h, c, v, signal, zero, one, one, 1.0, 0.3)  # a solid ignores it
     assert k == 2 and np.isclose(dt, 0.3 * 1e-3 / 3000.0)
 
 

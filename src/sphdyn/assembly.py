@@ -13,6 +13,7 @@ from .events import DomainExit
 from .interactions import Gravity, ParticleContact, Wall
 from .mesh_assembly import erosion_events, mesh_interactions, mesh_part
 from .kernels import KernelContext
+from .mass_scaling import MassScaling
 from .model import Model, build_model, debris_meshes, sublayer_meshes
 from .parts import SPHPart, SPHSettings
 from .stepper import Stepper
@@ -94,4 +95,21 @@ def build_stepper(deck, model: Model | None = None, events=(), monitors=()) -> S
         events.append(DomainExit(part, model.domain_lo, model.domain_hi))
     dt_max = deck.time.dt_max if deck.time.dt_max is not None else np.inf
     return Stepper(parts, interactions, events, monitors, dt_max=dt_max,
-                   interaction_work=deck.output.interaction_work)
+                   interaction_work=deck.output.interaction_work,
+                   mass_scaling=mass_scaling(deck, model, parts))
+
+
+def mass_scaling(deck, model: Model, parts) -> MassScaling | None:
+    """The deck's ``[time.mass_scaling]`` (None without), restricted to the items of
+    its ``parts`` names: an SPH part's particles of those bodies, the meshes of
+    those names."""
+    ms = deck.time.mass_scaling
+    if ms is None:
+        return None
+    select = None
+    if ms.parts is not None:
+        names = set(ms.parts)
+        bodies = [k for k, name in enumerate(model.body_names) if name in names]
+        select = {part.name: (np.isin(part.p.body, bodies) if part.kind == "sph"
+                              else part.name in names) for part in parts}
+    return MassScaling(ms.target, ms.max_added, select)

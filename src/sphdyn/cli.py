@@ -207,11 +207,17 @@ def cmd_check(args) -> int:
     estimate = estimate_size(deck, model)
     p = model.particles
     limit, source = memory_limit(deck)
-    if deck.gauge:  # placed on the stepper's parts, as a run places them
+    stepper = None
+    if deck.gauge or deck.time.mass_scaling is not None:
         from .assembly import build_stepper
+
+        # gauges are placed on the stepper's parts, as a run places them; the
+        # mass scaling is worked out on its started parts (and may be refused)
+        stepper = build_stepper(deck, model)
+    if deck.gauge:
         from .gauges import build_gauges
 
-        build_gauges(deck, build_stepper(deck, model).parts)
+        build_gauges(deck, stepper.parts)
     print(f"{args.deck}: OK")
     print(f"  {deck.run.dimension}D, t_end = {deck.run.t_end:g} s, {p.n} particles in "
           f"{len(model.body_names)} bodies{_mesh_counts(model)}, "
@@ -220,6 +226,8 @@ def cmd_check(args) -> int:
           f"{f', {len(deck.gauge)} gauges' if deck.gauge else ''}")
     print(f"  estimate: {estimate.summary()}; memory limit {show_bytes(limit)} "
           f"({source})")
+    if stepper is not None and stepper.mass_scaling is not None:
+        print(stepper.mass_scaling.describe())
     _warn_thin_members(deck, model)
     if args.resolved:
         from .deck import dump_resolved

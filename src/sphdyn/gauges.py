@@ -84,7 +84,7 @@ class Gauge:
         for pk, idx in self.side:
             q = parts[pk].kin
             keep = idx[q.bc[idx] != BC_SLAVE]
-            f += (q.m[keep, None] * (q.a[keep] - q.a_ext[keep])).sum(axis=0)
+            f += (q.inertia()[keep, None] * (q.a[keep] - q.a_ext[keep])).sum(axis=0)
         return {"force_x": float(f[0]), "force_y": float(f[1]), "force_z": float(f[2])}
 
 

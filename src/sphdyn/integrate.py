@@ -135,12 +135,22 @@ def drift(x, v, dt):
         x[i, 2] += dt * v[i, 2]
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _cfl_step(i, h, c, v, signal, viscous, factor, r, scale):
+    """Particle ``i``'s CFL step before the Courant number (:func:`cfl_time_step`),
+    with the wave-speed factor ``r``; with ``r = 1`` the bits of the step without
+    mass scaling."""
+    sp = np.sqrt(v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2)
+    return factor[i] * (scale * h[i] / (r * c[i] + sp + viscous[i] * (r * signal[i])
+                                        + 1e-300))
+
+
 @njit(cache=True, error_model="numpy")
-def cfl_time_step(h, c, v, signal, viscous, factor, scale, cfl):
+def cfl_time_step(h, c, v, signal, viscous, factor, c_mass, scale, cfl):
     r"""CFL-limited time step.
 
     .. math:: \Delta t = C \min_i \frac{f_i\, s\, h_i}
-              {c_i + |\mathbf v_i| + w_i\, v^{sig}_i},
+              {r_i\,(c_i + w_i\, v^{sig}_i) + |\mathbf v_i|},
               \quad s = \min(1, \kappa)
 
     (Monaghan 1992; LS-DYNA SPH time step), with ``factor`` :math:`f_i`
@@ -148,21 +158,48 @@ def cfl_time_step(h, c, v, signal, viscous, factor, scale, cfl):
     materials, the artificial viscosity's signal speed ``signal``
     :math:`v^{sig}_i = \max_j(\bar\alpha_{ij} \bar c_{ij} + \bar\beta_{ij}
     |\mu_{ij}|)` of the last force pass weighted by ``viscous``
-    :math:`w_i` (1.2, Monaghan 1992, sec. 10; 0 for solids). Zero-mass
+    :math:`w_i` (1.2, Monaghan 1992, sec. 10; 0 for solids). ``c_mass``
+    :math:`r_i = \sqrt{m_i / (m_i + \Delta m_i)}` is the wave-speed factor of
+    selective mass scaling (:mod:`sphdyn.mass_scaling`; 1 without it): added
+    inertia slows the particle's waves, not its own motion. Zero-mass
     particles are included (they move with the body). ``h``, ``c``,
-    ``signal``, ``viscous``, ``factor`` (N,), ``v`` (N, 3). A serial O(N)
-    loop without allocation (its cost is far below one pair pass).
+    ``signal``, ``viscous``, ``factor``, ``c_mass`` (N,), ``v`` (N, 3). A
+    serial O(N) loop without allocation (its cost is far below one pair pass).
     Returns the step [s] and the index of the controlling particle.
     """
     best = np.inf
     k = 0
     for i in range(h.shape[0]):
-        sp = np.sqrt(v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2)
-        t = factor[i] * (scale * h[i] / (c[i] + sp + viscous[i] * signal[i] + 1e-300))
+        t = _cfl_step(i, h, c, v, signal, viscous, factor, c_mass[i], scale)
         if t < best:
             best = t
             k = i
     return cfl * best, k
+
+
+@njit(cache=True, error_model="numpy")
+def cfl_mass_factors(h, c, v, signal, viscous, factor, scale, cfl, target, c_mass):
+    r"""The wave-speed factors that bring each particle's CFL step up to ``target``.
+
+    :func:`cfl_time_step`'s particle step solved for :math:`r_i`:
+    :math:`C f_i s h_i / (r_i W_i + |\mathbf v_i|) = \Delta t^*` gives
+    :math:`r_i = (C f_i s h_i / \Delta t^* - |\mathbf v_i|) / W_i`, taken as 1
+    where the step is above the target already (:math:`W_i = c_i + w_i
+    v^{sig}_i`; within 1e-9 of the target counts as at it). The mass that does
+    it is :math:`\Delta m_i = m_i (1/r_i^2 - 1)` (the particle's wave speed is
+    :math:`\sqrt{K/\rho}` of its stiffness over its inertia). :math:`r_i \le 0`
+    means the particle's own speed alone limits its step below the target: no
+    mass helps (the caller refuses it).
+    Out ``c_mass`` (N,).
+    """
+    for i in range(h.shape[0]):
+        if cfl * _cfl_step(i, h, c, v, signal, viscous, factor, 1.0, scale) \
+                >= (1.0 - 1e-9) * target:  # at the target to round-off: left alone
+            c_mass[i] = 1.0
+        else:
+            sp = np.sqrt(v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2)
+            wave = c[i] + viscous[i] * signal[i]
+            c_mass[i] = (cfl * factor[i] * scale * h[i] / target - sp) / (wave + 1e-300)
 
 
 @njit(cache=True, error_model="numpy")

@@ -299,6 +299,8 @@ class Simulation:
             if part.kind != "sph":
                 summary.setdefault("meshes", {})[part.name] = {
                     "nodes": part.kin.n, "elements": _element_count(part)}
+        if s.mass_scaling is not None:
+            summary["mass_scaling"] = s.mass_scaling.summary()
         if self.energy_guard is not None and self.energy_guard.warning is not None:
             summary["energy_warning"] = self.energy_guard.warning
         if "E_total" in h and h["E_total"].size:

@@ -70,10 +70,12 @@ class Stepper:
     dt_max : largest step [s].
     interaction_work : book each interaction's work apart
         (:mod:`sphdyn.interaction_work`; columns ``W_contact_<name>``).
+    mass_scaling : a :class:`~sphdyn.mass_scaling.MassScaling` or None: inertia
+        added to the items that limit the step, once the parts have started.
     """
 
     def __init__(self, parts, interactions=(), events=(), monitors=(), dt_max=np.inf,
-                 interaction_work=False):
+                 interaction_work=False, mass_scaling=None):
         self.parts = list(parts)
         self.interactions = list(interactions)
         self.events = list(events)
@@ -105,10 +107,15 @@ class Stepper:
         for part in self.parts:
             for q in dofs(part):
                 q.add("v_mid", (3,))
+        self.mass_scaling = mass_scaling
         self.dt0, _, _ = self.stable_dt()
-        self.dt_contact_step = self.dt0  # the step the penalty springs use
         for part in self.parts:
             part.start(self.dt0)
+        if mass_scaling is not None:  # the items' steps of the started state
+            mass_scaling.apply(self.parts, self.interactions)
+            dt_before, (self.dt0, _, _) = self.dt0, self.stable_dt()
+            mass_scaling.steps = (dt_before, self.dt0)
+        self.dt_contact_step = self.dt0  # the step the penalty springs use
         self._interaction_forces(self.dt0)
 
     # ------------------------------------------------------------- access
@@ -166,6 +173,8 @@ class Stepper:
                 books.after(inter.name)
         for part in self.parts:
             part.kin.a += part.kin.a_ext
+        if self.mass_scaling is not None:
+            self.mass_scaling.scale()
 
     def step(self, t_stop: float | None = None) -> None:
         """Advance one step; ``t_stop`` shortens it so that the run ends there."""
@@ -183,8 +192,8 @@ class Stepper:
         for part in self.parts:
             kp = wp = 0.0
             for j, q in enumerate(dofs(part)):
-                k_, c_, e_ = kick(q.v, q.a, q.a_ext, q.m, q.bc, q.bc_v, dt_kick, q.v_mid,
-                                  self._sums(f"{part.name}.{j}", q.n))
+                k_, c_, e_ = kick(q.v, q.a, q.a_ext, q.inertia(), q.bc, q.bc_v, dt_kick,
+                                  q.v_mid, self._sums(f"{part.name}.{j}", q.n))
                 ke, wc, we = _add(ke, k_), _add(wc, c_), _add(we, e_)
                 kp += k_
                 wp += c_ + e_
@@ -270,12 +279,14 @@ class Stepper:
                 rec.update(ev.columns(self.t))
         if self.books is not None:
             rec.update(self.books.columns())
+        if self.mass_scaling is not None:
+            rec.update(self.mass_scaling.columns())
         return rec
 
     def kinetic_now(self) -> float:
         """Kinetic energy of the current (mid-step) velocities [J] (slaves of
         tied and hybrid couplings left out: their masters carry their mass)."""
-        return float(sum(0.5 * np.sum(np.where(q.bc == BC_SLAVE, 0.0, q.m)
+        return float(sum(0.5 * np.sum(np.where(q.bc == BC_SLAVE, 0.0, q.inertia())
                                       * np.sum(q.v * q.v, axis=1))
                          for p in self.parts for q in dofs(p)))
 
@@ -364,3 +375,5 @@ class Stepper:
         if self.books is not None:
             self.books.restore(_own_state(scalars, groups, "books")[0],
                                groups.get("interaction_work", {}))
+        if self.mass_scaling is not None:  # the restored masses' inertia
+            self.mass_scaling.refresh()

@@ -94,6 +94,8 @@ class Reference:
     #: also a particle body made from a mesh (``body`` references:
     #: :func:`~sphdyn.deck.scope.mesh_body_names`)
     mesh_bodies: bool = False
+    #: further sections whose names are accepted too
+    also: tuple = ()
 
     def __call__(self, name: str) -> str:
         scope = SCOPE.get()
@@ -102,6 +104,8 @@ class Reference:
         known = scope.names.get(self.section, [])
         if self.mesh_bodies:
             known = known + scope.names.get(MESH_BODY, [])
+        for other in self.also:
+            known = known + scope.names.get(other, [])
         known = list(dict.fromkeys(known))
         if name in known:
             return name
@@ -252,10 +256,12 @@ def name_of(section: str) -> Any:
     return Annotated[str, Strict(), AfterValidator(UniqueName(section))]
 
 
-def reference_to(section: str, mesh_bodies: bool = False) -> Any:
+def reference_to(section: str, mesh_bodies: bool = False, also: tuple = ()) -> Any:
     """The name of an existing ``[[section]]`` table (with ``mesh_bodies``,
-    or of a particle body made from a mesh: :func:`~sphdyn.deck.scope.mesh_body_names`)."""
-    return Annotated[str, Strict(), AfterValidator(Reference(section, mesh_bodies))]
+    or of a particle body made from a mesh: :func:`~sphdyn.deck.scope.mesh_body_names`;
+    or of a table of the sections ``also``)."""
+    return Annotated[str, Strict(), AfterValidator(Reference(section, mesh_bodies,
+                                                             tuple(also)))]
 
 
 Position = vector(quantity(LENGTH))

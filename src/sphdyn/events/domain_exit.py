@@ -68,8 +68,8 @@ class DomainExit:
             return
         rows = outside_rows(p.x, p.active, p.tl, self.lo, self.hi, n)
         v = p.v[rows] + 0.5 * stepper.dt_prev * p.a[rows]  # after the coming half kick
-        m = p.m[rows]
-        self.energy_removed += float(0.5 * np.sum(m * np.sum(v * v, axis=1))
+        m, mi = p.m[rows], p.inertia()[rows]  # (mi: with a mass scaling's)
+        self.energy_removed += float(0.5 * np.sum(mi * np.sum(v * v, axis=1))
                                      + np.dot(m, p.e[rows]))
         self.removed += int(rows.size)
         self.part.deactivate(rows)

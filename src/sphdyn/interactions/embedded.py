@@ -104,6 +104,12 @@ class EmbeddedNodes(InteractionBase):
         self.force = np.zeros((q.n, 3))
         self.constrain(0.0, 0.0)
 
+    def slave_map(self):
+        """(slave table, slave rows (S,), master table, masters (S, nen), weights
+        (S, nen)): each bar node follows its element's nodes with the shape
+        functions (:mod:`sphdyn.mass_scaling` moves a slave's added mass so)."""
+        return self.part.kin, self.rows, self.solid.nodes, self.conn[self.elem], self.N
+
     def constrain(self, t: float, dt: float) -> None:
         q, s = self.part.kin, self.solid.nodes
         follow_masters(self.rows, self.elem, self.N, self.conn, s.x, s.v, q.x, q.v)

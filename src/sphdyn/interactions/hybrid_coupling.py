@@ -123,6 +123,12 @@ class HybridCoupling(InteractionBase):
                           p.x, p.v, p.m, p.rho, p.B, p.B, False, self.Lhh)
         set_pairs_off(self.rows, self.hybrid, sph.nl.offsets, sph.nl.idx, sph.F)
 
+    def slave_map(self):
+        """(slave table, slave rows (S,), master table, masters (S, nen), weights
+        (S, nen)): each hybrid particle follows its element's nodes with the shape
+        functions (:mod:`sphdyn.mass_scaling` moves a slave's added mass so)."""
+        return self.part.p, self.rows, self.solid.nodes, self.conn[self.elem], self.N
+
     def constrain(self, t: float, dt: float) -> None:
         p, q = self.part.p, self.solid.nodes
         self.dt = dt  # the step the material update of this step will take

@@ -216,7 +216,7 @@ class PrescribedMotion(_SetInteraction):
     def after_kick(self, dt_kick: float) -> None:
         q = self.part.kin
         if dt_kick > 0.0:
-            self.reaction[:] = reaction(self.idx, q.m, q.v, q.v_mid, q.a, dt_kick)
+            self.reaction[:] = reaction(self.idx, q.inertia(), q.v, q.v_mid, q.a, dt_kick)
 
     def columns(self, t: float) -> dict[str, float]:
         r = self.reaction

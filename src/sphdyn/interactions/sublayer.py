@@ -231,6 +231,12 @@ class SublayerCoupling(InteractionBase):
             bar_directions(q.kin.x, q.elements.conn, q.ptr, q.ent, self.nodes, self.rows,
                            p.hist, self.direction)
 
+    def slave_map(self):
+        """(slave table, slave rows (S,), master table, masters (S, 1), weights (S,
+        1)): each particle follows its node (:mod:`sphdyn.mass_scaling` moves a
+        slave's added mass to its node)."""
+        return self.part.p, self.rows, self.line.kin, self.master, self.one
+
     def constrain(self, t: float, dt: float) -> None:
         p, q = self.part.p, self.line.kin
         follow_masters(self.rows, self.order, self.one, self.master, q.x, q.v, p.x, p.v)

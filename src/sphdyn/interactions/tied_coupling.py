@@ -227,12 +227,21 @@ class TiedCoupling(InteractionBase):
         self.B = np.zeros((self.slaves.size, 4, 3, 3))
         self.force = np.zeros((self.slaves.size, 3))
         nf = self.faces.shape[1]
+        # each slave's face shape functions: its mass goes to the face's nodes so
+        self.shapes = np.array([face_shapes(self.xi[k], self.eta[k], nf)[:nf]
+                                for k in range(self.slaves.size)]).reshape(-1, nf)
         for k, s in enumerate(self.slaves):
-            N = face_shapes(self.xi[k], self.eta[k], nf)
             for a in range(nf):
-                q.m[self.faces[self.face_of[k], a]] += N[a] * p.m[s]
+                q.m[self.faces[self.face_of[k], a]] += self.shapes[k, a] * p.m[s]
         p.bc[self.slaves] = BC_SLAVE
         self.constrain(0.0, 0.0)
+
+    def slave_map(self):
+        """(slave table, slave rows (S,), master table, masters (S, nf), weights
+        (S, nf)): each slave's mass is on its face's nodes by the face's shape
+        functions (:mod:`sphdyn.mass_scaling` moves its added mass so)."""
+        return (self.part.p, self.slaves, self.solid.nodes, self.faces[self.face_of],
+                self.shapes)
 
     def constrain(self, t: float, dt: float) -> None:
         p, q = self.part.p, self.solid.nodes

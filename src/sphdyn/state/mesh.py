@@ -71,6 +71,9 @@ class Elements(ArrayStore):
         Stiffness-form hourglass generalised forces [N] (one mode in 2D).
     active : (E,) int8
         1 for elements taking part (erosion clears it).
+    dt_mass : (E,) float64
+        Factor on the element's stable step from selective mass scaling,
+        :math:`\\sqrt{1 + \\Delta m_e / m_e}` (:mod:`sphdyn.mass_scaling`; 1 without).
     """
 
     def __init__(self, n: int, nen: int):
@@ -84,6 +87,8 @@ class Elements(ArrayStore):
         self.add("e_hg", (), np.float64, kind=STATE)
         self.add("hg", (4, 3), np.float64, kind=STATE)
         self.add("active", (), np.int8, kind=STATE, fill=1)
+        # the step factor of mass scaling (sphdyn.mass_scaling), 1 without
+        self.add("dt_mass", (), np.float64, kind=STATE, fill=1)
 
 
 #: name -> (tail shape, dtype) of the integration-point fields (the particle

@@ -84,6 +84,13 @@ class Kinematics(ArrayStore):
         for name, (tail, dtype) in KINEMATICS.items():
             self.add(name, tail, dtype, kind=STATE, fill=1 if name == "active" else 0)
 
+    def inertia(self) -> np.ndarray:
+        """The masses that resist acceleration (N,): ``m`` plus the mass added by
+        selective mass scaling (``m_inertia``, :mod:`sphdyn.mass_scaling`), or
+        ``m`` itself without it. The kick and everything that turns a final
+        acceleration back into a force (reactions, section forces) use it."""
+        return self.m_inertia if "m_added" in self._full else self.m
+
 
 class Particles(Kinematics):
     """All particle fields of a model (kinematics plus the fields below).

@@ -6,7 +6,7 @@ from pydantic import AfterValidator, BeforeValidator, Field, StrictStr
 
 from ..units import TIME
 from ..values import (AccelerationVector, Bounds, Position, Section, UpperPosition,
-                      integer, memory_size, quantity, real)
+                      integer, memory_size, quantity, real, reference_to)
 
 
 class Run(Section):
@@ -59,6 +59,38 @@ class Run(Section):
                             "energy_warning) or off.")
 
 
+class MassScaling(Section):
+    """[time.mass_scaling]: selective mass scaling (LS-DYNA's ``DT2MS < 0``).
+
+    At the start of the run every particle, element or bar element whose
+    stable step is below ``target`` gets the mass that raises its step to
+    ``target`` (a particle's own mass, an element's shared by its nodes;
+    a tied, hybrid, embedded or sublayer slave's goes to the nodes it
+    follows). The added mass has inertia only: it changes no density,
+    stress, weight or contact stiffness. The summary and the history
+    (``mass_added_<part>``) report it per part. What it costs in accuracy
+    is the user's to check: a wave crosses the scaled items slower, by
+    sqrt(1 + added / mass) (docs/theory.md, "Selective mass scaling").
+    """
+
+    target: quantity(TIME, "time step", lo=0, lo_open=True) = Field(
+        description="The step to bring the scaled items to (the step the run takes, "
+                    "the CFL factors included), e.g. \"0.6 us\". Items whose step is "
+                    "above it get nothing; an interaction's own step limit (particle "
+                    "contact, walls) is not raised.")
+    parts: Optional[tuple[reference_to("body", mesh_bodies=True, also=("mesh",)), ...]] = \
+        Field(None, description="The bodies and meshes whose items may take mass "
+                                "(absent: all). Leave out an impactor: mass added to it "
+                                "adds to the energy it brings. A bar's sublayer "
+                                "particles are the body <mesh>_sublayer; their mass goes "
+                                "to the bar's nodes.")
+    max_added: real("mass fraction", lo=0, lo_open=True) = Field(
+        0.02, description="Largest mass the scaling may add, as a fraction of the "
+                          "model's mass (2 % by default); a target needing more is "
+                          "refused before the run, naming the part given the most and "
+                          "the largest target within the limit.")
+
+
 class Time(Section):
     """[time]: explicit time stepping."""
 
@@ -69,6 +101,8 @@ class Time(Section):
     collapse_ratio: real("ratio", lo=0, hi=1, lo_open=True, hi_open=True) = \
         Field(1e-4, description="The run stops when dt < collapse_ratio * "
                                 "initial dt.")
+    mass_scaling: Optional[MassScaling] = Field(
+        None, description="Selective mass scaling to a target step (absent: none).")
 
 
 class Domain(Section):

@@ -262,8 +262,27 @@ def beam_forces(x, triad, conn, frame0, L0, EA, GJ, EIy, EIz, phi_y, phi_z, fe, 
                            + mz_a * ta[2] + mz_b * tb[2])
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _beam_element_dt(e, x, conn, L0, rho, A, E, G, Iy, Iz, J, kappa, inertia_e):
+    """Beam element ``e``'s step :math:`2/\\omega_{max}` (:func:`beam_stable_dt`)."""
+    a = conn[e, 0]
+    b = conn[e, 1]
+    l = math.sqrt((x[b, 0] - x[a, 0]) ** 2 + (x[b, 1] - x[a, 1]) ** 2
+                  + (x[b, 2] - x[a, 2]) ** 2)
+    m = 0.5 * rho * A * L0[e]
+    w2 = 2.0 * E * A / (l * m)
+    ir = inertia_e[e]
+    if ir > 0.0:
+        for ii in (Iy, Iz):
+            phi = 12.0 * E * ii / (kappa * G * A * l * l)
+            c = E * ii / (l ** 3 * (1.0 + phi))
+            w2 = max(w2, c * (24.0 / m + 6.0 * l * l / ir), 2.0 * E * ii / (l * ir))
+        w2 = max(w2, 2.0 * G * J / (l * ir))
+    return 2.0 / math.sqrt(w2)
+
+
 @njit(cache=True, error_model="numpy")
-def beam_stable_dt(x, conn, L0, rho, A, E, G, Iy, Iz, J, kappa, inertia_e, scale):
+def beam_stable_dt(x, conn, L0, rho, A, E, G, Iy, Iz, J, kappa, inertia_e, scale, dt_mass):
     r"""Stable step of the beam elements and the controlling element.
 
     :math:`\Delta t = s\, 2/\omega_{max}` with :math:`\omega_{max}` the
@@ -281,30 +300,28 @@ def beam_stable_dt(x, conn, L0, rho, A, E, G, Iy, Iz, J, kappa, inertia_e, scale
     * torsion: :math:`2GJ/(l I_r)`.
 
     Units: lengths [m], rho [kg/m^3], A [m^2], E, G [Pa], I, J [m^4],
-    inertia_e (E,) [kg m^2]; ``scale`` the safety factor. Returns
-    ``(dt [s], element)``.
+    inertia_e (E,) [kg m^2]; ``scale`` the safety factor; ``dt_mass`` (E,) the
+    elements' mass-scaling step factors (1 without). Returns ``(dt [s],
+    element)``.
     """
     best = np.inf
     k = 0
     for e in range(conn.shape[0]):
-        a = conn[e, 0]
-        b = conn[e, 1]
-        l = math.sqrt((x[b, 0] - x[a, 0]) ** 2 + (x[b, 1] - x[a, 1]) ** 2
-                      + (x[b, 2] - x[a, 2]) ** 2)
-        m = 0.5 * rho * A * L0[e]
-        w2 = 2.0 * E * A / (l * m)
-        ir = inertia_e[e]
-        if ir > 0.0:
-            for ii in (Iy, Iz):
-                phi = 12.0 * E * ii / (kappa * G * A * l * l)
-                c = E * ii / (l ** 3 * (1.0 + phi))
-                w2 = max(w2, c * (24.0 / m + 6.0 * l * l / ir), 2.0 * E * ii / (l * ir))
-            w2 = max(w2, 2.0 * G * J / (l * ir))
-        dt = 2.0 / math.sqrt(w2)
+        dt = _beam_element_dt(e, x, conn, L0, rho, A, E, G, Iy, Iz, J, kappa,
+                              inertia_e) * dt_mass[e]
         if dt < best:
             best = dt
             k = e
     return scale * best, k
+
+
+@njit(cache=True, error_model="numpy")
+def beam_element_steps(x, conn, L0, rho, A, E, G, Iy, Iz, J, kappa, inertia_e, scale, out):
+    """Each beam element's own step (:func:`beam_stable_dt` before the minimum,
+    without mass scaling) into ``out`` (E,) [s]."""
+    for e in range(conn.shape[0]):
+        out[e] = scale * _beam_element_dt(e, x, conn, L0, rho, A, E, G, Iy, Iz, J, kappa,
+                                          inertia_e)
 
 
 # -------------------------------------------------------------------- truss
@@ -424,23 +441,36 @@ def truss_forces(x, conn, sig, A, fe, res):
         res[e, RES_L] = l
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _truss_length(e, x, conn):
+    a = conn[e, 0]
+    b = conn[e, 1]
+    return math.sqrt((x[b, 0] - x[a, 0]) ** 2 + (x[b, 1] - x[a, 1]) ** 2
+                     + (x[b, 2] - x[a, 2]) ** 2)
+
+
 @njit(cache=True, error_model="numpy")
-def truss_stable_dt(x, conn, c, scale):
-    r"""Stable step :math:`s \min_e l_e / c` of two lumped masses on a spring
+def truss_stable_dt(x, conn, c, scale, dt_mass):
+    r"""Stable step :math:`s \min_e g_e l_e / c` of two lumped masses on a spring
     (:math:`\omega = 2c/l`, :math:`\Delta t_{crit} = 2/\omega`; Belytschko,
     Liu & Moran 2000, sec. 6.3) and the controlling element. ``c`` the bar
-    wave speed :math:`\sqrt{E/\rho}` [m/s]."""
+    wave speed :math:`\sqrt{E/\rho}` [m/s], ``dt_mass`` (E,) the elements'
+    mass-scaling step factors :math:`g_e` (1 without)."""
     best = np.inf
     k = 0
     for e in range(conn.shape[0]):
-        a = conn[e, 0]
-        b = conn[e, 1]
-        l = math.sqrt((x[b, 0] - x[a, 0]) ** 2 + (x[b, 1] - x[a, 1]) ** 2
-                      + (x[b, 2] - x[a, 2]) ** 2)
-        if l / c < best:
-            best = l / c
+        dt = _truss_length(e, x, conn) / c * dt_mass[e]
+        if dt < best:
+            best = dt
             k = e
     return scale * best, k
+
+
+@njit(cache=True, error_model="numpy")
+def truss_element_steps(x, conn, c, scale, out):
+    r"""Each truss element's own step :math:`s\,l_e/c` into ``out`` (E,) [s]."""
+    for e in range(conn.shape[0]):
+        out[e] = scale * (_truss_length(e, x, conn) / c)
 
 
 # ------------------------------------------------------------------- gather

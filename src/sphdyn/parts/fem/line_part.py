@@ -73,9 +73,10 @@ from ...state import Elements, MaterialPoints, Nodes
 from ...state.store import STATE
 from ..base import register_part
 from .beam import (N_RES, RES_L, RES_MY_A, RES_MY_B, RES_MZ_A, RES_MZ_B, RES_N, RES_T,
-                   RES_VY, RES_VZ, beam_forces, beam_stable_dt, drift_rotations,
-                   lateral_ratio, lateral_secant, mass_damping,
-                   truss_forces, truss_gradient, truss_kinematics, truss_stable_dt)
+                   RES_VY, RES_VZ, beam_element_steps, beam_forces, beam_stable_dt,
+                   drift_rotations, lateral_ratio, lateral_secant, mass_damping,
+                   truss_element_steps, truss_forces, truss_gradient, truss_kinematics,
+                   truss_stable_dt)
 from .gather import gather_loads, node_element_list
 
 
@@ -276,8 +277,38 @@ class LinePart:
         if self.beam:
             return beam_stable_dt(self.kin.x, el.conn, el.L0, self.rho, s.area, self.E,
                                   self.G, s.iy, s.iz, s.j, s.shear_factor, self.inertia_e,
-                                  self.dt_scale)
-        return truss_stable_dt(self.kin.x, el.conn, self.c_bar, self.dt_scale)
+                                  self.dt_scale, el.dt_mass)
+        return truss_stable_dt(self.kin.x, el.conn, self.c_bar, self.dt_scale, el.dt_mass)
+
+    def scale_mass(self, target: float, mask=None) -> dict[str, np.ndarray]:
+        r"""Selective mass scaling (:mod:`sphdyn.mass_scaling`): each element whose
+        own step :math:`\Delta t_e` (:func:`.beam.beam_element_steps`,
+        :func:`.beam.truss_element_steps`) is below ``target`` gets the step factor
+        :math:`g_e = \Delta t^*/\Delta t_e` (``dt_mass``) and :math:`g_e^2 - 1`
+        times its share of the lumped masses, :math:`m_e/2` per node, and (beams)
+        of the rotary inertias: every frequency of the element falls by
+        :math:`g_e`. Returns the added masses per node [kg] and rotary inertias
+        [kg m^2] (N,), by table name (``kin``, ``rot``). ``mask``
+        is not used: a mesh is scaled whole."""
+        el, s, kin = self.elements, self.section, self.kin
+        dt = np.empty(el.n)
+        if self.beam:
+            beam_element_steps(kin.x, el.conn, el.L0, self.rho, s.area, self.E, self.G,
+                               s.iy, s.iz, s.j, s.shear_factor, self.inertia_e,
+                               self.dt_scale, dt)
+        else:
+            truss_element_steps(kin.x, el.conn, self.c_bar, self.dt_scale, dt)
+        g = np.where(dt < (1.0 - 1e-9) * target, target / dt, 1.0)  # (1e-9: at it)
+        el.dt_mass = g
+        f = g * g - 1.0
+        added = {"kin": np.zeros(kin.n)}
+        for side in (0, 1):
+            np.add.at(added["kin"], el.conn[:, side], 0.5 * f * el.m)
+        if self.beam:
+            added["rot"] = np.zeros(kin.n)
+            for side in (0, 1):
+                np.add.at(added["rot"], el.conn[:, side], f * self.inertia_e)
+        return added
 
     def describe_limit(self, k: int) -> str:
         """What element ``k`` of :meth:`stable_dt` is, for a diagnosis."""

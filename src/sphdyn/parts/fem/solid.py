@@ -625,11 +625,12 @@ DT_BLOCKS = 64
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def min_time_step(dt_el, cfl, blk_t, blk_k):
+def min_time_step(dt_el, dt_mass, cfl, blk_t, blk_k):
     r"""The part's stable step ``cfl * min(dt_el)`` and the controlling element.
 
     ``dt_el`` (E,) the element steps of the last force pass
-    (:func:`element_step`, ``inf`` for inactive elements). The minimum is
+    (:func:`element_step`, ``inf`` for inactive elements), each times its
+    mass-scaling factor ``dt_mass`` (E,) (1 without). The minimum is
     taken in parallel over ``blk_t.size`` contiguous blocks (scratch ``blk_t``
     (B,) float, ``blk_k`` (B,) int64), then over the blocks in order, so the
     controlling element is the first one with the smallest step, as a serial
@@ -642,8 +643,9 @@ def min_time_step(dt_el, cfl, blk_t, blk_k):
         best = np.inf
         k = 0
         for e in range(b * size, min(ne, (b + 1) * size)):
-            if dt_el[e] < best:
-                best = dt_el[e]
+            d = dt_el[e] * dt_mass[e]
+            if d < best:
+                best = d
                 k = e
         blk_t[b] = best
         blk_k[b] = k

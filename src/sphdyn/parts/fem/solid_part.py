@@ -207,7 +207,26 @@ class SolidPart:
     def stable_dt(self) -> tuple[float, int]:
         """Element step and the controlling element (:func:`.solid.min_time_step` of
         the element steps of the last force pass)."""
-        return min_time_step(self.el.dt_el, self.s.cfl, self._dt_t, self._dt_k)
+        return min_time_step(self.el.dt_el, self.el.dt_mass, self.s.cfl, self._dt_t, self._dt_k)
+
+    def scale_mass(self, target: float, mask=None) -> dict[str, np.ndarray]:
+        r"""Selective mass scaling (:mod:`sphdyn.mass_scaling`): each active element
+        whose step :math:`C\,\Delta t_e` (of the last force pass) is below
+        ``target`` gets the step factor :math:`g_e = \Delta t^* / (C\Delta t_e)`
+        (``el.dt_mass``) and the mass :math:`(g_e^2 - 1)\, m_e`, shared by its nodes
+        as its own mass is (``1/nen`` each): the element's frequencies fall by
+        :math:`g_e`, and so its step rises to the target (each node's mass is at
+        least every element's scaled share, so the element bound holds). Returns
+        the added mass per node [kg] (N,), by table name. ``mask``
+        is not used: a mesh is scaled whole."""
+        el = self.el
+        dt = self.s.cfl * el.dt_el
+        # (a step within 1e-9 of the target counts as at it)
+        g = np.where((el.active == 1) & (dt < (1.0 - 1e-9) * target), target / dt, 1.0)
+        el.dt_mass = g
+        added = np.zeros(self.nodes.n)
+        np.add.at(added, el.conn.ravel(), np.repeat((g * g - 1.0) * el.m / el.nen, el.nen))
+        return {"kin": added}
 
     def describe_limit(self, k: int) -> str:
         """What element ``k`` of :meth:`stable_dt` is, for a diagnosis."""
@@ -287,16 +306,19 @@ class SolidPart:
     def element_books(self, elements: np.ndarray,
                       dt_half: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         r"""What ``elements`` (k,) carry: masses (k,) [kg]; the kinetic energy of
-        their node shares (k,), :math:`\sum_I \tfrac12 (m_e/n_{en})
+        their node shares (k,), :math:`\sum_I \tfrac12 (g_e^2 m_e/n_{en})
         |\mathbf v_I + \Delta t_{1/2}\mathbf a_I|^2` [J] (``dt_half``: the
         coming half kick, so at the time the stepper books its kinetic
-        energy); their internal energy (k,) [J], the points' work ``m e`` plus
+        energy; :math:`g_e` the mass-scaling factor ``el.dt_mass``, 1 without);
+        their internal energy (k,) [J], the points' work ``m e`` plus
         the hourglass work."""
         el, q, p = self.el, self.nodes, self.pts
         m = el.m[elements].copy()
         conn = el.conn[elements]
         ve = q.v[conn] + dt_half * q.a[conn]  # (k, nen, 3)
-        kinetic = 0.5 * (m / el.nen) * np.sum(ve * ve, axis=(1, 2))
+        # the inertia of the node shares: with a mass scaling's, g_e^2 m_e
+        inertia = m * el.dt_mass[elements] ** 2
+        kinetic = 0.5 * (inertia / el.nen) * np.sum(ve * ve, axis=(1, 2))
         pts = self.element_points(elements)
         internal = np.sum(p.m[pts] * p.e[pts], axis=1) + el.e_hg[elements]
         return m, kinetic, internal
@@ -345,7 +367,7 @@ class SolidPart:
         el, q = self.el, self.nodes
         elements = np.asarray(elements, dtype=np.int64)
         conn = el.conn[elements]  # (k, nen)
-        m = q.m[conn]
+        m = q.inertia()[conn]  # (with a mass scaling's: the accelerations are its)
         inv = np.divide(1.0, m, out=np.zeros_like(m), where=m > 0.0)
         fe = el.fe[elements]  # (k, nen, 3)
         work = dt_half * np.sum(np.sum(fe * q.v[conn], axis=2) * (m > 0.0), axis=1)
@@ -372,8 +394,13 @@ class SolidPart:
         p.m[pts] = 0.0
         p.L[pts] = 0.0
         np.subtract.at(q.m, el.conn[elements].ravel(), np.repeat(el.m[elements] / nen, nen))
+        if "m_added" in q.names():  # and the mass scaling gave it
+            extra = (el.dt_mass[elements] ** 2 - 1.0) * el.m[elements] / nen
+            np.subtract.at(q.m_added, el.conn[elements].ravel(), np.repeat(extra, nen))
         orphan = np.bincount(el.conn[el.active == 1].ravel(), minlength=q.n) == 0
         q.m[orphan] = 0.0  # exactly: the subtraction leaves round-off
+        if "m_added" in q.names():
+            q.m_added[orphan] = 0.0
         q.v[orphan] = 0.0
         q.a[orphan] = 0.0
         q.a_ext[orphan] = 0.0

@@ -34,11 +34,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...guards import SimulationFailed
-from ...integrate import add_heat, cfl_time_step, drift, internal_energies
+from ...integrate import (add_heat, cfl_mass_factors, cfl_time_step, drift,
+                          internal_energies)
 from ...kernels import KernelContext
 from ...materials.base import young_modulus
 from ...neighbours import build_neighbours, mean_neighbours, update_neighbours
-from ...state import BC_FIXED, Particles
+from ...state import BC_FIXED, STATE, Particles
 from ..base import register_part
 from .artificial_stress import artificial_stress_forces, artificial_stress_tensor
 from .colouring import colour_pairs
@@ -126,6 +127,8 @@ class SPHPart:
                            ("dt_viscous", ())):
             p.add(name, tail)
         p.add("tl", (), np.bool_, fill=False)
+        # the wave-speed factor of mass scaling (sphdyn.mass_scaling), 1 without
+        p.add("c_mass", (), np.float64, kind=STATE, fill=1.0)
         # each row's own pairs within the support, at its head (velocity_gradient
         # counts them, forces visits them)
         p.add("n_support", (), np.int32)
@@ -263,7 +266,29 @@ class SPHPart:
         particle (:func:`~sphdyn.integrate.cfl_time_step`)."""
         p = self.p
         return cfl_time_step(p.h, p.c, p.v, p.av_signal, p.dt_viscous, p.dt_factor,
-                             min(1.0, self.kernel.support_scale), self.s.cfl)
+                             p.c_mass, min(1.0, self.kernel.support_scale), self.s.cfl)
+
+    def scale_mass(self, target: float, mask=None) -> dict[str, np.ndarray]:
+        """Selective mass scaling (:mod:`sphdyn.mass_scaling`): the wave-speed
+        factors ``c_mass`` that raise every particle's (of ``mask`` (N,) bool, if
+        given) step to ``target``
+        (:func:`~sphdyn.integrate.cfl_mass_factors`) and the mass that makes them,
+        :math:`\\Delta m_i = m_i (1/r_i^2 - 1)` [kg] (N,), by table name."""
+        p = self.p
+        r = np.ones(p.n)
+        cfl_mass_factors(p.h, p.c, p.v, p.av_signal, p.dt_viscous, p.dt_factor,
+                         min(1.0, self.kernel.support_scale), self.s.cfl, target, r)
+        if mask is not None:
+            r[~mask] = 1.0
+        fast = np.flatnonzero((r <= 0.0) & (p.m > 0.0))
+        if fast.size:
+            i = int(fast[0])
+            raise ValueError(
+                f"mass scaling: particle {i} of part '{self.name}' moves at "
+                f"{np.linalg.norm(p.v[i]):.4g} m/s, which alone keeps its step below the "
+                f"target {target:.4g} s (no mass raises it): lower time.mass_scaling.target")
+        p.c_mass = r
+        return {"kin": p.m * (1.0 / (r * r) - 1.0)}
 
     def start(self, dt: float) -> None:
         """Accelerations of the initial state (gradients and divergence, no update)."""
