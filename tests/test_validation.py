@@ -197,6 +197,16 @@ def test_table_shows_another_codes_answer_beside_sphdyns():
     res = [{"case": "a", "title": "A", "status": "completed", "rows": row}]
     assert "| 15 | +50 % | poor | 12.3 (+23 %) |" in report.table_markdown(res)
     assert "another code: LS-DYNA (Table 11.6)" in report.sources_markdown(res)
+    # two quantities of one source with their own peer pages: the source once,
+    # then both pages
+    rows = report.compare([
+        Reference("umax", "deflection", "mm", 10.0, 9.0, 11.0, "tab", peer=12.3,
+                  peer_label="LS-DYNA (Table 11.1)"),
+        Reference("t", "time", "ms", 8.0, 7.0, 9.0, "tab", peer=9.2,
+                  peer_label="LS-DYNA (Table 11.3)")], {"umax": 0.015, "t": 0.009})
+    text = report.sources_markdown([{"case": "a", "title": "A", "rows": rows}])
+    assert text.count("tab") == 1
+    assert text.endswith("tab; another code: LS-DYNA (Table 11.1) / LS-DYNA (Table 11.3).")
 
 
 def test_lozano_cases_carry_the_authors_ls_dyna_answers():

@@ -86,15 +86,17 @@ def sources_markdown(results: list[dict]) -> str:
     """Where each reference value comes from, one bullet per case."""
     out = []
     for res in results:
-        seen = []
+        seen, peers = [], []  # each text once, in the rows' order
         for row in res.get("rows", []):
             text = row["source"] + (f"; scatter: {row['scatter']}" if row["scatter"] else "")
-            if row.get("peer") is not None:
-                text += f"; another code: {row['peer_label']}"
             if text not in seen:
                 seen.append(text)
+            if row.get("peer") is not None and row["peer_label"] not in peers:
+                peers.append(row["peer_label"])
         if seen:
-            out.append(f"* **{res['case']}** ({res['title']}): " + " / ".join(seen) + ".")
+            other = f"; another code: {' / '.join(peers)}" if peers else ""
+            out.append(f"* **{res['case']}** ({res['title']}): " + " / ".join(seen)
+                       + other + ".")
     return "\n".join(out)
 
 
