@@ -48,7 +48,7 @@ def run(out: Path, quick: bool, scaled: bool) -> Path:
         cmd.append("--quick")
     for s in settings(quick) if scaled else []:
         cmd += ["--set", s]
-    subprocess.run(cmd, check=True, cwd=ROOT)
+    subprocess.run(cmd, check=True, cwd=ROOT, stdout=subprocess.DEVNULL)  # its table: below
     return where / (CASE + ("-quick" if quick else ""))
 
 

@@ -14,7 +14,9 @@ Central differences (leapfrog, :mod:`sphdyn.integrate`), state at
 3. drift of every part to :math:`\mathbf x^{n+1}`;
 4. parts' ``update_geometry``, interactions' ``update_geometry``;
 5. parts' ``internal_forces`` (:math:`\sigma^{n+1}` and ``a``), then the
-   interactions' forces into ``a_ext``, added to ``a``: :math:`\mathbf a^{n+1}`;
+   interactions' forces into ``a_ext``, added to ``a``: :math:`\mathbf a^{n+1}`
+   (with selective mass scaling, :mod:`sphdyn.mass_scaling`, turned into the
+   accelerations of the items' inertia);
 6. events (a change of the model between steps), then monitors'
    ``after_step`` (guards, history, frames, checkpoints).
 
