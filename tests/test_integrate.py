@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from sphdyn.integrate import cfl_time_step, drift, kick, kick_scratch
+from sphdyn.integrate import cfl_mass_factors, cfl_time_step, drift, kick, kick_scratch
 from sphdyn.state import BC_FIXED, BC_VELOCITY
 
 
@@ -76,6 +76,34 @@ def test_cfl_time_step_picks_the_controlling_particle():
     assert k == 2 and np.isclose(dt, 0.3 * 1e-3 / (3000.0 + 1.2 * 4000.0))
     dt, k = cfl_time_step(h, c, v, signal, zero, one, one, 1.0, 0.3)  # a solid ignores it
     assert k == 2 and np.isclose(dt, 0.3 * 1e-3 / 3000.0)
+    # mass scaling's wave-speed factor r slows the waves, c and the viscous
+    # signal alike, not the particle's own speed
+    r = np.array([1.0, 1.0, 0.25])
+    dt, k = cfl_time_step(h, c, v, signal, np.array([0.0, 0.0, 1.2]), one, r, 1.0, 0.3)
+    assert np.isclose(dt, min(0.3 * 1e-3 / (0.25 * (3000.0 + 1.2 * 4000.0)),
+                              0.3 * 1e-3 / (1000.0 + 1000.0), 0.3 * 2e-3 / 1000.0))
+
+
+def test_cfl_mass_factors_solve_the_cfl_step_for_the_target():
+    """r = (C f s h / target - |v|) / (c + w v_sig) below the target (the step
+    with it is the target, 1e-12), 1 at or above it, <= 0 where the speed
+    alone keeps the step below the target."""
+    h = np.array([1e-3, 1e-3, 1e-3, 1e-3])
+    c = np.array([5000.0, 1000.0, 5000.0, 5000.0])
+    v = np.zeros((4, 3))
+    v[2, 0] = 500.0
+    v[3, 0] = 5000.0
+    signal, viscous, one = np.zeros(4), np.zeros(4), np.ones(4)
+    target = 0.3 * 1e-3 / 2000.0
+    r = np.zeros(4)
+    cfl_mass_factors(h, c, v, signal, viscous, one, 1.0, 0.3, target, r)
+    assert r[1] == 1.0  # its step, 0.3 h / 1000, is above the target
+    assert r[0] == pytest.approx(2000.0 / 5000.0, rel=1e-12)
+    assert r[2] == pytest.approx((2000.0 - 500.0) / 5000.0, rel=1e-12)
+    assert r[3] <= 0.0
+    dt, _ = cfl_time_step(h[:3], c[:3], v[:3], signal[:3], viscous[:3], one[:3], r[:3],
+                          1.0, 0.3)
+    assert dt == pytest.approx(target, rel=1e-12)
 
 
 def test_kick_books_the_contact_work_and_energies_over_several_blocks():

@@ -17,6 +17,9 @@ What is pinned here, with its tolerance:
 * the limit: a target needing more than ``max_added`` of the model's mass
   is refused naming the part given the most and the largest target within
   the limit, and that target is accepted, within the limit (to 1e-6);
+* a beam element's rotary inertia scales with its mass (1e-12); an eroded
+  element takes its added mass off its nodes and erosion's books count its
+  inertia (1e-12);
 * a tied, hybrid or embedded slave's added mass lands on its masters with the
   weights of its own mass (1e-12), none on the slave;
 * a restart continues a mass-scaled run with the same bits;
@@ -340,3 +343,35 @@ def test_a_coupling_s_slaves_pass_their_added_mass_to_their_masters(kind):
     added = sum(v["added_kg"] for v in st.mass_scaling.summary()["parts"].values())
     translations = sum(float(own[id(part.kin)].sum()) for part in st.parts)
     assert added == pytest.approx(translations, rel=1e-12)
+
+
+def test_an_eroded_element_takes_its_added_mass_and_its_inertia_s_books_with_it():
+    """Erosion's books of a scaled element count the inertia of its node shares,
+    ``g^2 m_e / nen`` each (the block moves at 1 m/s: 1/2 g^2 m_e, 1e-12), and
+    eroding it takes ``(g^2 - 1) m_e`` off its nodes' added mass (1e-12)."""
+    target = 1.5 * build_stepper(loads_deck(BLOCK.format(materials=STEEL, scaling=""))).dt0
+    st = build_stepper(loads_deck(BLOCK.format(materials=STEEL, scaling=_scaling(
+        f"{target!r} s", "max_added = 2"))))
+    block = st.part("block")
+    m_e = float(block.el.m[0])
+    _, kinetic, _ = block.element_books(np.array([0]))
+    assert kinetic[0] == pytest.approx(0.5 * 1.5 ** 2 * m_e, rel=1e-12)
+    before = block.kin.m_added.sum()
+    block.erode(np.array([0]))
+    assert before - block.kin.m_added.sum() == pytest.approx(1.25 * m_e, rel=1e-12)
+
+
+BEAM = TRUSS.replace('element = "truss"', 'element = "beam"')
+
+
+def test_every_beam_element_scaled_takes_mass_and_rotary_inertia_alike():
+    """Target twice a beam's step: g = 2 on every element, so each node takes
+    three times its own mass and three times its rotary inertia (1e-12), and
+    the step is the target."""
+    dt = build_stepper(loads_deck(BEAM.format(materials=STEEL, scaling=""))).dt0
+    st = build_stepper(loads_deck(BEAM.format(materials=STEEL, scaling=_scaling(
+        f"{2 * dt!r} s", "max_added = 5"))))
+    kin = st.part("bar").kin
+    assert st.dt0 == pytest.approx(2 * dt, rel=1e-12)
+    assert np.allclose(kin.m_added, 3.0 * kin.m, rtol=1e-12)
+    assert np.allclose(kin.rot.m_added, 3.0 * kin.rot.m, rtol=1e-12)

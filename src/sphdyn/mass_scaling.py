@@ -106,7 +106,7 @@ class MassScaling:
         self.select = select
         self.parts: list = []
         self.scaled: list = []  # the tables with added mass (each has m_added)
-        self.items_scaled: dict[str, int] = {}
+        self.added0: dict[str, float] = {}  # mass added to each part at the start [kg]
         #: the model's first step without and with the added mass [s] (the stepper's)
         self.steps: tuple[float, float] | None = None
 
@@ -115,7 +115,6 @@ class MassScaling:
         """Added mass per row of every table (keyed by ``id(table)``) for
         ``target``; sets the parts' step factors for it."""
         added: dict[int, np.ndarray] = {}
-        self.items_scaled = {}
         for part in parts:
             chosen = True if self.select is None else self.select.get(part.name, False)
             if chosen is False:
@@ -127,7 +126,7 @@ class MassScaling:
             tables = _tables(part)
             mask = None if chosen is True else np.asarray(chosen, dtype=bool)
             for name, arr in fn(target, mask).items():
-                added[id(tables[name])] = np.asarray(arr, dtype=float).copy()
+                added[id(tables[name])] = np.asarray(arr, dtype=float)
         for inter in interactions:
             fn = getattr(inter, "slave_map", None)
             if fn is None:
@@ -195,8 +194,8 @@ class MassScaling:
                 q.add("m_added", (), np.float64, kind=STATE)
                 q.add("m_inertia", (), np.float64)
                 q.m_added = extra
-                q.m_inertia = q.m + extra
                 self.scaled.append(q)
+        self.refresh()
         self.added0 = {k: v[0] for k, v in self._fractions(parts, added).items()}
 
     def refresh(self) -> None:

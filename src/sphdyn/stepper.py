@@ -115,7 +115,8 @@ class Stepper:
             part.start(self.dt0)
         if mass_scaling is not None:  # the items' steps of the started state
             mass_scaling.apply(self.parts, self.interactions)
-            dt_before, (self.dt0, _, _) = self.dt0, self.stable_dt()
+            dt_before = self.dt0
+            self.dt0, _, _ = self.stable_dt()
             mass_scaling.steps = (dt_before, self.dt0)
         self.dt_contact_step = self.dt0  # the step the penalty springs use
         self._interaction_forces(self.dt0)

@@ -378,7 +378,8 @@ class SolidPart:
         """Take ``elements`` (k,) out of the part (read :meth:`element_books` first).
 
         Each element's mass leaves its nodes (the lumped share ``m_e / nen``
-        each; their accelerations of this step are kept); nodes left with no
+        each, and a mass scaling's :math:`(g_e^2 - 1) m_e / n_{en}`; their
+        accelerations of this step are kept); nodes left with no
         active element get zero mass, zero velocity and ``BC_FIXED``. The
         element's internal energy leaves the part's books: the points' masses
         and the hourglass work are zeroed, their rates too (the material update
@@ -394,12 +395,13 @@ class SolidPart:
         p.m[pts] = 0.0
         p.L[pts] = 0.0
         np.subtract.at(q.m, el.conn[elements].ravel(), np.repeat(el.m[elements] / nen, nen))
-        if "m_added" in q.names():  # and the mass scaling gave it
+        scaled = "m_added" in q.names()  # and the mass a mass scaling gave it
+        if scaled:
             extra = (el.dt_mass[elements] ** 2 - 1.0) * el.m[elements] / nen
             np.subtract.at(q.m_added, el.conn[elements].ravel(), np.repeat(extra, nen))
         orphan = np.bincount(el.conn[el.active == 1].ravel(), minlength=q.n) == 0
         q.m[orphan] = 0.0  # exactly: the subtraction leaves round-off
-        if "m_added" in q.names():
+        if scaled:
             q.m_added[orphan] = 0.0
         q.v[orphan] = 0.0
         q.a[orphan] = 0.0
