@@ -364,6 +364,19 @@ def test_bar_particles_take_the_concretes_density():
     assert np.allclose(p.vol0[rows], p.m[rows] / 2400.0, rtol=1e-15)
 
 
+def test_bar_particles_take_h_from_the_element_length_or_the_deck():
+    """h = sph.h_factor x the mean element length (10 mm here, h_factor 1.2
+    by default), or [mesh.sublayer] smoothing_length when given; the
+    concrete's own h is untouched."""
+    for extra, h in (("", 1.2 * 0.010), ('smoothing_length = "17 mm"', 0.017)):
+        st = build_stepper(loads_deck(deck_text(sets="", ratio=f"0.5\n{extra}")))
+        p = st.part("sph").p
+        rows = np.flatnonzero(p.body == 1)
+        assert np.allclose(p.h[rows], h, rtol=1e-12) and np.allclose(p.h0[rows], h,
+                                                                      rtol=1e-12)
+        assert np.allclose(p.h[p.body == 0], 1.2 * 0.010, rtol=1e-12)
+
+
 def test_each_particle_stiffness_transfers_the_pull_and_orders_the_force(tmp_path):
     """Every [mesh.sublayer] stiffness passes the pull to the concrete: the
     grip's, the bond's and the plate's forces agree (1e-3) and the energy

@@ -405,7 +405,8 @@ def _sublayer_particles(deck, mm: MeshModel, b: int, n_hist: int) -> Particles:
     """One particle per node of a bar (:mod:`sphdyn.interactions.sublayer`): its
     share ``mass_ratio`` of the bar's lumped mass, the bar's material (its
     density and volume are the concrete's, set by :func:`_seat_sublayers`),
-    h = sph.h_factor times the mean element length, body ``b``."""
+    h = sph.h_factor times the mean element length (or [mesh.sublayer]
+    smoothing_length), body ``b``."""
     from .mesh_assembly import section_of
     from .interactions.sublayer import sublayer_masses
 
@@ -420,7 +421,8 @@ def _sublayer_particles(deck, mm: MeshModel, b: int, n_hist: int) -> Particles:
     p.v[:] = np.asarray(mm.spec.velocity, dtype=float)
     p.m[:] = m
     p.mat[:] = int(mm.mat[0])
-    p.h[:] = deck.sph.h_factor * length
+    h = mm.spec.sublayer.smoothing_length
+    p.h[:] = deck.sph.h_factor * length if h is None else h
     p.h0[:] = p.h
     p.body[:] = b
     return p

@@ -276,13 +276,20 @@ class Sublayer(Section):
     moves with it (one degree of freedom); the particles meet the concrete
     particles through their overlapping supports. They form a body named
     ``<mesh>_sublayer`` (updated-Lagrangian) with h = sph.h_factor times the
-    element length.
+    element length, or ``smoothing_length``.
     """
 
     mass_ratio: real("mass ratio", lo=0, hi=1, lo_open=True, hi_open=True) = Field(
         0.5, description="The particles' share of the bar's mass (0 < r < 1; the "
                          "elements carry 1 - r). Equal (0.5) by default, as the thesis "
                          "found best.")
+    smoothing_length: Optional[PositiveLength] = Field(
+        None, description="The particles' smoothing length h (default: sph.h_factor "
+                          "times the bar's mean element length, as LS-DYNA sizes an "
+                          "SPH part from its own spacing). A pair with a concrete "
+                          "particle takes the mean of the two h, so this sets how far "
+                          "into the concrete the bar reaches (docs/validation.md, "
+                          "\"The full 5.0 m beam is punched through\").")
     body: Optional[reference_to("body", mesh_bodies=True)] = Field(
         None, description="The concrete body the bar lies in (a [[body]] or a "
                           "[mesh.convert]'s particles, named as the mesh; default: any "
