@@ -19,7 +19,7 @@ import numpy as np
 from numba import njit
 
 from sphdyn.events.domain_exit import count_outside, outside_rows
-from sphdyn.guards import outside_box
+from sphdyn.watchers.guards import outside_box
 
 
 @njit(cache=True, error_model="numpy")

@@ -25,7 +25,7 @@ import pytest
 from decks import ROLLERS
 from sphdyn.cli import main
 from sphdyn.deck import DeckError, loads_deck
-from sphdyn.guards import EnergyError
+from sphdyn.watchers.guards import EnergyError
 from sphdyn.interactions.base import InteractionBase
 from sphdyn.io import read_history_csv
 from sphdyn.simulation import Simulation
@@ -210,7 +210,7 @@ def test_a_transient_past_the_limit_is_waited_out_a_lasting_gain_is_not(monkeypa
     the limit starts the count again."""
     from types import SimpleNamespace
 
-    from sphdyn import monitors
+    from sphdyn.watchers import monitors
     from sphdyn.io.history import History
 
     monkeypatch.setattr(monitors, "energy_diagnosis", lambda s, *a: "made energy")

@@ -574,7 +574,7 @@ def test_particles_leaving_the_domain_are_removed_and_booked():
 
 def test_particles_leaving_the_domain_stop_the_run_by_default():
     from sphdyn.assembly import build_stepper
-    from sphdyn.guards import SimulationFailed, check_particles
+    from sphdyn.watchers.guards import SimulationFailed, check_particles
     st = build_stepper(load_deck_dict(_expanding_gas_deck("stop")))
     p = st.parts[0].p
     with pytest.raises(SimulationFailed, match="left the domain box"):

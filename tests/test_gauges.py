@@ -10,7 +10,7 @@ import pytest
 
 from sphdyn.assembly import build_stepper
 from sphdyn.deck import DeckError, loads_deck
-from sphdyn.gauges import build_gauges
+from sphdyn.watchers.gauges import build_gauges
 from sphdyn.io.history import read_history_csv
 from sphdyn.simulation import Simulation
 

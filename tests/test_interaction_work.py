@@ -1,5 +1,5 @@
 """The work of each interaction booked apart (``[output] interaction_work``,
-:mod:`sphdyn.interaction_work`).
+:mod:`sphdyn.watchers.interaction_work`).
 
 What is pinned here: the kick's work sum of one source against NumPy (slaves
 left out); in an impact with erosion into particles (a wall on the elements,
@@ -17,7 +17,7 @@ import copy
 import numpy as np
 import pytest
 
-from sphdyn.interaction_work import kick_work
+from sphdyn.watchers.interaction_work import kick_work
 from sphdyn.interactions import Gravity
 from sphdyn.state import BC_FIXED, BC_SLAVE
 from test_erosion import _impact

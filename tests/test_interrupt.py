@@ -14,10 +14,10 @@ import pytest
 
 from sphdyn.cli import main
 from sphdyn.deck import loads_deck
-from sphdyn.guards import SimulationFailed
-from sphdyn.interrupt import StopRequests
+from sphdyn.watchers.guards import SimulationFailed
+from sphdyn.watchers.interrupt import StopRequests
 from sphdyn.io import read_frame, read_history_csv
-from sphdyn.monitors import HistoryFlush
+from sphdyn.watchers.monitors import HistoryFlush
 from sphdyn.simulation import Simulation
 from decks import SMALL_DISC
 

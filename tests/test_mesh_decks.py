@@ -39,7 +39,7 @@ from sphdyn.assembly import build_stepper
 from sphdyn.cli import main
 from sphdyn.deck import DeckError, loads_deck
 from sphdyn.geometry.mesh import block_mesh
-from sphdyn.guards import SimulationFailed
+from sphdyn.watchers.guards import SimulationFailed
 from sphdyn.io import read_checkpoint, read_frame_meshes, read_history_csv
 from sphdyn.model import build_model
 from sphdyn.simulation import Simulation
@@ -578,7 +578,7 @@ point = [0.45, 0.05, 0.05]
     assert model.body_names == ["bar"]
     assert np.array_equal(model.sets["converted"], np.arange(4))
     assert np.allclose(model.particles.x[model.sets["right_half"], 0], [0.55, 0.65])
-    from sphdyn.gauges import build_gauges
+    from sphdyn.watchers.gauges import build_gauges
 
     parts = build_stepper(deck, model).parts
     (gauge,) = build_gauges(deck, parts)

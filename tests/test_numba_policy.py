@@ -1,7 +1,7 @@
 """Project-wide policy of the compiled kernels.
 
 Every Numba kernel uses ``error_model="numpy"``: a division by zero or a math
-domain error gives inf/NaN, which the run's guards (sphdyn.guards) stop with
+domain error gives inf/NaN, which the run's guards (sphdyn.watchers.guards) stop with
 a diagnosis. Under Numba's default "python" model such an error raises, and
 inside a ``prange`` region the exception is swallowed and resurfaces later
 as an unrelated ``SystemError`` (seen with the CSCM Lode ratio, 2026-11-22).

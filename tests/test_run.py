@@ -10,7 +10,7 @@ import pytest
 
 from sphdyn.cli import main
 from sphdyn.deck import loads_deck
-from sphdyn.guards import SimulationFailed
+from sphdyn.watchers.guards import SimulationFailed
 from sphdyn.io import read_checkpoint, read_frame, read_history_csv, read_pvd
 from sphdyn.simulation import Simulation
 from decks import SMALL_DISC
@@ -321,7 +321,7 @@ def test_remaining_time_leaves_out_compilation_and_waits_for_steady_steps():
     1000 s, not the 3:57:10 extrapolated from the first step. A later step
     during which Numba compiled (5 s) is left out too. Sums of equal floats:
     relative error of a few ulp (tolerance 1e-12)."""
-    from sphdyn.monitors import RemainingTime
+    from sphdyn.watchers.monitors import RemainingTime
 
     eta = RemainingTime()
     assert eta.seconds(1e-4) is None
@@ -350,7 +350,7 @@ def test_the_progress_bar_says_compiling_and_shows_no_eta_before_steady_steps():
 
     import numba
 
-    from sphdyn.monitors import COMPILING, Progress, compile_notice
+    from sphdyn.watchers.monitors import COMPILING, Progress, compile_notice
 
     clock = iter(np.arange(0.0, 100.0, 0.5))
     bar = Progress(0.0, 2e-5, clock=lambda: float(next(clock)))

@@ -6,7 +6,7 @@ import pytest
 
 from sphdyn.deck import loads_deck
 from sphdyn.simulation import Simulation
-from sphdyn.threads import ThreadTuner
+from sphdyn.watchers.threads import ThreadTuner
 from decks import concrete_disc_2d
 
 

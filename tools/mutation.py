@@ -313,12 +313,12 @@ MUTANTS: tuple[Mutant, ...] = (
            ("tests/test_sublayer.py::"
             "test_corrected_concrete_is_exact_around_a_bonded_bar_in_affine_motion",),
            "corrected bar particle: the moment sum with the wrong component of x_j - x_i"),
-    Mutant("interaction_work_born_rows", "issue 16.1", "sphdyn/interaction_work.py",
+    Mutant("interaction_work_born_rows", "issue 16.1", "sphdyn/watchers/interaction_work.py",
            "acc[n0:] = q.a_ext[n0:]", "acc[n0:] = 0.0",
            ("tests/test_interaction_work.py::"
             "test_the_sources_add_up_to_the_interactions_work_through_erosion",),
            "the loads of particles born in an erosion left out of the events' work"),
-    Mutant("interaction_work_dt", "issue 16.1", "sphdyn/interaction_work.py",
+    Mutant("interaction_work_dt", "issue 16.1", "sphdyn/watchers/interaction_work.py",
            "    return w * dt_kick", "    return w",
            ("tests/test_interaction_work.py::"
             "test_kick_work_is_the_mass_weighted_power_over_the_kick",),

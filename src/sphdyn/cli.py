@@ -99,7 +99,7 @@ def _writable_dir(path, flag: str) -> Path:
 
 def cmd_run(args) -> int:
     from .deck import load_deck
-    from .monitors import compile_notice
+    from .watchers.monitors import compile_notice
     from .simulation import Simulation
 
     deck = load_deck(args.deck, args.set)
@@ -141,7 +141,7 @@ def _mesh_counts(model) -> str:
 
 
 def cmd_restart(args) -> int:
-    from .monitors import compile_notice
+    from .watchers.monitors import compile_notice
     from .simulation import Simulation
 
     if Path(args.dir).is_dir():  # a missing one is reported by from_directory
@@ -171,7 +171,7 @@ def _finish(summary: dict, out, quiet: bool = False) -> int:
     if summary.get("status") == "interrupted":
         import signal
 
-        from .interrupt import SIGNALS
+        from .watchers.interrupt import SIGNALS
 
         sig = signal.Signals[summary["signal"]]
         print(f"sphdyn: interrupted by {sig.name} at t = {summary['time']:.6e} s "
@@ -215,7 +215,7 @@ def cmd_check(args) -> int:
         # mass scaling is worked out on its started parts (and may be refused)
         stepper = build_stepper(deck, model)
     if deck.gauge:
-        from .gauges import build_gauges
+        from .watchers.gauges import build_gauges
 
         build_gauges(deck, stepper.parts)
     print(f"{args.deck}: OK")
@@ -717,7 +717,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv=None) -> int:
     from .deck import DeckError
-    from .guards import SimulationFailed
+    from .watchers.guards import SimulationFailed
 
     try:
         args = build_parser().parse_args(argv)

@@ -28,7 +28,7 @@ from .preflight import (check_meshes_in_domain, checked_lattices, history_models
 from .materials import MaterialGroup, get_model, history_layout
 from .materials.uniaxial import UNIAXIAL, uniaxial_params
 from .mesh_model import MeshModel, build_meshes, mesh_node_set, pressure_faces
-from .probes import Probe, quantity
+from .watchers.probes import Probe, quantity
 from .state import Particles
 
 

@@ -25,7 +25,7 @@ import numpy as np
 
 from . import __version__
 from .deck import dump_resolved, load_deck
-from .guards import SimulationFailed
+from .watchers.guards import SimulationFailed
 from .io import (FrameWriter, History, MeshFrame, atomic_write_text, particle_fields,
                  plot_history, read_checkpoint, write_checkpoint)
 from .analysis import window_mean_force
@@ -33,12 +33,12 @@ from .io.frames import STOP_FRAME, list_frames
 from .io.plots import (energy_columns, per_depth, plot_gauges, relative_drift, scaled_unit,
                        time_unit)
 from .assembly import build_stepper
-from .gauges import GaugeRecorder, build_gauges
+from .watchers.gauges import GaugeRecorder, build_gauges
 from .model import Model, build_model
-from .interrupt import StopRequests
-from .monitors import (Checkpoints, EnergyGuard, FrameOutput, Guards, HistoryFlush,
+from .watchers.interrupt import StopRequests
+from .watchers.monitors import (Checkpoints, EnergyGuard, FrameOutput, Guards, HistoryFlush,
                        HistoryRecorder, Progress)
-from .threads import ThreadTuner
+from .watchers.threads import ThreadTuner
 from .neighbours import max_neighbours, mean_neighbours
 from .stepper import Stepper
 
@@ -51,7 +51,7 @@ class Simulation:
 
     Use :meth:`from_deck` for a new run and :meth:`from_directory` to restart.
     The run's output is written by monitors attached to the stepper
-    (:mod:`sphdyn.monitors`): guards, history rows and probes, frames and
+    (:mod:`sphdyn.watchers.monitors`): guards, history rows and probes, frames and
     checkpoints.
     """
 
@@ -136,7 +136,7 @@ class Simulation:
         """Run to ``t_end`` (default the deck's) or for ``max_steps`` steps.
 
         ``threads``: a fixed Numba thread count, or None to let a
-        :class:`~sphdyn.threads.ThreadTuner` keep the faster of all threads
+        :class:`~sphdyn.watchers.threads.ThreadTuner` keep the faster of all threads
         and half of them (results are the same bits either way).
 
         SIGINT or SIGTERM (in the main thread) end the run after the current

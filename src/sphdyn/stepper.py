@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 
 from .integrate import KICK_BLOCK, kick, kick_scratch
-from .interaction_work import InteractionWork
+from .watchers.interaction_work import InteractionWork
 from .state import BC_SLAVE
 
 
@@ -71,7 +71,7 @@ class Stepper:
         ``after_kick(stepper)``, ``after_step(stepper)``.
     dt_max : largest step [s].
     interaction_work : book each interaction's work apart
-        (:mod:`sphdyn.interaction_work`; columns ``W_contact_<name>``).
+        (:mod:`sphdyn.watchers.interaction_work`; columns ``W_contact_<name>``).
     mass_scaling : a :class:`~sphdyn.mass_scaling.MassScaling` or None: inertia
         added to the items that limit the step, once the parts have started.
     """
@@ -97,7 +97,7 @@ class Stepper:
         self.work_contact = 0.0  # work of the interaction forces [J]
         self.work_external = 0.0  # work of the boundary-condition reactions [J]
         self._kick_sums: dict[str, np.ndarray] = {}  # per part, grown with it
-        # per part (the energy guard's diagnosis, sphdyn.monitors.EnergyGuard):
+        # per part (the energy guard's diagnosis, sphdyn.watchers.monitors.EnergyGuard):
         # kinetic energy at the last kick [J], the work done on its items by
         # interaction accelerations and boundary reactions so far [J], and its
         # kinetic plus internal energy at the first kick [J]

@@ -49,7 +49,7 @@ def run_sample(spec: SampleSpec) -> dict:
     ``result.json`` is written atomically as the last file.
     """
     from ..deck import DeckError, load_deck
-    from ..guards import SimulationFailed
+    from ..watchers.guards import SimulationFailed
     from ..simulation import Simulation
 
     t0, c0 = time.perf_counter(), time.process_time()

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ..guards import outside_box
+from ..watchers.guards import outside_box
 
 
 @njit(cache=True, error_model="numpy", parallel=True)

@@ -342,7 +342,7 @@ def history_figures(data: dict[str, np.ndarray], title: str = "",
     return figures
 
 
-#: units of the gauges' columns (:mod:`sphdyn.gauges`)
+#: units of the gauges' columns (:mod:`sphdyn.watchers.gauges`)
 GAUGE_UNITS = {"strain": "-", "displacement": "m", "velocity": "m/s", "force": "N"}
 
 

@@ -2,7 +2,7 @@
 
 The instruments of an experiment (thesis ch. 8: a strain gauge on the top
 surface, a displacement transducer at mid-span), LS-DYNA's
-DATABASE_HISTORY_NODE and DATABASE_CROSS_SECTION: see :mod:`sphdyn.gauges`.
+DATABASE_HISTORY_NODE and DATABASE_CROSS_SECTION: see :mod:`sphdyn.watchers.gauges`.
 """
 
 from typing import Literal, Optional

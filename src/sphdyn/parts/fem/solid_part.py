@@ -243,9 +243,9 @@ class SolidPart:
 
     def hotspot(self) -> str:
         """The element of the largest specific internal energy (the energy
-        guard's diagnosis, :func:`sphdyn.guards.energy_diagnosis`) and the
+        guard's diagnosis, :func:`sphdyn.watchers.guards.energy_diagnosis`) and the
         fastest node."""
-        from ...guards import _fmt, fastest
+        from ...watchers.guards import _fmt, fastest
 
         el, p = self.el, self.pts
         work = (p.m * p.e).reshape(el.n, self.ngp).sum(axis=1) + el.e_hg

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...guards import SimulationFailed
+from ...watchers.guards import SimulationFailed
 from ...integrate import (add_heat, cfl_mass_factors, cfl_time_step, drift,
                           internal_energies)
 from ...kernels import KernelContext
@@ -342,9 +342,9 @@ class SPHPart:
 
     def hotspot(self) -> str:
         """The particle of the largest specific internal energy (the energy
-        guard's diagnosis, :func:`sphdyn.guards.energy_diagnosis`) and the
+        guard's diagnosis, :func:`sphdyn.watchers.guards.energy_diagnosis`) and the
         fastest particle."""
-        from ...guards import _fmt, fastest
+        from ...watchers.guards import _fmt, fastest
 
         p = self.p
         e = np.where(p.active != 0, p.e, -np.inf)

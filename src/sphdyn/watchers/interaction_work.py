@@ -35,7 +35,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .state import BC_SLAVE
+from ..state import BC_SLAVE
 
 
 @njit(cache=True, error_model="numpy")

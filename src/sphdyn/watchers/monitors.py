@@ -5,7 +5,7 @@ A monitor has any of the hooks the :class:`~sphdyn.stepper.Stepper` calls:
 ``after_kick(stepper)`` with the state at the kick's time :math:`t^n`, and
 ``after_step(stepper)`` at :math:`t^{n+1}`. They are attached in this order
 by :class:`~sphdyn.simulation.Simulation`: the thread tuner
-(:mod:`sphdyn.threads`, when the thread count is automatic), guards, history
+(:mod:`sphdyn.watchers.threads`, when the thread count is automatic), guards, history
 (with probes), the energy guard (after the history, so that the row that
 broke the limit is kept), frames, checkpoints, progress, the history flush.
 """
@@ -19,13 +19,13 @@ from contextlib import contextmanager
 import numpy as np
 
 from .guards import EnergyError, check_particles, check_time_step, energy_diagnosis
-from .io.plots import energy_columns
+from ..io.plots import energy_columns
 from .probes import record as probe_record
 
 
 class Guards:
     """Stop the run with a diagnosis: time-step collapse, NaN, particles leaving
-    the domain box ``[lo, hi]`` (see :mod:`sphdyn.guards`)."""
+    the domain box ``[lo, hi]`` (see :mod:`sphdyn.watchers.guards`)."""
 
     def __init__(self, lo, hi, collapse_ratio: float, parts):
         self.lo, self.hi, self.collapse_ratio = lo, hi, collapse_ratio
@@ -79,8 +79,8 @@ class EnergyGuard:
     quasi-static ramp's first steps, with all energies still tiny, lose 19 %
     of them to the leapfrog's booking of the prescribed motion's work, a
     transient), reported by ``energy_error_max_rel`` alone. Past ``limit``,
-    ``action`` ``"stop"`` raises :class:`~sphdyn.guards.EnergyError` with
-    :func:`~sphdyn.guards.energy_diagnosis` (after the row is kept),
+    ``action`` ``"stop"`` raises :class:`~sphdyn.watchers.guards.EnergyError` with
+    :func:`~sphdyn.watchers.guards.energy_diagnosis` (after the row is kept),
     ``"warn"`` prints that diagnosis once and keeps it in ``warning``.
     ``history`` (the rows of a restarted run) gives the first row and the
     largest term so far.

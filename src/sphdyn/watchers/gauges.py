@@ -35,11 +35,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .deck import DeckError
-from .deck.errors import format_problem
-from .io.history import History
+from ..deck import DeckError
+from ..deck.errors import format_problem
+from ..io.history import History
 from .monitors import next_multiple
-from .state import BC_SLAVE
+from ..state import BC_SLAVE
 
 
 @dataclass
@@ -99,7 +99,7 @@ def _candidates(deck, parts, spec):
                 out.append((pk, np.arange(q.n)))
         elif spec.body is not None:
             if part.kind == "sph":
-                from .model import particle_body_names
+                from ..model import particle_body_names
 
                 k = particle_body_names(deck).index(spec.body)
                 out.append((pk, np.flatnonzero(q.body == k)))

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .fields import probe_values
+from ..fields import probe_values
 
 _REDUCE = {"mean": np.mean, "min": np.min, "max": np.max}
 
