@@ -36,8 +36,8 @@ from .assembly import build_stepper
 from .watchers.gauges import GaugeRecorder, build_gauges
 from .model import Model, build_model
 from .watchers.interrupt import StopRequests
-from .watchers.monitors import (Checkpoints, EnergyGuard, FrameOutput, Guards, HistoryFlush,
-                       HistoryRecorder, Progress)
+from .watchers.monitors import (Checkpoints, EnergyGuard, FrameOutput, Guards,
+                                HistoryFlush, HistoryRecorder, Progress)
 from .watchers.threads import ThreadTuner
 from .neighbours import max_neighbours, mean_neighbours
 from .stepper import Stepper
