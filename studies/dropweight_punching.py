@@ -10,8 +10,11 @@ about 2 and 7 minutes on 2 cores. Prints
 * the contact force's first touch and peak (of these runs and of any
   ``--runs`` directory, e.g. the quick case or the 2.5 m beam);
 * the history of the concrete particle nearest (590, 50, 59.4) mm, at
-  mid-depth under the impact: pressure, von Mises stress, principal
-  stresses, brittle and ductile damage, vertical velocity;
+  mid-depth under the impact: pressure, von Mises stress, the ratio
+  |J1| / sqrt(3 J2') by which MAT_159 moves its fracture energy from GFS (0,
+  shear) to GFC or GFT (1, uniaxial stress), principal stresses, brittle and
+  ductile damage, vertical velocity (and, for an element, the largest
+  ductile damage variable tau_c so far [sqrt(Pa)] and the rate factor);
 * the mid-span section (x 585-595 mm) at 1 and 2 ms: per particle row, the
   mean stress along the beam and along z, brittle and ductile damage; the
   largest and smallest axial force of a bottom and a top bar within 100 mm
@@ -24,7 +27,13 @@ about 2 and 7 minutes on 2 cores. Prints
   6 and 10 ms (kinetic energy's fall over the deflection's growth: the
   force that resists the motion, as one number).
 
-    PYTHONPATH=src python studies/dropweight_punching.py --out OUT [--runs DIR ...]
+With ``--fem`` the same for the beam of hexahedra
+(``lozano2017_dropweight_fem_5.0m``: the same concrete meshed, the bars
+embedded), its runs ``fem_early`` and ``fem_section`` like ``early`` and
+``section`` (about 2 and 6 minutes on one core), read off the elements
+(their centroids) instead of the particles.
+
+    PYTHONPATH=src python studies/dropweight_punching.py --out OUT [--fem] [--runs DIR ...]
 """
 
 from __future__ import annotations
@@ -37,43 +46,64 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-CASE = "lozano2017_dropweight_5.0m"
 FIELDS = '["velocity","damage","damage_brittle","damage_ductile","stress","displacement",' \
          '"material"]'
-RUNS = {"early": ("0.0005", "0.000025"), "section": ("0.002", "0.00025")}  # t_end, every [s]
+#: case, t_end, frame interval [s] of each run
+RUNS = {"early": ("lozano2017_dropweight_5.0m", "0.0005", "0.000025"),
+        "section": ("lozano2017_dropweight_5.0m", "0.002", "0.00025"),
+        "fem_early": ("lozano2017_dropweight_fem_5.0m", "0.0005", "0.000025"),
+        "fem_section": ("lozano2017_dropweight_fem_5.0m", "0.002", "0.00025")}
 TRACE = np.array([0.590, 0.050, 0.0594])  # [m], mid-depth under the impact
 SECTION = (0.585, 0.595)  # [m], mid-span
 
 
 def run(out: Path, name: str) -> Path:
     """The run directory of one variant (run by ``sphdyn validate`` unless done)."""
-    t_end, every = RUNS[name]
+    case, t_end, every = RUNS[name]
     where = out / name
-    subprocess.run([sys.executable, "-m", "sphdyn", "validate", CASE, "--out", str(where),
+    subprocess.run([sys.executable, "-m", "sphdyn", "validate", case, "--out", str(where),
                     "--reuse", "--set", f"run.t_end={t_end}", "--set",
                     f"output.every={every}", "--set", f"output.fields={FIELDS}"],
                    check=True, cwd=ROOT, stdout=subprocess.DEVNULL)
-    return where / CASE
+    return where / case
+
+
+def concrete(path: Path) -> tuple[float, dict]:
+    """(t [s], the concrete's points) of one frame: the particles of material
+    0, or, in a frame with a mesh ``beam``, its elements (at their centroids;
+    displacement and velocity the mean of their nodes'); the stress (N, 3, 3)."""
+    from sphdyn.io import read_frame, read_frame_meshes
+
+    t, _, fields, _ = read_frame(path)
+    beam = read_frame_meshes(path).get("beam")
+    if beam is not None:
+        cells = beam.cells
+        fields = {k: beam.cell_data[k] for k in ("stress", "damage", "damage_brittle",
+                                                  "damage_ductile", "tau_c_max",
+                                                  "rate_factor") if k in beam.cell_data}
+        fields["position"] = beam.points[cells].mean(axis=1)
+        for k in ("displacement", "velocity"):
+            fields[k] = beam.point_data[k][cells].mean(axis=1)
+        fields["material"] = np.zeros(cells.shape[0], dtype=np.int32)
+    fields["stress"] = fields["stress"].reshape(-1, 3, 3)
+    return t, fields
 
 
 def frames(d: Path):
-    """(t [s], fields) of every frame of run ``d``, the stress as (N, 3, 3)."""
-    from sphdyn.io import read_frame
+    """(t [s], fields) of the concrete (:func:`concrete`) in every frame of run ``d``."""
     from sphdyn.io.frames import list_frames
 
     for f in list_frames(d):
-        t, _, fields, _ = read_frame(f)
-        if "stress" in fields:
-            fields["stress"] = fields["stress"].reshape(-1, 3, 3)
-        yield t, fields
+        yield concrete(f)
 
 
 def contact(d: Path) -> str:
     """First touch and peak of the drop weight's contact force in run ``d``."""
     from sphdyn.io import read_history_csv
+    from sphdyn.validation.measures import contact_force
 
     h = read_history_csv(d / "history.csv")
-    t, f = np.asarray(h["time"]), np.abs(np.asarray(h["F_rod_contact"]))
+    t, f = np.asarray(h["time"]), np.abs(contact_force(h, "rod"))
     k = int(np.argmax(f))
     return (f"first touch {1e3 * t[np.argmax(f > 0)]:.3f} ms, peak {f[k] / 1e3:.0f} kN "
             f"at {1e3 * t[k]:.3f} ms")
@@ -103,14 +133,20 @@ def trace(d: Path) -> None:
             x0 = f["position"] - f["displacement"]
             conc = f["material"] == 0
             i = int(np.flatnonzero(conc)[np.argmin(np.sum((x0[conc] - TRACE) ** 2, axis=1))])
-            print(f"particle {i} at {np.round(1e3 * x0[i], 2)} mm")
+            print(f"point {i} at {np.round(1e3 * x0[i], 2)} mm")
         s = f["stress"][i] / 1e6
         p = -np.trace(s) / 3.0
         dev = s + p * np.eye(3)
-        print(f"  t {1e3 * t:.3f} ms  p {p:6.1f}  von Mises {np.sqrt(1.5 * np.sum(dev * dev)):5.1f}"
-              f"  principal {np.round(np.linalg.eigvalsh(s), 1)} MPa  brittle "
+        mises = np.sqrt(1.5 * np.sum(dev * dev))  # sqrt(3 J2')
+        # MAT_159's fracture-energy transition reads |J1| / sqrt(3 J2'): 1 in
+        # uniaxial stress (GFT or GFC), 0 in pure shear (GFS)
+        ratio = abs(3.0 * p) / mises if mises > 0.0 else np.inf
+        print(f"  t {1e3 * t:.3f} ms  p {p:6.1f}  von Mises {mises:5.1f}  |J1|/sqrt(3J2') "
+              f"{ratio:5.2f}  principal {np.round(np.linalg.eigvalsh(s), 1)} MPa  brittle "
               f"{f['damage_brittle'][i]:.2f}  ductile {f['damage_ductile'][i]:.2f}  "
-              f"v_z {f['velocity'][i, 2]:.2f} m/s")
+              f"v_z {f['velocity'][i, 2]:.2f} m/s"
+              + (f"  tau_c max {f['tau_c_max'][i]:.1f}, rate factor {f['rate_factor'][i]:.2f}"
+                 if "tau_c_max" in f else ""))
 
 
 def section(d: Path, times=(1e-3, 2e-3)) -> None:
@@ -120,7 +156,8 @@ def section(d: Path, times=(1e-3, 2e-3)) -> None:
             continue
         x0 = f["position"] - f["displacement"]
         sel = (f["material"] == 0) & (x0[:, 0] > SECTION[0]) & (x0[:, 0] < SECTION[1])
-        print(f"t {1e3 * t:.2f} ms: z [mm], mean sigma_xx, sigma_zz [MPa], brittle, ductile")
+        print(f"t {1e3 * t:.2f} ms: z [mm], mean sigma_xx, sigma_zz [MPa], brittle, ductile"
+              f" (of {sel.sum()} points)")
         for z in np.unique(np.round(x0[sel, 2], 6))[::-1]:
             q = sel & (abs(x0[:, 2] - z) < 1e-6)
             s = f["stress"][q]
@@ -152,7 +189,7 @@ def damaged_block(d: Path, t: float = 1e-3) -> str:
             return "none"
         lo, hi = 1e3 * x0[q].min(axis=0), 1e3 * x0[q].max(axis=0)
         return (f"x {lo[0]:.0f}-{hi[0]:.0f} mm, z {lo[2]:.0f}-{hi[2]:.0f} mm "
-                f"({q.sum()} particles)")
+                f"({q.sum()} points)")
     return "(no frame at 1 ms)"
 
 
@@ -161,7 +198,12 @@ def main() -> None:
     ap.add_argument("--out", type=Path, required=True)
     ap.add_argument("--runs", type=Path, nargs="*", default=[],
                     help="other run directories (a case's folder) to measure too")
+    ap.add_argument("--fem", action="store_true",
+                    help="the beam of hexahedra instead (the run fem_section)")
     args = ap.parse_args()
+    if args.fem:
+        fem(run(args.out, "fem_early"), run(args.out, "fem_section"), args.runs)
+        return
     early, mid = run(args.out, "early"), run(args.out, "section")
     for d in [mid, *args.runs]:
         print(f"{d}: contact {contact(d)}")
@@ -176,6 +218,25 @@ def main() -> None:
     for d in [mid, *args.runs]:
         print(f"{d}: damaged at 1 ms {damaged_block(d)}")
     for d in args.runs:
+        print(f"{d}: resisting force {resisting_force(d)}")
+
+
+def fem(early: Path, mid: Path, runs: list[Path]) -> None:
+    """The beam of hexahedra: contact, the traced element, section, bars,
+    damaged block, resisting force."""
+    from sphdyn.io.frames import list_frames
+
+    for d in [mid, *runs]:
+        print(f"{d}: contact {contact(d)}")
+    trace(early)
+    trace(mid)
+    section(mid)
+    for f in list_frames(mid)[4::4]:  # 1 and 2 ms
+        print(f"bars at {f.name}:")
+        bars(f)
+    for d in [mid, *runs]:
+        print(f"{d}: damaged at 1 ms {damaged_block(d)}")
+    for d in runs:
         print(f"{d}: resisting force {resisting_force(d)}")
 
 

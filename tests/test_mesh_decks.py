@@ -465,9 +465,40 @@ def test_rotations_on_solid_nodes_are_refused(tmp_path, capsys):
     _bad(tmp_path, text, "boundary[0].rotations", ["no rotational"], capsys)
 
 
-def test_probe_of_mesh_nodes_is_refused(tmp_path, capsys):
-    text = _bar_text(extra="") + '\n[[probe]]\nset = "left"\nquantities = ["velocity_x"]\n'
-    _bad(tmp_path, text, "probe[0].set", ["mesh nodes"], capsys)
+def test_probe_of_mesh_nodes_records_their_kinematics(tmp_path):
+    """A [[probe]] of a mesh's node set (LS-DYNA's nodout): the bar's right
+    end is pulled 0.1 mm over the 2 ms smooth ramp, so at every record the
+    probe's mean displacement_x is the prescribed displacement of the ramp at
+    that time (the nodes follow it exactly: to round-off, 1e-12 m), its
+    velocity_x the ramp's velocity within one step of its change (the kick's
+    velocity is the ramp's over the step: |dv/dt| dt, 3e-3 m/s at the ramp's
+    largest acceleration, of a peak of 0.1 m/s); "max" of position_x is 1 m
+    plus the displacement. A probe without quantities records the default
+    ones that nodes have (not von_mises); the fixed end stays at zero."""
+    text = _bar_text(extra="") + (
+        '\n[[probe]]\nset = "right"\nquantities = ["displacement_x", "velocity_x"]'
+        '\n[[probe]]\nset = "right"\nquantities = ["position_x"]\nreduce = "max"\n'
+        '\n[[probe]]\nset = "left"\n')
+    sim = Simulation.from_deck(loads_deck(text), tmp_path / "bar")
+    assert sim.run()["status"] == "completed"
+    h = read_history_csv(tmp_path / "bar/history.csv")
+    t = h["time"] / 2e-3
+    ramp = np.where(t < 1.0, t - np.sin(2 * np.pi * t) / (2 * np.pi), 1.0)  # smooth
+    rate = np.where(t < 1.0, (1.0 - np.cos(2 * np.pi * t)) / 2e-3, 0.0)
+    assert np.abs(h["probe_right_displacement_x"] - 1e-4 * ramp).max() < 1e-12
+    slope = 1e-4 * 2 * np.pi / 2e-3 ** 2  # the ramp's largest acceleration [m/s^2]
+    assert np.abs(h["probe_right_velocity_x"] - 1e-4 * rate).max() < slope * h["dt"].max()
+    assert np.abs(h["probe_right_position_x"] - 1.0 - 1e-4 * ramp).max() < 1e-12
+    # the default quantities that nodes have: the displacements and velocities
+    assert sorted(k for k in h if k.startswith("probe_left")) == sorted(
+        f"probe_left_{f}_{c}" for f in ("displacement", "velocity") for c in "xyz")
+    assert np.all(h["probe_left_displacement_x"] == 0.0)
+
+
+def test_probe_of_mesh_nodes_names_what_nodes_have(tmp_path, capsys):
+    text = _bar_text(extra="") + '\n[[probe]]\nset = "left"\nquantities = ["stress_xx"]\n'
+    _bad(tmp_path, text, "probe[0].quantities", ["'stress_xx' is not a quantity of mesh "
+                                                 "nodes", "displacement"], capsys)
 
 
 def test_huge_generated_mesh_is_refused_before_it_is_made(tmp_path, capsys):

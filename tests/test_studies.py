@@ -137,3 +137,31 @@ def test_punching_study_measures_the_resisting_force_and_the_contact_peak(tmp_pa
     values = [float(w.split(" ")[2]) for w in got.split(", ")]
     assert len(values) == 3 and np.allclose(values, 4.0, rtol=1e-9)
     assert dp.contact(tmp_path) == "first touch 0.200 ms, peak 2 kN at 0.500 ms"
+
+
+def test_punching_study_reads_a_meshed_beam_at_its_elements(tmp_path):
+    """studies/dropweight_punching.py on a frame with a mesh ``beam``: each
+    element is a point at its centroid, with its cell stress (3 x 3) and
+    damages and its nodes' mean displacement and velocity, so the section
+    and the damaged block read elements as they read particles (exact)."""
+    import dropweight_punching as dp
+    from sphdyn.geometry.mesh import block_mesh
+    from sphdyn.io import MeshFrame
+    from sphdyn.io.hdf5 import write_frame
+
+    mesh = block_mesh((0, 0, 0), (0.02, 0.01, 0.01), (2, 1, 1), 3)
+    pts, cells = mesh.points, mesh.cells
+    disp = np.column_stack([np.zeros(len(pts)), np.zeros(len(pts)), -pts[:, 0]])
+    cell = {k: np.array([0.1, 0.9]) for k in ("damage", "damage_brittle", "damage_ductile")}
+    cell["stress"] = np.arange(18.0).reshape(2, 9)
+    write_frame(tmp_path / "frame_000000.h5", 1e-3, 10, {"position": np.zeros((0, 3))},
+                meshes={"beam": MeshFrame(points=pts + disp, cells=cells, kind="hex8",
+                                          point_data={"displacement": disp, "velocity": disp},
+                                          cell_data=cell)})
+    t, f = dp.concrete(tmp_path / "frame_000000.h5")
+    assert t == 1e-3
+    x0 = f["position"] - f["displacement"]
+    assert np.allclose(x0, [[0.005, 0.005, 0.005], [0.015, 0.005, 0.005]], rtol=0, atol=1e-15)
+    assert np.allclose(f["displacement"][:, 2], [-0.005, -0.015], rtol=0, atol=1e-15)
+    assert f["stress"].shape == (2, 3, 3) and f["stress"][1, 2, 2] == 17.0
+    assert f["damage_ductile"].tolist() == [0.1, 0.9] and (f["material"] == 0).all()

@@ -211,16 +211,49 @@ def test_table_shows_another_codes_answer_beside_sphdyns():
 
 def test_lozano_cases_carry_the_authors_ls_dyna_answers():
     """The Lozano references' peers are the authors' LS-DYNA hexahedron
-    model's (lozano2017_reference_predictions.csv: Tables 11.3, 11.6, 11.18)."""
+    model's (lozano2017_reference_predictions.csv: Tables 11.3, 11.6, 11.18),
+    for the beam of particles and the beam of hexahedra alike."""
     from sphdyn.validation.cases import CASES
 
     data = ROOT / "validation" / "data"
-    peers = {name: {r.key: r.peer for r in CASES[name].references(data)}
-             for name in ("lozano2017_dropweight_2.5m", "lozano2017_dropweight_5.0m",
-                          "lozano2017_static")}
-    assert peers == {"lozano2017_dropweight_2.5m": {"umax": 12.3, "t_umax": 6.9},
-                     "lozano2017_dropweight_5.0m": {"umax": 24.6, "t_umax": 9.2},
+    names = ("lozano2017_dropweight_2.5m", "lozano2017_dropweight_5.0m",
+             "lozano2017_dropweight_fem_2.5m", "lozano2017_dropweight_fem_5.0m",
+             "lozano2017_static")
+    peers = {name: {r.key: r.peer for r in CASES[name].references(data)} for name in names}
+    impact = {"2.5": {"umax": 12.3, "t_umax": 6.9}, "5.0": {"umax": 24.6, "t_umax": 9.2}}
+    assert peers == {**{f"lozano2017_dropweight_{v}{h}m": impact[h]
+                        for v in ("", "fem_") for h in impact},
                      "lozano2017_static": {"peak_load": 13.0}}
+
+
+@pytest.mark.parametrize("quick", [False, True])
+def test_the_meshed_beams_deck_keeps_the_contact_thickness_at_every_size(quick):
+    """The beam of hexahedra (lozano2017_dropweight_fem.toml) with its own
+    and its quick overrides: the nodes of the beam meet the rod and the
+    supports at 2.5 mm (thickness_factor x the element size: 0.5 x 5 mm,
+    0.25 x 10 mm), where the supports' top faces stand below the beam (so
+    nothing touches at the start) and the rod's tip 2 mm farther up."""
+    from sphdyn.assembly import build_stepper
+    from sphdyn.deck import load_deck
+    from sphdyn.interactions.penalty_coupling import PenaltyCoupling
+    from sphdyn.validation.cases import CASES
+    from sphdyn.validation.runner import case_overrides
+
+    case = CASES["lozano2017_dropweight_fem_5.0m"]
+    deck = load_deck(ROOT / case.deck, overrides=case_overrides(case, quick))
+    s = build_stepper(deck)
+    couplings = {c.name: c for c in s.interactions if isinstance(c, PenaltyCoupling)}
+    assert sorted(couplings) == ["rod_contact_beam", "support_left_contact_beam",
+                                 "support_right_contact_beam"]
+    beam = next(q for q in s.parts if q.name == "beam")
+    for c in couplings.values():
+        t = c.thickness_factor * beam.p.vol0 ** (1.0 / 3.0)
+        on_face = beam.p.x[:, 2] < 1e-9  # the beam's bottom face nodes
+        assert np.allclose(t[on_face], 0.0025, rtol=1e-9)
+    rod = next(q for q in s.parts if q.name == "rod")
+    assert rod.kin.x[:, 2].min() == pytest.approx(0.1 + 0.0025 + 0.002, abs=1e-9)
+    support = next(q for q in s.parts if q.name == "support_left")
+    assert support.kin.x[:, 2].max() == pytest.approx(-0.0025, abs=1e-12)
 
 
 @pytest.mark.parametrize("argv, message", [
@@ -374,3 +407,20 @@ def test_figures_find_another_codes_answer_in_the_rows():
     rows = [{"key": "umax", "peer": 12.3}, {"key": "t_umax", "peer": None}]
     assert _peer(rows, "umax") == 12.3
     assert _peer(rows, "t_umax") is None and _peer(rows, "peak_load") is None
+
+
+def test_contact_force_sums_the_particles_and_the_meshes_a_mesh_meets():
+    """An impactor's contact force is its particles' column plus one column per
+    mesh of its ``[mesh.contact] meshes``; tie forces (a sum of magnitudes)
+    and another mesh whose name starts alike stay out; a mesh without
+    contact is named in the error."""
+    from sphdyn.validation.measures import contact_force
+    h = {"time": np.array([0.0, 1.0, 2.0]), "F_rod_contact": np.array([0.0, 1.0, 2.0]),
+         "F_rod_contact_beam": np.array([0.0, 10.0, 0.0]),
+         "F_rod_contact_tie": np.array([5.0, 5.0, 5.0]),
+         "F_rodx_contact": np.array([7.0, 7.0, 7.0])}
+    assert contact_force(h, "rod").tolist() == [0.0, 11.0, 2.0]
+    del h["F_rod_contact"]
+    assert contact_force(h, "rod").tolist() == [0.0, 10.0, 0.0]
+    with pytest.raises(KeyError, match="'plate'"):
+        contact_force(h, "plate")

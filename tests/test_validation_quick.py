@@ -2,13 +2,14 @@
 their compared numbers (issue 53).
 
 Each quick case runs (leppanen2004_fragment about 1 minute on 2 cores, the
-two lozano2017_dropweight cases about 4 and 5, lozano2017_static about 6)
-and its compared
+two lozano2017_dropweight cases about 4 and 5, the two meshed
+lozano2017_dropweight_fem cases about 2 and 2.5 on one core, lozano2017_static
+about 6) and its compared
 numbers must stay within the tolerance of the values stored in
 tests/data/validation_quick.json, which ``python tests/test_validation_quick.py
---store [RUNS_DIR]`` rewrites after a deliberate change (say why in the
-commit; the runs go to RUNS_DIR/a and RUNS_DIR/b, and completed ones there
-are measured again, not rerun).
+--store [RUNS_DIR [CASE ...]]`` rewrites after a deliberate change (say why in
+the commit; the runs go to RUNS_DIR/a and RUNS_DIR/b, and completed ones
+there are measured again, not rerun; with CASEs only their entries).
 
 The tolerance of each number is stored beside it and comes from the same
 evidence as the example regression's (docs/testing.md, "The regression
@@ -48,6 +49,8 @@ PERTURB = {
     "leppanen2004_fragment": "body.fragment.velocity.2=-1879.0000000000002",
     "lozano2017_dropweight_2.5m": "mesh.rod.velocity.2=-6.900000000000001",
     "lozano2017_dropweight_5.0m": "mesh.rod.velocity.2=-9.800000000000002",
+    "lozano2017_dropweight_fem_2.5m": "mesh.rod.velocity.2=-6.900000000000001",
+    "lozano2017_dropweight_fem_5.0m": "mesh.rod.velocity.2=-9.800000000000002",
     # the loader's prescribed velocity moved by one ulp moves its nodes by
     # less than their positions' ulp, so nothing changes: the concrete's
     # density instead
@@ -78,16 +81,18 @@ def _run(names, out: Path, perturb: bool = False, reuse: bool = False):
     return results
 
 
-def store(runs: Path) -> None:
-    """Run each quick case and its one-ulp perturbed twin into ``runs``
-    (completed runs there are measured again, not rerun); write the values
-    and tolerances to :data:`STORE`."""
+def store(runs: Path, names=None) -> None:
+    """Run each quick case (or those of ``names``) and its one-ulp perturbed
+    twin into ``runs`` (completed runs there are measured again, not rerun);
+    write their values and tolerances to :data:`STORE`, keeping the other
+    cases' entries."""
     from sphdyn.validation.cases import CASES
 
-    names = list(CASES)
+    names = list(CASES) if not names else list(names)
     base = _run(names, runs / "a", reuse=True)
     moved = _run(names, runs / "b", perturb=True, reuse=True)
-    table = {}
+    table = json.loads(STORE.read_text()) if STORE.is_file() else {}
+    table = {k: v for k, v in table.items() if k in CASES}
     for name in names:
         table[name] = {}
         for key, value in base[name].items():
@@ -123,7 +128,7 @@ def test_every_case_has_stored_quick_numbers():
 
 
 if __name__ == "__main__":
-    # python tests/test_validation_quick.py --store [RUNS_DIR]
+    # python tests/test_validation_quick.py --store [RUNS_DIR [CASE ...]]
     if "--store" in sys.argv:
         rest = sys.argv[sys.argv.index("--store") + 1:]
-        store(Path(rest[0]) if rest else ROOT / "out" / "validation_quick_store")
+        store(Path(rest[0]) if rest else ROOT / "out" / "validation_quick_store", rest[1:])

@@ -101,6 +101,10 @@ def _target(model, sph_part, meshes: dict, set_name: str):
     return sph_part, model.sets[set_name]
 
 
+#: the elements of a line mesh, in a message
+_PLURAL = {"beam": "beams", "truss": "trusses"}
+
+
 def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
     """Prescribed motions, loads, damping, walls on meshes and the couplings."""
     out, taken = [], set()
@@ -162,11 +166,14 @@ def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
                                         np.arange(part.kin.n)))
         ero, con = mm.spec.erosion, mm.spec.contact
         if con is not None:
-            out.append(PenaltyCoupling(f"{mm.name}_contact", sph_part, part,
-                                       stiffness=con.stiffness, alpha=con.alpha,
-                                       thickness_factor=con.thickness_factor,
-                                       friction=con.friction,
-                                       stiffness_step=con.stiffness_step))
+            keys = dict(stiffness=con.stiffness, alpha=con.alpha,
+                        thickness_factor=con.thickness_factor, friction=con.friction,
+                        stiffness_step=con.stiffness_step)
+            if sph_part is not None:  # a model of meshes only has no particles
+                out.append(PenaltyCoupling(f"{mm.name}_contact", sph_part, part, **keys))
+            for slave in _contact_meshes(model, mm):
+                out.append(PenaltyCoupling(f"{mm.name}_contact_{slave}", meshes[slave],
+                                           part, **keys))
         elif ero is not None and ero.to == "particles" and not (
                 mm.converted is not None and mm.converted.spec.coupling == "penalty"):
             # the debris meets the remaining elements by penalty ([mesh.contact]
@@ -184,7 +191,7 @@ def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
         where = f"mesh[{mm.index}] '{mm.name}'.embed"
         if host.element != "solid":
             raise DeckError([format_problem(where, f"mesh '{host.name}' is a line of "
-                                            f"{host.element}s, not solid elements",
+                                            f"{_PLURAL[host.element]}, not solid elements",
                                             "embed the bar in a [mesh.block] or a file "
                                             "of hex8 / quad4")])
         try:
@@ -194,6 +201,24 @@ def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
             raise DeckError([format_problem(where, str(exc).split(": ", 1)[-1],
                                             "move the bar into the solid mesh")]) from None
     return out
+
+
+def _contact_meshes(model, mm) -> list[str]:
+    """The solid meshes of ``[mesh.contact] meshes`` (their nodes are slaves of
+    ``mm``'s faces); a line mesh or ``mm`` itself is a deck error."""
+    kinds = {m.name: m.element for m in model.meshes}
+    where = f"mesh[{mm.index}] '{mm.name}'.contact.meshes"
+    for slave in mm.spec.contact.meshes:
+        if slave == mm.name:
+            raise DeckError([format_problem(where, f"mesh '{slave}' is this mesh: a "
+                                            "mesh does not contact its own faces",
+                                            "name the other mesh that meets these faces")])
+        if kinds[slave] != "solid":
+            raise DeckError([format_problem(where, f"mesh '{slave}' is a line of "
+                                            f"{_PLURAL[kinds[slave]]}, not solid elements",
+                                            "list solid meshes only (a bar inside a solid "
+                                            "mesh: embed)")])
+    return list(mm.spec.contact.meshes)
 
 
 def blast_loads(deck, model, sph_part, meshes: dict, taken: set) -> list:

@@ -28,7 +28,7 @@ from .preflight import (check_meshes_in_domain, checked_lattices, history_models
 from .materials import MaterialGroup, get_model, history_layout
 from .materials.uniaxial import UNIAXIAL, uniaxial_params
 from .mesh_model import MeshModel, build_meshes, mesh_node_set, pressure_faces
-from .watchers.probes import Probe, quantity
+from .watchers.probes import NODE_FIELDS, Probe, node_probe_field, quantity
 from .state import Particles
 
 
@@ -326,10 +326,19 @@ def build_model(deck) -> Model:
     probes = []
     for k, pr in enumerate(deck.probe):
         if pr.set in mesh_sets:
-            raise DeckError([format_problem(
-                f"probe[{k}].set", f"'{pr.set}' is a set of mesh nodes; probes record "
-                "particle sets", "probe a particle set; the reactions of a mesh "
-                "set's [[boundary]] are in the history (<set>_reaction_x|y|z)")])
+            mesh, idx = mesh_sets[pr.set]
+            names = tuple(pr.quantities) if "quantities" in pr.model_fields_set else tuple(
+                q for q in pr.quantities if node_probe_field(q) is not None)
+            probe = Probe(pr.set, idx, names, pr.reduce, mesh=mesh)
+            for q in probe.quantities:
+                if node_probe_field(q) is None:
+                    raise DeckError([format_problem(
+                        f"probe[{k}].quantities", f"'{q}' is not a quantity of mesh "
+                        f"nodes (set '{pr.set}' holds nodes of mesh '{mesh}')",
+                        f"name one of {', '.join(NODE_FIELDS)} or a component (_x, _y, "
+                        "_z); a mesh's stresses and damage are in its frames")])
+            probes.append(probe)
+            continue
         probe = Probe(pr.set, sets[pr.set], tuple(pr.quantities), pr.reduce)
         for q in probe.quantities:
             try:

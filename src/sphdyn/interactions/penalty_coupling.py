@@ -125,6 +125,15 @@ touched a crushed, warped element lightly met the face behind it 2 mm deep
 (a thousand times the force) and the 1000 m/s penetration run took kilojoules
 of spurious work from such jumps.
 
+The slaves may also be the nodes of another solid part (``[mesh.contact]
+meshes``: node-to-surface contact between meshes, LS-DYNA's
+*CONTACT_AUTOMATIC_NODES_TO_SURFACE with that mesh as the slave side). A node
+is treated as a particle of its elements' mean size :math:`h_I`
+(:func:`~sphdyn.parts.fem.solid_part.node_contact_items`, as at a wall): its
+contact thickness is :math:`f_t h_I`, its mass spring takes the smaller of
+the node's and the face point's masses. The contact is one-way: the master
+mesh's nodes do not meet the slave's faces unless that mesh lists it too.
+
 Limitations: one face per particle (at a concave corner of the master
 surface a particle is held out of the nearer face only). With the default
 master surface (all exterior faces) the faces follow erosion: an eroded
@@ -500,8 +509,11 @@ class PenaltyCoupling(InteractionBase):
     name : the interaction's name (history columns ``F_<name>``: total normal
         force on the interface [N] (N/m in 2D), ``contacts_<name>``: number
         of particles in contact).
-    sph_part : the SPH part (its particles are the slaves; ``x, v, m, vol0,
-        rho0, bulk_modulus``).
+    sph_part : the slave part: an SPH part (its particles are the slaves) or
+        another solid part (its nodes are: node-to-surface contact between
+        meshes); its ``p`` holds ``x, v, m, vol0, rho0, bulk_modulus`` (a
+        solid part's nodes have them, with the size of their elements,
+        :func:`~sphdyn.parts.fem.solid_part.node_contact_items`).
     solid_part : the solid part (its nodes carry the master faces).
     faces : (F, 4) quadrilaterals (3D) or (F, 2) segments (2D) of the solid
         part's node ids, oriented outward (:mod:`.penalty_geometry`);

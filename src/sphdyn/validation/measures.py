@@ -79,15 +79,26 @@ def lost_face_diameter(run: Path, mesh: str, face: float, normal: float, h: floa
     return float(2.0 * (r.max() + 0.5 * h))
 
 
+def contact_force(h: dict, mesh: str) -> np.ndarray:
+    """The normal force [N] of a mesh's ``[mesh.contact]`` on everything it
+    meets: ``F_<mesh>_contact`` (the particles) plus ``F_<mesh>_contact_<slave>``
+    of each mesh in its ``meshes`` (their nodes), from a history's columns."""
+    own = f"F_{mesh}_contact"
+    names = [k for k in h if k == own or (k.startswith(own + "_") and not k.endswith("_tie"))]
+    if not names:
+        raise KeyError(f"the history has no contact force of mesh {mesh!r} ({own})")
+    return np.sum([h[k] for k in names], axis=0)
+
+
 def deflection_history(run: Path, midspan: str, impactor: str, axis: str = "z"
                        ) -> tuple[np.ndarray, np.ndarray]:
     """(time after the contact's start [s], deflection [m], positive
     downwards along -``axis``) from the probe ``probe_<midspan>_displacement_<axis>``
-    and the impactor mesh's contact force ``F_<impactor>_contact``: the
+    and the impactor mesh's contact force (:func:`contact_force`): the
     contact starts at the first record where that force is positive;
     records before it are dropped."""
     h = History.from_csv(Path(run) / "history.csv").as_arrays()
-    t, force = h["time"], h[f"F_{impactor}_contact"]
+    t, force = h["time"], contact_force(h, impactor)
     started = np.flatnonzero(force > 0.0)
     if not started.size:
         raise ValueError(f"{run}: the impactor {impactor!r} never touched: no contact force")
@@ -107,13 +118,13 @@ def largest_deflection(run: Path, midspan: str, impactor: str, axis: str = "z"
 def load_deflection(run: Path, loader: str, midspan: str, window: float, axis: str = "z"
                     ) -> tuple[np.ndarray, np.ndarray]:
     """(deflection [m], load [N]) of a quasi-static test: the contact force
-    ``F_<loader>_contact`` and the mid-span probe's displacement (positive
+    of the loading mesh (:func:`contact_force`) and the mid-span probe's displacement (positive
     along -``axis``), each averaged over consecutive windows of ``window``
     [s] of the history's records (a window's mean of the records in it; a
     last partial window is dropped)."""
     h = History.from_csv(Path(run) / "history.csv").as_arrays()
     t = h["time"]
-    force = h[f"F_{loader}_contact"]
+    force = contact_force(h, loader)
     u = -h[f"probe_{midspan}_displacement_{axis}"]
     k = np.floor((t - t[0]) / window).astype(np.int64)
     full = k < k[-1]

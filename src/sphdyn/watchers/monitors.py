@@ -54,7 +54,8 @@ class HistoryRecorder:
 
     def row(self, s, **kw) -> dict:
         rec = s.record(**kw)
-        rec.update(probe_record(s.particles, self.probes))
+        rec.update(probe_record(s.particles, self.probes,
+                                meshes={q.name: q.kin for q in s.parts}))
         return rec
 
     def after_kick(self, s) -> None:

@@ -219,8 +219,20 @@ class Contact(PenaltyKeys):
 
     Particles are slave nodes, the element faces the master surface, which
     follows erosion (the faces an eroded element exposes take part); the
-    debris of [mesh.erosion] meets the mesh through it too.
+    debris of [mesh.erosion] meets the mesh through it too. With ``meshes``
+    the nodes of other solid meshes meet the faces as well (node-to-surface
+    contact between meshes, as LS-DYNA's *CONTACT_AUTOMATIC_NODES_TO_SURFACE
+    with those meshes as the slave side): a drop weight meshed on a meshed
+    beam. A node is a slave as a particle is, with the size of its elements
+    for the contact thickness (``thickness_factor`` times it: the meshes meet
+    that far apart) and the mass spring of the smaller of the node's and the
+    face point's masses.
     """
+
+    meshes: tuple[reference_to("mesh"), ...] = Field(
+        (), description="Solid meshes whose nodes meet this mesh's faces too "
+                        "(node-to-surface contact, the listed meshes as slaves; history "
+                        "columns F_<mesh>_contact_<slave>). Make the finer mesh the slave.")
 
 
 class Convert(PenaltyKeys):

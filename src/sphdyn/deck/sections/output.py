@@ -16,7 +16,8 @@ from ..values import Section, integer, quantity, reference_to
 
 
 class Probe(Section):
-    """[[probe]]: time history of a quantity over a particle set."""
+    """[[probe]]: time history of a quantity over a set of particles or of a
+    mesh's nodes (LS-DYNA's nodout)."""
 
     set: reference_to("set") = Field(description="Name of a [[set]].")
     quantities: tuple[Literal[probe_quantities()], ...] = Field(
@@ -24,9 +25,10 @@ class Probe(Section):
          "velocity_y", "velocity_z", "von_mises"),
         description="Quantities recorded (stress tension positive, pressure "
                     "positive in compression; plastic_strain needs a j2 "
-                    "material).")
+                    "material). Mesh nodes have position, velocity, speed, "
+                    "displacement and mass (the default: without von_mises).")
     reduce: Literal["mean", "min", "max"] = Field(
-        "mean", description="Reduction over the set's particles; history "
+        "mean", description="Reduction over the set's particles or nodes; history "
                             "columns are named probe_<set>_<quantity>.")
 
 
