@@ -193,37 +193,9 @@ def damaged_block(d: Path, t: float = 1e-3) -> str:
     return "(no frame at 1 ms)"
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", type=Path, required=True)
-    ap.add_argument("--runs", type=Path, nargs="*", default=[],
-                    help="other run directories (a case's folder) to measure too")
-    ap.add_argument("--fem", action="store_true",
-                    help="the beam of hexahedra instead (the run fem_section)")
-    args = ap.parse_args()
-    if args.fem:
-        fem(run(args.out, "fem_early"), run(args.out, "fem_section"), args.runs)
-        return
-    early, mid = run(args.out, "early"), run(args.out, "section")
-    for d in [mid, *args.runs]:
-        print(f"{d}: contact {contact(d)}")
-    trace(early)
-    trace(mid)
-    section(mid)
-    from sphdyn.io.frames import list_frames
-
-    for f in list_frames(mid)[4::4]:  # 1 and 2 ms
-        print(f"bars at {f.name}:")
-        bars(f)
-    for d in [mid, *args.runs]:
-        print(f"{d}: damaged at 1 ms {damaged_block(d)}")
-    for d in args.runs:
-        print(f"{d}: resisting force {resisting_force(d)}")
-
-
-def fem(early: Path, mid: Path, runs: list[Path]) -> None:
-    """The beam of hexahedra: contact, the traced element, section, bars,
-    damaged block, resisting force."""
+def report(early: Path, mid: Path, runs: list[Path]) -> None:
+    """Contact, the traced point, section, bars, damaged block and resisting
+    force of the runs ``early`` and ``mid`` (and ``runs``)."""
     from sphdyn.io.frames import list_frames
 
     for d in [mid, *runs]:
@@ -238,6 +210,18 @@ def fem(early: Path, mid: Path, runs: list[Path]) -> None:
         print(f"{d}: damaged at 1 ms {damaged_block(d)}")
     for d in runs:
         print(f"{d}: resisting force {resisting_force(d)}")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", type=Path, required=True)
+    ap.add_argument("--runs", type=Path, nargs="*", default=[],
+                    help="other run directories (a case's folder) to measure too")
+    ap.add_argument("--fem", action="store_true",
+                    help="the beam of hexahedra instead (the runs fem_early, fem_section)")
+    args = ap.parse_args()
+    prefix = "fem_" if args.fem else ""
+    report(run(args.out, prefix + "early"), run(args.out, prefix + "section"), args.runs)
 
 
 if __name__ == "__main__":
