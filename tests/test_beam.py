@@ -559,3 +559,13 @@ def test_checkpoint_continues_bitwise():
     assert np.array_equal(t.points.hist, t2.points.hist)
     assert s.record() == s2.record()
     assert t.points.hist[:, 0].max() > 0.0  # the truss yielded
+
+
+def test_a_beam_needs_a_linear_elastic_material_and_a_truss_does_not():
+    """Beams are resultant beams: a material model without the registry's
+    ``linear_elastic`` flag (j2) is refused for a beam, naming the model and
+    the truss instead; the same j2 bar as a truss is built."""
+    j2 = ("j2", dict(STEEL, yield_stress=355e6))
+    with pytest.raises(ValueError, match="'j2' is not 'elastic' \\(use a truss\\)"):
+        straight(4, 1.0, BeamSection.circle(0.01), material=j2)
+    assert straight(4, 1.0, BeamSection.circle(0.01), element="truss", material=j2).kin.n == 5

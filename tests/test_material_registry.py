@@ -140,3 +140,17 @@ def test_schema_must_name_its_model():
     with pytest.raises(ValueError, match="Literal\\['other'\\]"):
         registry.register(MaterialModel("other", (), ELASTIC.pack, ELASTIC.update,
                                         schema=ElasticParams))
+
+
+def test_the_built_in_models_say_what_they_allow():
+    """The flags that replace material-name checks outside ``materials/``:
+    only the elastic model forms beam resultants, elastic and j2 scale their
+    stress with their stress parameters (a split sublayer bar), only the high
+    explosive is lit by a detonation; CSCM is none of these."""
+    from sphdyn.materials import get_model
+
+    flags = {name: (get_model(name).linear_elastic, get_model(name).stress_scalable,
+                    get_model(name).explosive)
+             for name in ("elastic", "j2", "high_explosive", "cscm")}
+    assert flags == {"elastic": (True, True, False), "j2": (False, True, False),
+                     "high_explosive": (False, False, True), "cscm": (False, False, False)}

@@ -54,7 +54,7 @@ def light_explosives(deck, particles, groups) -> None:
     if not dets:
         return
     spacing = particles.vol0 ** (1.0 / particles.dim)
-    he = {g.material for g in groups if g.model.name == "high_explosive"}
+    he = {g.material for g in groups if g.model.explosive}
     for k, d in enumerate(dets):
         mats = he if d.material is None else {
             next(i for i, m in enumerate(deck.material) if m.name == d.material)}
@@ -67,7 +67,7 @@ def light_explosives(deck, particles, groups) -> None:
                 f"detonation[{k}].point", f"{list(d.point)} is not in the charge "
                 f"({names}){near}", "place the point inside the explosive's body")])
     for g in groups:
-        if g.model.name != "high_explosive" or not lit(g.params) or not g.idx.size:
+        if not g.model.explosive or not lit(g.params) or not g.idx.size:
             continue
         name = deck.material[g.material].name
         ks = [k for k, d in enumerate(dets) if d.material in (None, name)]

@@ -71,7 +71,7 @@ def mesh_part(deck, mm: MeshModel):
                 values = dict(mat.values())
             values["density"] *= keep
             params = model.pack(values)
-        if mm.element == "beam" and model.name != "elastic":
+        if mm.element == "beam" and not model.linear_elastic:
             raise DeckError([format_problem(
                 f"mesh[{mm.index}] '{mm.name}'.material", f"beams are elastic resultant "
                 f"beams; material model '{model.name}' is not elastic",

@@ -25,7 +25,7 @@ from .deck.errors import format_problem
 from .detonation import light_explosives
 from .preflight import (check_meshes_in_domain, checked_lattices, history_models,
                         support_radius)
-from .materials import MaterialGroup, get_model, history_layout
+from .materials import MaterialGroup, available_models, get_model, history_layout
 from .materials.uniaxial import UNIAXIAL, uniaxial_params
 from .mesh_model import MeshModel, build_meshes, mesh_node_set, pressure_faces
 from .watchers.probes import NODE_FIELDS, Probe, node_probe_field, quantity
@@ -477,11 +477,6 @@ def _seat_sublayers(deck, meshes, particles: Particles, body_names: list[str]) -
         particles.vol0[rows] = particles.m[rows] / rho
 
 
-#: bar materials whose stress is homogeneous of degree one in their stress
-#: parameters, so that [mesh.sublayer] stiffness = "split" can scale them
-SPLIT_MODELS = ("elastic", "j2")
-
-
 def _sublayer_groups(deck, meshes, particles: Particles, body_names: list[str],
                      groups: list, models: dict, first: dict) -> list:
     r"""The material groups with each bar's sublayer particles as its
@@ -510,12 +505,14 @@ def _sublayer_groups(deck, meshes, particles: Particles, body_names: list[str],
             k = int(mm.mat[0])
             mat = deck.material[k]
             model = models[mat.name]
-            if model.name not in SPLIT_MODELS:
+            if not model.stress_scalable:
+                split = " or ".join(m for m in available_models()
+                                    if get_model(m).stress_scalable)
                 raise DeckError([format_problem(
                     f"mesh[{mm.index}] '{mm.name}'.sublayer.stiffness",
                     f"\"{stiffness}\" scales the bar material's stresses, which model "
                     f"'{model.name}' does not allow", "use a bar material of model "
-                    f"{' or '.join(SPLIT_MODELS)}, or stiffness = \"material\" or \"none\"")])
+                    f"{split}, or stiffness = \"material\" or \"none\"")])
             ratio = float(particles.rho0[rows[0]]) / mat.density
             values = mat.stress_scaled(ratio)
             if not all(np.isfinite(v) for v in values.values() if isinstance(v, float)):

@@ -22,6 +22,7 @@ from typing import Annotated, Union
 
 from pydantic import BeforeValidator, Field, create_model, model_validator
 
+from ..materials import get_model
 from .introspect import field_annotation, metadata, strip_optional, variants
 from .scope import SCOPE, scope_of
 from .sections.bodies import Body, Crack, MassField, Mesostructure, Variation
@@ -138,7 +139,7 @@ class DeckSections(Section):
     def _explosives_lit(self):
         """Every detonation lights a high explosive; every explosive with a
         programmed burn has a detonation that lights it."""
-        he = [m.name for m in self.material if m.model == "high_explosive"]
+        he = [m.name for m in self.material if get_model(m.model).explosive]
         for k, d in enumerate(self.detonation):
             if d.material is not None and d.material not in he:
                 raise problem(f"detonation[{k}].material '{d.material}' is not a high "
@@ -149,7 +150,7 @@ class DeckSections(Section):
                           "add a material with model = \"high_explosive\", or remove "
                           "the [[detonation]] tables")
         for k, m in enumerate(self.material):
-            if m.model != "high_explosive" or m.burn == "beta":
+            if not get_model(m.model).explosive or m.burn == "beta":
                 continue
             if not any(d.material in (None, m.name) for d in self.detonation):
                 raise problem(f"material[{k}] '{m.name}' has a programmed burn but no "

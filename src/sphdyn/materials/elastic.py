@@ -157,4 +157,6 @@ ELASTIC = register(MaterialModel(
     update=elastic_update,
     schema=ElasticParams,
     initial_stress=True,
+    linear_elastic=True,
+    stress_scalable=True,
 ))

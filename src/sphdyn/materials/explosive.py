@@ -246,6 +246,7 @@ HIGH_EXPLOSIVE = register(MaterialModel(
     schema=ExplosiveParams,
     history_init=lambda params: np.array([0.0, UNLIT]),
     fluid=True,
+    explosive=True,
     released_energy=released_chemical_energy,
 ))
 

@@ -173,4 +173,5 @@ J2 = register(MaterialModel(
     update=j2_update,
     schema=J2Params,
     initial_stress=True,
+    stress_scalable=True,
 ))

@@ -136,6 +136,19 @@ class MaterialModel:
         A fluid (gas, detonation products): no shear stiffness, and its
         particles' time step includes the artificial viscosity's signal
         speed (:func:`sphdyn.integrate.cfl_time_step`).
+    linear_elastic : bool
+        Stress linear in strain with the moduli K and G and nothing else:
+        a beam's stress resultants (:class:`~sphdyn.parts.fem.line_part.LinePart`)
+        can be formed from it.
+    stress_scalable : bool
+        Its stress is homogeneous of degree one in its stress parameters
+        (moduli, strengths), so scaling those scales the stress: a bar of it
+        can share its stiffness between its elements and its sublayer
+        particles (``[mesh.sublayer] stiffness = "split"``,
+        :func:`sphdyn.model.build_model`).
+    explosive : bool
+        A high explosive: the material a ``[[detonation]]`` lights
+        (:mod:`sphdyn.detonation`).
     initial_state : callable or None
         ``initial_state(params) -> (e0, p0)``: the specific internal energy
         [J/kg] and pressure [Pa] of the material at rest at its initial
@@ -161,6 +174,9 @@ class MaterialModel:
     has_damage: bool = False
     softening: bool = False
     fluid: bool = False
+    linear_elastic: bool = False
+    stress_scalable: bool = False
+    explosive: bool = False
     initial_state: Callable[[np.ndarray], tuple[float, float]] | None = None
     released_energy: Callable[[np.ndarray, np.ndarray, np.ndarray], float] | None = None
     modulus: Callable[[np.ndarray], float] | None = None

@@ -195,7 +195,7 @@ class LinePart:
         self.model = get_model(model) if isinstance(model, str) else model
         self.params = (self.model.pack(params) if isinstance(params, dict)
                        else np.asarray(params, np.float64))
-        if self.beam and self.model.name != "elastic":
+        if self.beam and not self.model.linear_elastic:
             raise ValueError(f"beams are elastic resultant beams; material model "
                              f"{self.model.name!r} is not 'elastic' (use a truss)")
         rho = self.model.density(self.params)
