@@ -33,7 +33,8 @@ P_RETRACT = _NEXT + 10   # 1.0: the cap retracts with dilation (ITRETRC = 1)
 P_RATE_R0 = _NEXT + 11   # 1.0: damage thresholds raised by the rate factor (with IRATE)
 P_WAVE_UNDAMAGED = _NEXT + 12  # 1.0: wave speed from the undamaged moduli
 P_R0_ELASTIC = _NEXT + 13  # derived: sqrt(J2') below which J1 >= 0 is surely elastic
-N_PARAMS = _NEXT + 14
+P_GROW_ON_LOADING = _NEXT + 14  # 1.0: damage grows only while its variable tau grows
+N_PARAMS = _NEXT + 15
 
 HISTORY_NAMES = (
     "kappa", "plastic_vol_strain", "damage_brittle", "damage_ductile",

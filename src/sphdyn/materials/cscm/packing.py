@@ -17,9 +17,9 @@ from ..base import P_G, P_K, get_float
 from ..registry import schema_defaults
 from .defaults import PARAM_NAMES, default_parameters
 from .layout import (H_KAPPA, H_RF, H_RFMAX, HISTORY_NAMES, N_PARAMS, P_DMAX_POWER,
-                     P_ERODE, P_ERODE_STRAIN, P_INCRE, P_IRATE, P_J1APEX, P_KAPPA0,
-                     P_LI2B, P_R0_ELASTIC, P_RATE_R0, P_RECOV, P_RECOV_VOL, P_RETRACT,
-                     P_WAVE_UNDAMAGED, PARAM_INDEX)
+                     P_ERODE, P_ERODE_STRAIN, P_GROW_ON_LOADING, P_INCRE, P_IRATE,
+                     P_J1APEX, P_KAPPA0, P_LI2B, P_R0_ELASTIC, P_RATE_R0, P_RECOV,
+                     P_RECOV_VOL, P_RETRACT, P_WAVE_UNDAMAGED, PARAM_INDEX)
 from .schema import CscmParams
 from .surface import elastic_radius_bound, kappa_from_cap, shear_surface
 
@@ -73,7 +73,8 @@ def cscm_parameters(values: dict) -> dict:
     pressure, or [10, 11]: option 2 = RECOV - 10 on the signs of pressure
     and volume strain), ``cap_retraction`` (ITRETRC), ``rate_thresholds``
     (with rate effects the damage thresholds scale with the dynamic
-    strength ratio, choice [D]), ``wave_speed`` ("damaged" or "undamaged").
+    strength ratio, choice [D]), ``wave_speed`` ("damaged" or "undamaged"),
+    ``damage_growth`` ("state" or "loading").
     An absent key takes the default of the deck table
     :class:`~sphdyn.materials.cscm.schema.CscmParams`. Two keys the
     deck does not offer: ``incre`` (sub-increment strain limit, default from
@@ -98,6 +99,10 @@ def cscm_parameters(values: dict) -> dict:
     if out["wave_speed"] not in ("damaged", "undamaged"):
         raise ValueError("material parameter 'wave_speed' must be \"damaged\" or "
                          f"\"undamaged\", got {out['wave_speed']!r}")
+    out["damage_growth"] = values.get("damage_growth", default["damage_growth"])
+    if out["damage_growth"] not in ("state", "loading"):
+        raise ValueError("material parameter 'damage_growth' must be \"state\" or "
+                         f"\"loading\", got {out['damage_growth']!r}")
     out["erode_strain"] = get_float(values, "erode_strain",
                                     default=default["erode_strain"], min_value=0.0)
     recov = get_float(values, "recovery", default=default["recovery"], min_value=0.0,
@@ -121,7 +126,8 @@ def pack_cscm(values: dict) -> np.ndarray:
 
     Layout ``[density, K, G] + PARAM_NAMES + [irate, erode, erode_strain,
     recovery, incre, dmax_power, kappa0, J1_apex, Li2(-B), recovery_mode,
-    cap_retraction, rate_thresholds, wave_speed_undamaged]``. The default
+    cap_retraction, rate_thresholds, wave_speed_undamaged, r0_elastic,
+    grow_on_loading]``. The default
     sub-increment limit is ``incre = 0.25 (alpha - lamda) / (2 G)``, a quarter
     of the tensor shear strain at which the TXC surface is reached at zero
     pressure (LS-DYNA's INCRE default formula is not known, notes sec. 1.3:
@@ -140,6 +146,7 @@ def pack_cscm(values: dict) -> np.ndarray:
     p[P_RETRACT] = 1.0 if v["cap_retraction"] else 0.0
     p[P_RATE_R0] = 1.0 if v["rate_thresholds"] else 0.0
     p[P_WAVE_UNDAMAGED] = 1.0 if v["wave_speed"] == "undamaged" else 0.0
+    p[P_GROW_ON_LOADING] = 1.0 if v["damage_growth"] == "loading" else 0.0
     p[P_DMAX_POWER] = v["dmax_power"]
     p[P_INCRE] = v.get("incre", 0.25 * (v["alpha"] - v["lamda"]) / (2.0 * v["G"]))
     p[P_J1APEX] = _apex(p)

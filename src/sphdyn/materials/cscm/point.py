@@ -18,8 +18,8 @@ from .damage import (DMAX, brittle_softening_c, ductile_softening_a, logistic_da
 from .layout import (H_DB, H_DD, H_EPS, H_ERODED, H_EV, H_KAPPA, H_R0C, H_R0T, H_RATE,
                      H_RF, H_RFMAX, H_SVP, H_TC, H_TT, P_ALPHA, P_BB, P_DD,
                      P_DMAX_POWER, P_ERODE, P_ERODE_STRAIN, P_ETA0C, P_ETA0T, P_GFC,
-                     P_GFS, P_GFT, P_INCRE, P_IRATE, P_J1APEX, P_LI2B, P_NC, P_NT,
-                     P_OVERC, P_OVERT, P_PWRC, P_PWRT, P_RATE_R0, P_RECOV,
+                     P_GFS, P_GFT, P_GROW_ON_LOADING, P_INCRE, P_IRATE, P_J1APEX, P_LI2B,
+                     P_NC, P_NT, P_OVERC, P_OVERT, P_PWRC, P_PWRT, P_RATE_R0, P_RECOV,
                      P_RECOV_VOL, P_REPOW, P_RETRACT, P_SRATE, P_WAVE_UNDAMAGED)
 from .projection import project_from_trial, yield_fraction
 from .surface import (cap_from_compaction, invariants, j1_radius, kappa_from_cap, meridian,
@@ -203,6 +203,10 @@ def cscm_point(h, deps, dt, p, size):
             # viscoplastic (dynamic) strength; never decreasing, like a
             # damage threshold. In uniaxial stress tau = rf r0 at the dynamic
             # peak for both tau_t = sqrt(E) eps and tau_c = sqrt(s:eps/2).
+            # damage_growth (docs/cscm.md): "state" (0) evaluates the damage at
+            # every step past the threshold, "loading" (1) only in a step that
+            # raises tau past its largest value so far
+            on_loading = p[P_GROW_ON_LOADING]
             rscale = 1.0
             if irate and p[P_RATE_R0] > 0.0:
                 if rf > h[H_RFMAX]:
@@ -210,12 +214,14 @@ def cscm_point(h, deps, dt, p, size):
                 rscale = h[H_RFMAX]
             if J1v < 0.0 and h[H_R0T] > 0.0:
                 sqrt_e = math.sqrt(E)
+                grew = False
                 if sqrt_e * max_principal_bound(eps) > h[H_TT]:
                     tau = sqrt_e * max(max_principal(eps), 0.0)
                     if tau > h[H_TT]:
                         h[H_TT] = tau
+                        grew = True
                 r0 = h[H_R0T] * rscale
-                if h[H_TT] > r0:
+                if h[H_TT] > r0 and (grew or on_loading == 0.0):
                     tr = transition(J1v, rv, p[P_PWRT])
                     gf = (p[P_GFS] + tr * (p[P_GFT] - p[P_GFS])) * damage_scale(rf, irate, p)
                     cc = brittle_softening_c(r0, size, gf, p[P_DD])
@@ -224,10 +230,11 @@ def cscm_point(h, deps, dt, p, size):
                         h[H_DB] = db
             elif J1v >= 0.0 and h[H_R0C] > 0.0:
                 tau = math.sqrt(max(0.5 * ddot6(svp, eps), 0.0))
-                if tau > h[H_TC]:
+                grew = tau > h[H_TC]
+                if grew:
                     h[H_TC] = tau
                 r0 = h[H_R0C] * rscale
-                if h[H_TC] > r0:
+                if h[H_TC] > r0 and (grew or on_loading == 0.0):
                     tr = transition(J1v, rv, p[P_PWRC])
                     gf = (p[P_GFS] + tr * (p[P_GFC] - p[P_GFS])) * damage_scale(rf, irate, p)
                     aa = ductile_softening_a(r0, size, gf, p[P_BB], p[P_LI2B])

@@ -148,6 +148,16 @@ class CscmParams(MaterialSection):
                            "the dynamic strength ratio (docs/cscm.md, choice "
                            "[D]). Not part of MAT_159, so off by default; the "
                            "decks that switch it on mark it as calibrated.")
+    damage_growth: Literal["state", "loading"] = Field(
+        "state", description="When the damage is evaluated: state: at every step, "
+                             "as the logistic function of the largest tau so far "
+                             "with the softening rate of the current stress state "
+                             "and rate factor (kept if larger), so it can grow "
+                             "while the point unloads; loading: only in a step "
+                             "that raises tau past its largest value so far, the "
+                             "loading condition of strain-driven damage. Which "
+                             "one LS-DYNA's MAT_159 uses is not known "
+                             "(docs/cscm.md).")
     wave_speed: Literal["damaged", "undamaged"] = Field(
         "damaged", description="Wave speed of the time step and of the "
                                "viscosities (artificial, bulk, hourglass): "
