@@ -99,7 +99,7 @@ def page_block(results: list[dict], root: Path, figures: dict[str, str]) -> str:
     for res in results:
         secs = res.get("wall_seconds")
         lines.append(f"* `{res['case']}`: {res['deck']}, {res.get('items')} particles and "
-                     f"elements, {res.get('steps')} steps, "
+                     f"mesh nodes, {res.get('steps')} steps, "
                      + (f"{secs / 60:.1f} min, " if secs else "") + f"status {res['status']}"
                      + (f" ({res['diagnosis']})" if res.get("diagnosis") else "") + ".")
     lines += ["", table_markdown(results), "", "Where the measured values come from:", "",
