@@ -23,7 +23,7 @@
     ``examples/NAME.toml``.
 
   Usage synopses are not commands: spans with placeholders (``DECK``, ``DIR``,
-  ``N``, ``<seed>``), optional parts (``[...]``) or elisions (``...``), and bare
+  ``N``, ``<seed>``, ``OUT/case``), optional parts (``[...]``) or elisions (``...``), and bare
   command names (```sphdyn ucs```). Anything else that cannot run here is in
   :data:`SKIP`, with the reason.
 """
@@ -85,7 +85,7 @@ FRAGMENT_HOSTS = {
 }
 
 _FENCE = re.compile(r"^```(\w*)\n(.*?)^```", re.S | re.M)
-_PLACEHOLDER = re.compile(r"(^|[\s=,/])([A-Z][A-Z0-9_]*)([\s,.\]]|$)|<\w+>|\.\.\.|\[|\|")
+_PLACEHOLDER = re.compile(r"(^|[\s=,/])([A-Z][A-Z0-9_]*)([\s,.\]/]|$)|<\w+>|\.\.\.|\[|\|")
 
 
 # -------------------------------------------------------------------- extraction
@@ -252,6 +252,9 @@ def test_the_documents_show_decks_and_commands():
     assert any(c.startswith("sphdyn ucs out/ucs_mesostructure-ensemble/sample_*")
                for c in commands)
     assert not any("DECK" in c for c in commands if c not in SKIP)
+    # a placeholder directory with a real case under it is a synopsis too
+    assert _is_synopsis("sphdyn restart OUT/lozano2017_dropweight_5.0m --t-end 11ms")
+    assert not _is_synopsis("sphdyn plot out/disc_impact --snapshots damage")
     assert set(SKIP) <= set(commands), "SKIP lists commands the documents no longer show"
 
 
