@@ -11,9 +11,11 @@ run: the share of particles with damage > 0.9 and > 0.5 at 100 and 200 us
 (the last frame at or before each time), the peak wall force (summary.json)
 and the top's velocity at 200 us (the ``top`` probe, the deck's last history
 row: positive = rebound). The table goes into docs/validation.md,
-"Calibrated parameters".
+"Calibrated parameters". ``--set KEY=VALUE`` (repeatable) adds an override to
+every run, e.g. ``--set material.concrete.damage_growth=loading`` for the
+three runs with the damage formed only on loading (docs/cscm.md, 3a).
 
-    PYTHONPATH=src python studies/calibration_disc.py [--out DIR]
+    PYTHONPATH=src python studies/calibration_disc.py [--out DIR] [--set KEY=VALUE]
 """
 
 from __future__ import annotations
@@ -75,9 +77,11 @@ def run(label: str, overrides: list[str], base: Path) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="out/calibration_disc")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="an override added to every run")
     args = ap.parse_args(argv)
     base = Path(args.out)
-    rows = [run(label, o, base) for label, o in RUNS.items()]
+    rows = [run(label, o + args.set, base) for label, o in RUNS.items()]
     print("| run | d>0.9, 100 us | d>0.5, 100 us | d>0.9, 200 us | d>0.5, 200 us "
           "| peak wall force [kN] | top velocity at 200 us [m/s] |")
     print("|---|---|---|---|---|---|---|")

@@ -154,3 +154,19 @@ def test_the_built_in_models_say_what_they_allow():
              for name in ("elastic", "j2", "high_explosive", "cscm")}
     assert flags == {"elastic": (True, True, False), "j2": (False, True, False),
                      "high_explosive": (False, False, True), "cscm": (False, False, False)}
+
+
+def test_the_material_test_takes_the_models_typical_density():
+    """``sphdyn material-test`` without a density gives a solid its model's
+    ``test_density`` (concrete 2400, steel 7850) and a fluid none: the
+    explosive keeps its preset's (TNT 1630 kg/m^3), a gas must be given one."""
+    from sphdyn.cli import _test_density
+    from sphdyn.materials import get_model
+
+    assert {name: get_model(name).test_density
+            for name in ("elastic", "j2", "cscm", "gas", "high_explosive")} == {
+        "elastic": 2400.0, "j2": 7850.0, "cscm": 2400.0, "gas": None,
+        "high_explosive": None}
+    assert _test_density("j2", {}) == 7850.0
+    assert _test_density("j2", {"density": 7800.0}) is None  # the user's stands
+    assert _test_density("high_explosive", {"preset": "tnt"}) is None

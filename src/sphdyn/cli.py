@@ -376,14 +376,6 @@ def cmd_bench(args) -> int:
     return 0
 
 
-#: Density [kg/m^3] a material test assumes when none is given: a material
-#: point driven by strain has a stress independent of its density (it sets
-#: only the wave speed), so the test needs none; normal-weight concrete, or
-#: steel for the J2 metal. Fluids (gas, explosives) still need theirs.
-MATERIAL_TEST_DENSITY = {"j2": 7850.0}
-MATERIAL_TEST_DENSITY_DEFAULT = 2400.0
-
-
 def _param_value(text: str):
     """``true``/``false`` -> bool, a number -> float (SI units), else the text
     (a word such as ``linear_polynomial``, or a quantity with units, which
@@ -436,16 +428,14 @@ def _material_params(name: str, params: dict, given: dict | None = None) -> dict
 
 
 def _test_density(name: str, params: dict) -> float | None:
-    """The material test's density (:data:`MATERIAL_TEST_DENSITY`) when
-    ``params`` give none and the model is a solid (a fluid's state needs its
-    own), else None."""
+    """The material test's density when ``params`` give none: the model's
+    ``test_density`` (:class:`~sphdyn.materials.registry.MaterialModel`;
+    None for a fluid, whose state needs its own), else None."""
     from .materials import available_models, get_model
 
     if "density" in params or name not in available_models():
         return None
-    if get_model(name).initial_state is not None:  # a gas or explosive
-        return None
-    return MATERIAL_TEST_DENSITY.get(name, MATERIAL_TEST_DENSITY_DEFAULT)
+    return get_model(name).test_density
 
 
 def cmd_material_test(args) -> int:

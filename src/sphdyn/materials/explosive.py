@@ -247,6 +247,7 @@ HIGH_EXPLOSIVE = register(MaterialModel(
     history_init=lambda params: np.array([0.0, UNLIT]),
     fluid=True,
     explosive=True,
+    test_density=None,
     released_energy=released_chemical_energy,
 ))
 

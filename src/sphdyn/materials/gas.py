@@ -154,6 +154,7 @@ GAS = register(MaterialModel(
     schema=GasParams,
     fluid=True,
     initial_state=initial_gas_state,
+    test_density=None,
 ))
 
 __all__ = ["GAS", "GasParams", "gas_update", "initial_gas_state", "pack_gas"]

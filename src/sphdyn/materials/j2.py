@@ -174,4 +174,5 @@ J2 = register(MaterialModel(
     schema=J2Params,
     initial_stress=True,
     stress_scalable=True,
+    test_density=7850.0,
 ))

@@ -149,6 +149,13 @@ class MaterialModel:
     explosive : bool
         A high explosive: the material a ``[[detonation]]`` lights
         (:mod:`sphdyn.detonation`).
+    test_density : float or None
+        The density [kg/m^3] ``sphdyn material-test`` gives a point of the
+        model when the user gives none: a point driven by strain has a
+        stress independent of its density (it sets only the wave speed), so
+        a typical one of the material class serves (normal-weight concrete
+        2400, steel 7850). None: the test needs the user's (fluids, whose
+        state depends on it).
     initial_state : callable or None
         ``initial_state(params) -> (e0, p0)``: the specific internal energy
         [J/kg] and pressure [Pa] of the material at rest at its initial
@@ -177,6 +184,7 @@ class MaterialModel:
     linear_elastic: bool = False
     stress_scalable: bool = False
     explosive: bool = False
+    test_density: float | None = 2400.0
     initial_state: Callable[[np.ndarray], tuple[float, float]] | None = None
     released_energy: Callable[[np.ndarray, np.ndarray, np.ndarray], float] | None = None
     modulus: Callable[[np.ndarray], float] | None = None
