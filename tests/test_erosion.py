@@ -705,6 +705,10 @@ def test_debris_inherits_no_contact_force_and_the_contact_moves_to_the_new_surfa
 
 @pytest.mark.parametrize("last, d_last, speed, allowed", [
     ("top", 2e-4, 300.0, 0.0),       # the same face: no switch, no allowance
+    # the same face 3 mm nearer with no motion (an element turned over under
+    # it): beyond half the 2 mm thickness, all allowed
+    ("top", -2e-3, 0.0, 1e-3),
+    ("top", 1e-4, 0.0, 0.0),         # the same face 0.9 mm nearer, less than the half: none
     ("side", 2e-4, 300.0, 5e-4),     # a switch: 1 mm deep, 0.2 + 0.3 by motion: 0.5 allowed
     ("side", 2e-4, 900.0, 0.0),      # the motion (0.9 mm) can take it there: none
     ("none", 2e-4, 0.0, 0.0),        # faced nothing before (far): no check
@@ -716,7 +720,8 @@ def test_a_switch_of_face_allows_what_the_motion_cannot_explain(last, d_last, sp
     at signed depth ``d_last`` (0.2 mm). At a switch of face the spring's
     extension grows by at most the approach the motion allows, |v_r| dt: the
     allowance takes the excess, 1 - 0.2 - 0.3 = 0.5 mm at 300 m/s, none at
-    900 m/s; the acceleration is then alpha (1 mm - allowance) / dt^2 (paper
+    900 m/s; on the same face only an excess beyond half the thickness (a
+    face turned over, ``JUMP_FRACTION``); the acceleration is then alpha (1 mm - allowance) / dt^2 (paper
     eq. 8, the particle lighter than the face). 1e-9: round-off."""
     solid, sph, cp = _cube_and_particle([0.005, 0.005, 0.01 + 0.002 - 0.001], 1e-5,
                                         0.004 ** 3, 0.006)
