@@ -70,15 +70,18 @@ def run_dir(runs: Path, dx_mm: float) -> Path:
     return runs / f"dx_{dx_mm:.3f}mm"
 
 
-def run_one(dx_mm: float, out: Path, threads: int) -> None:
+def run_one(dx_mm: float, out: Path, threads: int, sets: tuple[str, ...] = ()) -> None:
     """``sphdyn run`` of the main deck at spacing ``dx_mm`` into ``out`` (the
-    frames also hold the particle masses; no VTK copy)."""
+    frames also hold the particle masses; no VTK copy), with the user's
+    ``sets`` (``KEY=VALUE`` overrides) after the study's own."""
     cmd = [sys.executable, "-m", "sphdyn", "run", str(DECK), "--out", str(out),
            "--threads", str(threads), "-q",
            "--set", f"body.disc.dx={dx_mm * 1e-3!r}",
            "--set", f"run.t_end={T_END!r}",
            "--set", "output.vtk=false",
            "--set", 'output.fields=["velocity","damage","density","mass"]']
+    for kv in sets:
+        cmd += ["--set", kv]
     subprocess.run(cmd, check=True, env=os.environ.copy())
 
 
@@ -289,6 +292,9 @@ def main(argv=None) -> None:
     ap.add_argument("--reuse", action="store_true", help="keep completed runs in --runs")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--out", type=Path, default=FIGURES, help="directory of the CSV and PNG")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="a deck override added to every run (e.g. "
+                         "material.concrete.damage_growth=state)")
     args = ap.parse_args(argv)
     spacings = sorted((float(d) for d in args.dx.split(",")), reverse=True)
     results = []
@@ -297,7 +303,7 @@ def main(argv=None) -> None:
         done = (out / "summary.json").exists() and \
             json.loads((out / "summary.json").read_text())["status"] == "completed"
         if not (args.reuse and done):
-            run_one(dx_mm, out, args.threads)
+            run_one(dx_mm, out, args.threads, tuple(args.set))
         results.append(measure(out, dx_mm))
         r = results[-1]
         print(f"  dx = {dx_mm:.3g} mm: {r['particles']} particles, {r['steps']} steps, "

@@ -806,8 +806,8 @@ def test_deck_keys_reach_the_parameters():
     with pytest.raises(DeckError, match="wave_speed"):
         loads_deck(base.replace('model = "cscm"', 'model = "cscm"\nwave_speed = "elastic"'))
     g = build_model(loads_deck(base.replace('model = "cscm"', 'model = "cscm"\n'
-                                            'damage_growth = "loading"'))).groups[0]
-    assert g.params[mod.P_GROW_ON_LOADING] == 1.0 and g0.params[mod.P_GROW_ON_LOADING] == 0.0
+                                            'damage_growth = "state"'))).groups[0]
+    assert g.params[mod.P_GROW_ON_LOADING] == 0.0 and g0.params[mod.P_GROW_ON_LOADING] == 1.0
     with pytest.raises(DeckError, match="damage_growth"):
         loads_deck(base.replace('model = "cscm"', 'model = "cscm"\ndamage_growth = "always"'))
 
@@ -819,7 +819,7 @@ def test_damage_growth_on_loading_only_keeps_the_damage_in_unloading():
     axial stress falls to a few MPa of tension while the lateral stress
     stays near -40 MPa, so |J1| / sqrt(3 J2') falls towards the shear
     side): tau_c never passes its largest value again in either. With
-    "loading" the damage is exactly what it was; with "state" (the default)
+    "loading" (the default) the damage is exactly what it was; with "state"
     it is evaluated at every step with the softening rate of the current,
     more shear-like state and grows while the point unloads (by 0.03 here;
     at least 0.01 asked). The loaded states are identical."""
@@ -842,3 +842,5 @@ def test_damage_growth_on_loading_only_keeps_the_damage_in_unloading():
     assert out["state"][1] > out["state"][0] + 0.01
     with pytest.raises(ValueError, match="damage_growth"):
         packed(damage_growth="always")
+    # the default is the loading condition (docs/cscm.md, 3a)
+    assert packed()[cscm.P_GROW_ON_LOADING] == 1.0

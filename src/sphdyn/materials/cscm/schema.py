@@ -149,15 +149,17 @@ class CscmParams(MaterialSection):
                            "[D]). Not part of MAT_159, so off by default; the "
                            "decks that switch it on mark it as calibrated.")
     damage_growth: Literal["state", "loading"] = Field(
-        "state", description="When the damage is evaluated: state: at every step, "
-                             "as the logistic function of the largest tau so far "
-                             "with the softening rate of the current stress state "
-                             "and rate factor (kept if larger), so it can grow "
-                             "while the point unloads; loading: only in a step "
-                             "that raises tau past its largest value so far, the "
-                             "loading condition of strain-driven damage. Which "
-                             "one LS-DYNA's MAT_159 uses is not known "
-                             "(docs/cscm.md).")
+        "loading", description="When the damage is formed: loading (the "
+                               "default): only in a step that raises tau past "
+                               "its largest value so far, the loading condition "
+                               "of strain-driven damage (Simo and Ju 1987); "
+                               "state: at every step, as the logistic function "
+                               "of the largest tau so far with the softening "
+                               "rate of the current stress state and rate "
+                               "factor (kept if larger), so it can grow while "
+                               "the point unloads (sphdyn's rule before "
+                               "2026-11-29). Which one LS-DYNA's MAT_159 uses "
+                               "is not known (docs/cscm.md, 3a).")
     wave_speed: Literal["damaged", "undamaged"] = Field(
         "damaged", description="Wave speed of the time step and of the "
                                "viscosities (artificial, bulk, hourglass): "
