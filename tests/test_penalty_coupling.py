@@ -458,10 +458,12 @@ def test_a_particle_behind_a_faces_edge_keeps_its_allowance():
     face = faces_on_nodes(exterior_faces(solid.el.conn), nodes)
     assert face.shape == (1, 4)
     sph, solid, cp, alpha, force = _pressed_particle(faces=face)
-    cp.pen0[0], cp.last_face[0], cp.d_last[0] = 3e-4, 0, 3.5e-4
+    # (its last depth 0.5 mm: back at 0.7 it is 0.2 mm deeper, less than the half
+    # thickness a same-face leap needs to count as geometry)
+    cp.pen0[0], cp.last_face[0], cp.d_last[0] = 3e-4, 0, 5e-4
     # 0.7 mm into the face's plane (thickness 0.5): the particle's centre 0.2 mm below it
     assert force([0.0025, 0.001, 0.004], 7e-4, 0.0, dt) == 0.0
-    assert (cp.pen0[0], cp.last_face[0], cp.d_last[0], cp.k_last[0]) == (3e-4, 0, 3.5e-4, 0.0)
+    assert (cp.pen0[0], cp.last_face[0], cp.d_last[0], cp.k_last[0]) == (3e-4, 0, 5e-4, 0.0)
     assert not sph.p.a_ext[0].any()
     f = force([0.0015, 0.001, 0.004], 7e-4, 0.0, dt)
     k = alpha * sph.p.m[0] / dt ** 2
