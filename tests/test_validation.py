@@ -424,3 +424,22 @@ def test_contact_force_sums_the_particles_and_the_meshes_a_mesh_meets():
     assert contact_force(h, "rod").tolist() == [0.0, 10.0, 0.0]
     with pytest.raises(KeyError, match="'plate'"):
         contact_force(h, "plate")
+
+
+def test_the_generated_block_names_a_stopped_runs_diagnosis_in_one_line(tmp_path):
+    """A case whose run stopped is listed with its status and the first line of
+    its diagnosis (the guard's verdict), pointing to summary.json for the rest
+    (the whole diagnosis is many lines: what gained energy, where, likely
+    causes), so the bullet list stays one line per case."""
+    from sphdyn.validation.runner import page_block
+
+    res = {"case": "a", "title": "A", "deck": "validation/cases/a.toml", "items": 10,
+           "steps": 5, "wall_seconds": 60.0, "status": "energy_error", "rows": [],
+           "date": "2026-11-29",
+           "diagnosis": "run stopped at t = 2.5e-05 s: the energy balance is off.\n"
+                        "  Part 'sph' gained the most.\n  Likely causes: ..."}
+    block = page_block([res], tmp_path, {})
+    line = next(x for x in block.splitlines() if x.startswith("* `a`"))
+    assert line.endswith("status energy_error (run stopped at t = 2.5e-05 s: the energy "
+                         "balance is off; the whole diagnosis in its summary.json).")
+    assert "Part 'sph'" not in block

@@ -101,7 +101,9 @@ def page_block(results: list[dict], root: Path, figures: dict[str, str]) -> str:
         lines.append(f"* `{res['case']}`: {res['deck']}, {res.get('items')} particles and "
                      f"mesh nodes, {res.get('steps')} steps, "
                      + (f"{secs / 60:.1f} min, " if secs else "") + f"status {res['status']}"
-                     + (f" ({res['diagnosis']})" if res.get("diagnosis") else "") + ".")
+                     + (f" ({res['diagnosis'].splitlines()[0].rstrip('.')}; the whole "
+                        "diagnosis in its summary.json)" if res.get("diagnosis") else "")
+                     + ".")
     lines += ["", table_markdown(results), "", "Where the measured values come from:", "",
               sources_markdown(results)]
     for res in results:
