@@ -709,6 +709,7 @@ def test_debris_inherits_no_contact_force_and_the_contact_moves_to_the_new_surfa
     # it): beyond half the 2 mm thickness, all allowed
     ("top", -2e-3, 0.0, 1e-3),
     ("top", 1e-4, 0.0, 0.0),         # the same face 0.9 mm nearer, less than the half: none
+    ("top", -1e-4, 0.0, 1e-3),       # 1.1 mm nearer, past the half: all (up to the depth)
     ("side", 2e-4, 300.0, 5e-4),     # a switch: 1 mm deep, 0.2 + 0.3 by motion: 0.5 allowed
     ("side", 2e-4, 900.0, 0.0),      # the motion (0.9 mm) can take it there: none
     ("none", 2e-4, 0.0, 0.0),        # faced nothing before (far): no check

@@ -326,12 +326,14 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
             continue
         pen = max(-gap, 0.0)
         N = face_shapes(xi, eta, nf)
-        if last_face[i] != -1 and (bf != last_face[i]  # a switch of face, or the
-                                   or -gap - d_last[i] > JUMP_FRACTION * tp):  # same face leapt
+        # the excess over the motion's approach that counts as geometry: any at
+        # a switch of face, beyond JUMP_FRACTION of the thickness on the same face
+        leap = 0.0 if bf != last_face[i] else JUMP_FRACTION * tp
+        if last_face[i] != -1 and -gap - d_last[i] > leap:  # (else the excess is less)
             w0, w1, w2 = _relative_velocity(vp, vn, i, faces[bf], N)
             excess = -gap - d_last[i] - motion_dt * np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
-            if excess > (0.0 if bf != last_face[i] else JUMP_FRACTION * tp):
-                pen0[i] = min(pen0[i] + excess, pen)  # deeper than the motion: geometry
+            if excess > leap:  # deeper than the motion can take it: geometry
+                pen0[i] = min(pen0[i] + excess, pen)
         if pen < pen0[i]:
             pen0[i] = pen
         last_face[i] = bf
