@@ -17,7 +17,7 @@ compiled later would see the wrapper instead of a kernel (Numba refuses it).
 Usage::
 
     python benchmarks/profile_step.py [--deck DECK] [--steps N] [--warmup W]
-        [--threads T] [--start-steps S] [--set KEY=VALUE ...]
+        [--threads T] [--start-steps S] [--set KEY=VALUE ...] [--hex3d ELEMENTS]
 """
 
 from __future__ import annotations
@@ -32,6 +32,7 @@ import numba
 from numba.core.registry import CPUDispatcher
 
 from sphdyn.assembly import build_stepper
+from sphdyn.bench import hex3d_stepper
 from sphdyn.deck import load_deck
 
 
@@ -82,6 +83,8 @@ def instrument(stepper) -> dict:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--deck", default="examples/disc_impact.toml")
+    ap.add_argument("--hex3d", type=int, metavar="ELEMENTS",
+                    help="profile `sphdyn bench hex3d` of about ELEMENTS elements instead")
     ap.add_argument("--steps", type=int, default=200)
     ap.add_argument("--warmup", type=int, default=5)
     ap.add_argument("--start-steps", type=int, default=0,
@@ -90,8 +93,11 @@ def main() -> None:
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     a = ap.parse_args()
     numba.set_num_threads(a.threads)
-    deck = load_deck(a.deck, overrides=a.set)
-    stepper = build_stepper(deck)
+    if a.hex3d:
+        stepper = hex3d_stepper(a.hex3d)
+        a.deck = f"bench hex3d ({a.hex3d} elements)"
+    else:
+        stepper = build_stepper(load_deck(a.deck, overrides=a.set))
     for _ in range(a.start_steps + a.warmup):
         stepper.step()
     tally = instrument(stepper)
