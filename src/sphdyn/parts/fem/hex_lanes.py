@@ -31,10 +31,11 @@ from numba import njit, prange
 
 from ...geometry.shapes import hourglass_vectors
 from .hex_gradient import hex_volume_gradient_lanes
-from .lane_layout import (C_, COEF_, DKK_, DT_, F_, FACE_, G_, HEAT_, HG_, INV_, INVV_, L_, LANES,
-                          LB_, M_, POWER_, Q_, QA_, RHO_, ROWS, SIG_, VN_, VOL_, X_)
+from .lane_layout import (C_, COEF_, DKK_, DT_, F_, FACE_, G_, GM_, HEAT_, HG_, INV_, INVV_, L_,
+                          LAM_, LANES, LB_, M_, POWER_, Q_, QA_, RHO_, ROW_, ROWS, SIG_, VN_, VOL_,
+                          X_)
 from .solid import (HG_VISCOUS, block_count, block_span, bulk_viscosity, element_step,
-                     length_from_gradient)
+                     hourglass_step, length_from_gradient, smallest_node_mass)
 
 #: hourglass base vectors (4, 8) of the hex8, a compile-time constant
 GAMMA = hourglass_vectors(3)
@@ -192,6 +193,10 @@ def force_lanes(S, hg_form, qh, q1, q2, dt):
             h0 *= inv_v
             h1 *= inv_v
             h2 *= inv_v
+            for I in range(8):  # the shape vectors (the step's Gram bound below)
+                S[(GM_ + 8 * a + I) * LANES + l] = GAMMA[a, I] - (
+                    h0 * S[(G_ + 3 * I) * LANES + l] + h1 * S[(G_ + 3 * I + 1) * LANES + l]
+                    + h2 * S[(G_ + 3 * I + 2) * LANES + l])
             qd0 = w0 - (S[LB_ * LANES + l] * h0 + S[(LB_ + 1) * LANES + l] * h1
                         + S[(LB_ + 2) * LANES + l] * h2)
             qd1 = w1 - (S[(LB_ + 3) * LANES + l] * h0 + S[(LB_ + 4) * LANES + l] * h1
@@ -223,6 +228,20 @@ def force_lanes(S, hg_form, qh, q1, q2, dt):
             S[(M_ + 6) * LANES + l] += Q2 * h0
             S[(M_ + 7) * LANES + l] += Q2 * h1
             S[(M_ + 8) * LANES + l] += Q2 * h2
+    # .solid.hourglass_gram_bound: max_a sum_b |sum_I gamma_aI gamma_bI|
+    for l in range(LANES):
+        S[LAM_ * LANES + l] = 0.0
+    for a in range(4):
+        for l in range(LANES):
+            S[ROW_ * LANES + l] = 0.0
+        for b in range(4):
+            for l in range(LANES):
+                s = 0.0
+                for I in range(8):
+                    s += S[(GM_ + 8 * a + I) * LANES + l] * S[(GM_ + 8 * b + I) * LANES + l]
+                S[ROW_ * LANES + l] += abs(s)
+        for l in range(LANES):
+            S[LAM_ * LANES + l] = max(S[LAM_ * LANES + l], S[ROW_ * LANES + l])
     # f_iI = -(sigma_ij - q delta_ij - M_ij / V) dV/dx_jI - sum_a Q_ai Gamma_aI
     for i in range(3):
         for j in range(3):
@@ -244,12 +263,14 @@ def force_lanes(S, hg_form, qh, q1, q2, dt):
 
 @njit(cache=True, error_model="numpy", parallel=True)
 def hex_forces(x, v, conn, active, sig, L, rho, c, e_spec, e_av, hg_form, qh, hg, e_hg,
-               q1, q2, dt, vol, dt_el, fe, work):
+               q1, q2, dt, vol, dt_el, fe, work, m_node):
     r"""Nodal forces ``fe`` (E, 8, 3) [N] of one-point hex8 elements, lane by lane:
     :func:`.solid.uniform_forces` (same arguments and equations: the geometry
     at :math:`n+1` with ``vol`` and ``dt_el`` written on the way, bulk
     viscosity heating ``e_spec`` and ``e_av``, hourglass forces with their work
-    in ``e_hg`` and the stiffness form's ``hg`` (E, 4, 3) updated).
+    in ``e_hg`` and the stiffness form's ``hg`` (E, 4, 3) updated; the
+    element step the smaller of the element's and its hourglass control's,
+    :func:`.solid.hourglass_step` with the node masses ``m_node`` (N,) [kg]).
     ``work``: :func:`lane_scratch`."""
     ne = conn.shape[0]
     stiffness = hg_form != HG_VISCOUS
@@ -272,7 +293,9 @@ def hex_forces(x, v, conn, active, sig, L, rho, c, e_spec, e_av, hg_form, qh, hg
                     continue
                 V = S[VOL_ * LANES + l]
                 vol[e] = V
-                dt_el[e] = S[DT_ * LANES + l]
+                dt_el[e] = min(S[DT_ * LANES + l],
+                               hourglass_step(S[LAM_ * LANES + l], S[COEF_ * LANES + l],
+                                              smallest_node_mass(m_node, conn, e), hg_form))
                 if S[Q_ * LANES + l] > 0.0 and rho[e] > 0.0:
                     heat = S[HEAT_ * LANES + l]
                     e_spec[e] += heat

@@ -34,4 +34,7 @@ INVV_ = 137  #: 1 / V where hourglass control acts, else 0 [1/m^3]
 LB_ = 138  #: 9 rows: sum_I v_iI dV/dx_jI [m^3/s]
 M_ = 147  #: 9 rows: hourglass share M_ij = sum_a Q_ai h_aj / V [Pa]
 QA_ = 156  #: 12 rows: hourglass generalised forces (a, k) -> QA_ + 3 a + k [N]
-ROWS = 168  #: rows in all
+GM_ = 168  #: 32 rows: hourglass shape vectors gamma_aI -> GM_ + 8 a + I
+ROW_ = 200  #: a Gershgorin row sum of their Gram matrix
+LAM_ = 201  #: Gershgorin's bound of the Gram matrix's largest eigenvalue
+ROWS = 202  #: rows in all

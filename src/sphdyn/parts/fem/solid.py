@@ -83,6 +83,30 @@ eigenvalue of the uniform-strain element with lumped mass is bounded by
 form with the bulk viscosity). For a cube of side a: :math:`\ell = a/\sqrt3`
 (the odd-even dilatational mode of a cube mesh has :math:`\omega^2 = 12K/\rho
 a^2`, which this bound covers for any Poisson ratio).
+
+**Stable step of the hourglass control** (:func:`hourglass_step`): the
+hourglass forces are explicit too. On the nodes of one element they act as
+:math:`\mathbf f = -\,a_h\, \Gamma^{\gamma T}\Gamma^{\gamma}\,\mathbf v` (viscous;
+:math:`k_h` on the displacements for the stiffness form), with
+:math:`\Gamma^\gamma` the shape vectors :math:`\gamma_{\alpha I}` above, so the
+central-difference update of a mode multiplies it by :math:`1 - \Delta t\,
+a_h \lambda / m` per step (viscous: stable for :math:`\Delta t \le 2m/(a_h
+\lambda)`) or is an oscillator of :math:`\omega^2 = k_h \lambda / m`
+(stiffness: :math:`\Delta t \le 2/\omega`), :math:`\lambda` the largest
+eigenvalue of the Gram matrix :math:`G_{\alpha\beta} = \sum_I
+\gamma_{\alpha I}\gamma_{\beta I}`, bounded by Gershgorin's row sums
+:math:`\lambda \le \max_\alpha \sum_\beta |G_{\alpha\beta}|`, and
+:math:`m` the smallest mass of the element's nodes. For an undistorted element
+:math:`\gamma = \Gamma`, :math:`\lambda = n_{en}` (the base vectors are
+orthogonal), and the bound is 2.3 times the element step at
+:math:`Q_{hg} = 0.1` for a lone cube (more for a node shared by several
+elements): it does not act. In an element distorted towards its hourglass
+modes (a crushed or strongly dilated one: :math:`\sum_I\gamma_{\alpha I}^2`
+grew from 8 to 64 in the Forrestal target, docs/validation.md) :math:`\lambda`
+grows with the distortion and the bound takes over; without it such an
+element's hourglass mode grew by about 1.4 times per step. The element step is the
+smaller of the two (LS-DYNA's element step has no hourglass term; it deletes
+such elements through its erosion criteria instead).
 """
 
 from __future__ import annotations
@@ -285,6 +309,75 @@ def bulk_viscosity(rho, c, ell, dkk, q1, q2):
 
 
 @njit(cache=True, error_model="numpy")
+def hourglass_gram_bound(xl, g, V, gam):
+    r"""Gershgorin's bound :math:`\max_\alpha \sum_\beta |G_{\alpha\beta}|` of the
+    largest eigenvalue of the Gram matrix :math:`G_{\alpha\beta} = \sum_I
+    \gamma_{\alpha I}\gamma_{\beta I}` of the hourglass shape vectors
+    :math:`\gamma_{\alpha I} = \Gamma_{\alpha I} - \mathbf h_\alpha\cdot
+    \partial V/\partial\mathbf x_I`, :math:`\mathbf h_\alpha = \sum_J
+    \Gamma_{\alpha J}\mathbf x_J / V` (module docstring, "Stable step of the
+    hourglass control"; dimensionless, ``nen`` for an undistorted element).
+    ``xl``, ``g`` (nen, 3) node coordinates [m] and volume derivatives [m^2],
+    ``V`` > 0 [m^3], ``gam`` (modes, nen) the base vectors. The reference of
+    the lane pass (:func:`.hex_lanes.force_lanes`: the same operations in the
+    same order), so each shape vector is formed where it is used."""
+    nm, nen = gam.shape
+    inv_v = 1.0 / V
+    lam = 0.0
+    for a in range(nm):
+        row = 0.0
+        for b in range(nm):
+            s = 0.0
+            for I in range(nen):
+                s += (shape_vector(xl, g, inv_v, gam, a, I)
+                      * shape_vector(xl, g, inv_v, gam, b, I))
+            row += abs(s)
+        lam = max(lam, row)
+    return lam
+
+
+@njit(cache=True, error_model="numpy")
+def shape_vector(xl, g, inv_v, gam, a, I):
+    r""":math:`\gamma_{\alpha I} = \Gamma_{\alpha I} - \mathbf h_\alpha\cdot
+    \partial V/\partial\mathbf x_I` of :func:`hourglass_gram_bound` (``inv_v`` =
+    1/V; :math:`\mathbf h_\alpha` summed as in :func:`hourglass_resultants`)."""
+    h0 = h1 = h2 = 0.0
+    for J in range(xl.shape[0]):
+        G = gam[a, J]
+        h0 += G * xl[J, 0]
+        h1 += G * xl[J, 1]
+        h2 += G * xl[J, 2]
+    h0 *= inv_v
+    h1 *= inv_v
+    h2 *= inv_v
+    return gam[a, I] - (h0 * g[I, 0] + h1 * g[I, 1] + h2 * g[I, 2])
+
+
+@njit(cache=True, error_model="numpy")
+def hourglass_step(lam, coef, m_min, hg_form):
+    r"""Stable step of an element's hourglass control [s] (module docstring):
+    viscous :math:`2 m / (a_h\lambda)`, stiffness :math:`2\sqrt{m / (k_h
+    \lambda)}`; ``inf`` without hourglass control (``coef`` <= 0). ``lam`` the
+    bound of :func:`hourglass_gram_bound`, ``coef`` :math:`a_h` [kg/s] or
+    :math:`k_h` [N/m], ``m_min`` the smallest mass of the element's nodes
+    [kg]."""
+    if coef <= 0.0 or lam <= 0.0:
+        return np.inf
+    if hg_form == HG_VISCOUS:
+        return 2.0 * m_min / (coef * lam)
+    return 2.0 * sqrt(m_min / (coef * lam))
+
+
+@njit(cache=True, error_model="numpy")
+def smallest_node_mass(m_node, conn, e):
+    """The smallest of the masses ``m_node`` (N,) [kg] of element ``e``'s nodes."""
+    m = m_node[conn[e, 0]]
+    for I in range(1, conn.shape[1]):
+        m = min(m, m_node[conn[e, I]])
+    return m
+
+
+@njit(cache=True, error_model="numpy")
 def hourglass_resultants(e, vl, xl, g, V, gam, hg_form, coef, hg, dt, dim, Q, M):
     r"""Hourglass generalised forces ``Q`` (modes, 3) [N] of element ``e`` and
     their share ``M`` (3, 3) [N m] of the force pass; returns their power [W].
@@ -363,7 +456,7 @@ def hourglass_resultants(e, vl, xl, g, V, gam, hg_form, coef, hg, dt, dim, Q, M)
 
 @njit(cache=True, error_model="numpy", parallel=True)
 def uniform_forces(x, v, conn, active, sig, L, rho, c, e_spec, e_av, dim, tab, gam,
-                   hg_form, qh, hg, e_hg, q1, q2, dt, vol, dt_el, fe, work):
+                   hg_form, qh, hg, e_hg, q1, q2, dt, vol, dt_el, fe, work, m_node):
     r"""Nodal forces (E, nen, 3) of one-point elements: stress, bulk viscosity, hourglass.
 
     The geometry at :math:`n+1` (``x`` (N, 3)) is computed here, element by
@@ -376,7 +469,9 @@ def uniform_forces(x, v, conn, active, sig, L, rho, c, e_spec, e_av, dim, tab, g
     stiffness-form generalised forces [N] (updated); ``e_hg`` (E,) hourglass
     work [J] (updated); bulk viscosity ``q1`` (quadratic), ``q2`` (linear),
     whose heat goes to ``e_spec`` and ``e_av`` (E,) [J/kg]; ``work``:
-    :func:`block_scratch`. Equations: module docstring and
+    :func:`block_scratch`; ``m_node`` (N,) the node masses [kg] of the
+    hourglass control's step (:func:`hourglass_step`: the element step is the
+    smaller of the two). Equations: module docstring and
     :func:`hourglass_resultants`.
     """
     ne = conn.shape[0]
@@ -419,6 +514,9 @@ def uniform_forces(x, v, conn, active, sig, L, rho, c, e_spec, e_av, dim, tab, g
                     coef = qh * rho[e] * c[e] * c[e] * bb / (V * dim)
                 e_hg[e] += dt * hourglass_resultants(e, vl, xl, g, V, gam, hg_form, coef,
                                                      hg, dt, dim, Q, M)
+                dt_el[e] = min(dt_el[e], hourglass_step(hourglass_gram_bound(xl, g, V, gam),
+                                                        coef, smallest_node_mass(m_node, conn, e),
+                                                        hg_form))
             else:
                 M[:] = 0.0
             # f_iI = -(sigma_ij - q delta_ij - M_ij / V) dV/dx_jI - sum_a Q_ai Gamma_aI

@@ -195,12 +195,12 @@ class SolidPart:
         elif self.lanes is not None:
             hex_forces(q.x, q.v, el.conn, el.active, p.sig, p.L, p.rho, p.c, p.e, p.e_av,
                        self.hg_form, s.hourglass_coefficient, el.hg, el.e_hg, s.q1, s.q2, dt,
-                       el.vol, el.dt_el, el.fe, self.lanes)
+                       el.vol, el.dt_el, el.fe, self.lanes, q.m)
         else:
             uniform_forces(q.x, q.v, el.conn, el.active, p.sig, p.L, p.rho, p.c, p.e,
                            p.e_av, self.dim, self.tab, self.gam, self.hg_form,
                            s.hourglass_coefficient, el.hg, el.e_hg, s.q1, s.q2, dt, el.vol,
-                           el.dt_el, el.fe, self.work)
+                           el.dt_el, el.fe, self.work, q.m)
         gather_loads(el.fe, 0, self.offsets, self.slots, q.m, q.a)
 
     # ----------------------------------------------------------- protocol
