@@ -340,17 +340,22 @@ def hourglass_gram_bound(xl, g, V, gam):
 def shape_vector(xl, g, inv_v, gam, a, I):
     r""":math:`\gamma_{\alpha I} = \Gamma_{\alpha I} - \mathbf h_\alpha\cdot
     \partial V/\partial\mathbf x_I` of :func:`hourglass_gram_bound` (``inv_v`` =
-    1/V; :math:`\mathbf h_\alpha` summed as in :func:`hourglass_resultants`)."""
+    1/V)."""
+    h0, h1, h2 = hourglass_moment(xl, gam, a, inv_v)
+    return gam[a, I] - (h0 * g[I, 0] + h1 * g[I, 1] + h2 * g[I, 2])
+
+
+@njit(cache=True, error_model="numpy")
+def hourglass_moment(xl, gam, a, inv_v):
+    r""":math:`\mathbf h_\alpha = \sum_J \Gamma_{\alpha J}\mathbf x_J / V` [-] of
+    mode ``a`` (``xl`` (nen, 3) node coordinates [m], ``inv_v`` = 1/V [1/m^3])."""
     h0 = h1 = h2 = 0.0
     for J in range(xl.shape[0]):
         G = gam[a, J]
         h0 += G * xl[J, 0]
         h1 += G * xl[J, 1]
         h2 += G * xl[J, 2]
-    h0 *= inv_v
-    h1 *= inv_v
-    h2 *= inv_v
-    return gam[a, I] - (h0 * g[I, 0] + h1 * g[I, 1] + h2 * g[I, 2])
+    return h0 * inv_v, h1 * inv_v, h2 * inv_v
 
 
 @njit(cache=True, error_model="numpy")
@@ -417,19 +422,13 @@ def hourglass_resultants(e, vl, xl, g, V, gam, hg_form, coef, hg, dt, dim, Q, M)
             M[i, j] = 0.0
     power = 0.0
     for a in range(gam.shape[0]):
-        h0 = h1 = h2 = 0.0
+        h0, h1, h2 = hourglass_moment(xl, gam, a, inv_v)
         w0 = w1 = w2 = 0.0
         for J in range(nen):
             G = gam[a, J]
-            h0 += G * xl[J, 0]
-            h1 += G * xl[J, 1]
-            h2 += G * xl[J, 2]
             w0 += G * vl[J, 0]
             w1 += G * vl[J, 1]
             w2 += G * vl[J, 2]
-        h0 *= inv_v
-        h1 *= inv_v
-        h2 *= inv_v
         qd0 = w0 - (Lb00 * h0 + Lb01 * h1 + Lb02 * h2)
         qd1 = w1 - (Lb10 * h0 + Lb11 * h1 + Lb12 * h2)
         qd2 = w2 - (Lb20 * h0 + Lb21 * h1 + Lb22 * h2)
