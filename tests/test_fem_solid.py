@@ -537,16 +537,18 @@ def test_simd_sqrt_is_the_ieee_square_root():
 
 
 def hourglass_bound_by_hand(x, gam, dim):
-    """Gershgorin's bound of the Gram matrix of the Flanagan-Belytschko shape
-    vectors of one element (node coordinates ``x`` (nen, 3)), formed with
-    NumPy from the volume derivatives; also the Gram matrix's largest
-    eigenvalue."""
+    """The smaller of the trace and Gershgorin's bound of the Gram matrix of
+    the Flanagan-Belytschko shape vectors of one element (node coordinates
+    ``x`` (nen, 3)), formed with NumPy from the volume derivatives (the bound
+    the step takes where the trace's step would act); also the Gram matrix's
+    largest eigenvalue and its trace."""
     g = np.zeros((x.shape[0], 3))
     V = volume_gradient(x - x[0], dim, volume_table(dim), g)
     h = gam @ (x - x[0]) / V  # (modes, 3)
     shape = gam - h @ g.T  # (modes, nen)
     gram = shape @ shape.T
-    return np.abs(gram).sum(axis=1).max(), np.linalg.eigvalsh(gram).max(), V, g
+    bound = min(np.trace(gram), np.abs(gram).sum(axis=1).max())
+    return bound, np.linalg.eigvalsh(gram).max(), V, g, np.trace(gram)
 
 
 @pytest.mark.parametrize("dim", [2, 3])
@@ -557,8 +559,9 @@ def test_an_element_distorted_into_its_hourglass_shape_takes_the_hourglass_step(
     the Forrestal target took), beside an undistorted one: its step is the hourglass control's
     (module docstring of sphdyn.parts.fem.solid), 2 m / (a_h lambda) (viscous)
     or 2 sqrt(m / (k_h lambda)) (stiffness) with m the smallest node mass and
-    lambda Gershgorin's bound of the shape vectors' Gram matrix formed here
-    with NumPy (rel. 1e-12: the same formula, other operation order), smaller
+    lambda the smaller of the trace and Gershgorin's bound of the shape
+    vectors' Gram matrix formed here with NumPy (rel. 1e-12: the same
+    formula, other operation order), smaller
     than the element step (at Q_hg = 1, so that it acts in all four cases; at
     0.1 it does here for the viscous hex only); the bound is at least the Gram
     matrix's largest eigenvalue. An undistorted cube: lambda = 2^d exactly (orthogonal base
@@ -568,8 +571,9 @@ def test_an_element_distorted_into_its_hourglass_shape_takes_the_hourglass_step(
     gam = hourglass_vectors(dim)
     x, cells = block([0, 0, 0], [a, a, a], (1, 1, 1)[:dim], dim)
     cube = part(x.copy(), cells, dim, hourglass=form, hourglass_coefficient=qh)
-    lam, eig, V, g = hourglass_bound_by_hand(x[cells[0]], gam, dim)
+    lam, eig, V, g, trace = hourglass_bound_by_hand(x[cells[0]], gam, dim)
     assert lam == 2 ** dim and eig == pytest.approx(2 ** dim, rel=1e-12)
+    assert trace == 2 ** dim * gam.shape[0]  # the trace alone: 4x too high (hex)
     dt_cube = cube.el.dt_el[0]
     # two elements side by side, the first distorted: its nodes' masses differ
     x, cells = block([0, 0, 0], [2 * a, a, a], (2, 1, 1)[:dim], dim)
@@ -577,7 +581,7 @@ def test_an_element_distorted_into_its_hourglass_shape_takes_the_hourglass_step(
     p = part(x, cells, dim, hourglass=form, hourglass_coefficient=qh)
     p._geometry(0.0)
     p._forces(1e-9)
-    lam, eig, V, g = hourglass_bound_by_hand(p.nodes.x[cells[0]], gam, dim)
+    lam, eig, V, g, trace = hourglass_bound_by_hand(p.nodes.x[cells[0]], gam, dim)
     assert lam >= eig > 1.5 * 2 ** dim  # distorted: larger than the cube's
     m_nodes = p.nodes.m[cells[0]]
     assert m_nodes.max() > 1.5 * m_nodes.min()  # the smallest is the one taken

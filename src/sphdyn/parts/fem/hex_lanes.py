@@ -32,8 +32,8 @@ from numba import njit, prange
 from ...geometry.shapes import hourglass_vectors
 from .hex_gradient import hex_volume_gradient_lanes
 from .lane_layout import (C_, COEF_, DKK_, DT_, F_, FACE_, G_, GM_, HEAT_, HG_, INV_, INVV_, L_,
-                          LAM_, LANES, LB_, M_, POWER_, Q_, QA_, RHO_, ROW_, ROWS, SIG_, VN_, VOL_,
-                          X_)
+                          LAM_, LANES, LB_, M_, MMIN_, POWER_, Q_, QA_, RHO_, ROW_, ROWS, SIG_, TR_,
+                          VN_, VOL_, X_)
 from .solid import (HG_VISCOUS, block_count, block_span, bulk_viscosity, element_step,
                      hourglass_step, length_from_gradient, smallest_node_mass)
 
@@ -116,11 +116,13 @@ def hex_strain_rate(x, v, conn, active, m_el, dt, L, rho, work):
 
 
 @njit(cache=True, error_model="numpy")
-def gather_fields(sig, L, rho, c, hg, lo, nl, stiffness, S):
-    """Rows SIG_, DKK_, RHO_, C_ and FACE_ (viscous form) or HG_ (stiffness form)
-    of elements ``lo`` .. ``lo + nl - 1``, padded as :func:`gather_nodes`."""
+def gather_fields(sig, L, rho, c, hg, lo, nl, stiffness, m_node, conn, S):
+    """Rows SIG_, DKK_, RHO_, C_, MMIN_ (the smallest node mass of ``m_node``)
+    and FACE_ (viscous form) or HG_ (stiffness form) of elements ``lo`` ..
+    ``lo + nl - 1``, padded as :func:`gather_nodes`."""
     for l in range(LANES):
         e = lo + min(l, nl - 1)
+        S[MMIN_ * LANES + l] = smallest_node_mass(m_node, conn, e)
         for i in range(3):
             for j in range(3):
                 S[(SIG_ + 3 * i + j) * LANES + l] = sig[e, i, j]
@@ -152,6 +154,7 @@ def force_lanes(S, hg_form, qh, q1, q2, dt):
         rho = S[RHO_ * LANES + l]
         c = S[C_ * LANES + l]
         dkk = S[DKK_ * LANES + l]
+        S[TR_ * LANES + l] = 0.0
         bb = 0.0
         for I in range(8):
             g0 = S[(G_ + 3 * I) * LANES + l]
@@ -193,10 +196,14 @@ def force_lanes(S, hg_form, qh, q1, q2, dt):
             h0 *= inv_v
             h1 *= inv_v
             h2 *= inv_v
-            for I in range(8):  # the shape vectors (the step's Gram bound below)
-                S[(GM_ + 8 * a + I) * LANES + l] = GAMMA[a, I] - (
+            tr = S[TR_ * LANES + l]
+            for I in range(8):  # the shape vectors and their Gram trace (the step)
+                gm = GAMMA[a, I] - (
                     h0 * S[(G_ + 3 * I) * LANES + l] + h1 * S[(G_ + 3 * I + 1) * LANES + l]
                     + h2 * S[(G_ + 3 * I + 2) * LANES + l])
+                S[(GM_ + 8 * a + I) * LANES + l] = gm
+                tr += gm * gm
+            S[TR_ * LANES + l] = tr
             qd0 = w0 - (S[LB_ * LANES + l] * h0 + S[(LB_ + 1) * LANES + l] * h1
                         + S[(LB_ + 2) * LANES + l] * h2)
             qd1 = w1 - (S[(LB_ + 3) * LANES + l] * h0 + S[(LB_ + 4) * LANES + l] * h1
@@ -228,20 +235,30 @@ def force_lanes(S, hg_form, qh, q1, q2, dt):
             S[(M_ + 6) * LANES + l] += Q2 * h0
             S[(M_ + 7) * LANES + l] += Q2 * h1
             S[(M_ + 8) * LANES + l] += Q2 * h2
-    # .solid.hourglass_gram_bound: max_a sum_b |sum_I gamma_aI gamma_bI|
+    # .solid.hourglass_bound: the trace, or where its step is below the element
+    # step, the smaller of it and Gershgorin's max_a sum_b |sum_I gamma_aI gamma_bI|
+    need = False
     for l in range(LANES):
-        S[LAM_ * LANES + l] = 0.0
-    for a in range(4):
+        S[LAM_ * LANES + l] = S[TR_ * LANES + l]
+        need |= hourglass_step(S[TR_ * LANES + l], S[COEF_ * LANES + l],
+                               S[MMIN_ * LANES + l], hg_form) < S[DT_ * LANES + l]
+    if need:  # (rarely: a group with a strongly distorted element, or a corner)
         for l in range(LANES):
-            S[ROW_ * LANES + l] = 0.0
-        for b in range(4):
+            S[ROW_ * LANES + l] = 0.0  # the largest row sum so far
+        for a in range(4):
             for l in range(LANES):
-                s = 0.0
-                for I in range(8):
-                    s += S[(GM_ + 8 * a + I) * LANES + l] * S[(GM_ + 8 * b + I) * LANES + l]
-                S[ROW_ * LANES + l] += abs(s)
+                row = 0.0
+                for b in range(4):
+                    s = 0.0
+                    for I in range(8):
+                        s += S[(GM_ + 8 * a + I) * LANES + l] * S[(GM_ + 8 * b + I) * LANES + l]
+                    row += abs(s)
+                S[ROW_ * LANES + l] = max(S[ROW_ * LANES + l], row)
         for l in range(LANES):
-            S[LAM_ * LANES + l] = max(S[LAM_ * LANES + l], S[ROW_ * LANES + l])
+            tr = S[TR_ * LANES + l]
+            if hourglass_step(tr, S[COEF_ * LANES + l], S[MMIN_ * LANES + l],
+                              hg_form) < S[DT_ * LANES + l]:
+                S[LAM_ * LANES + l] = min(tr, S[ROW_ * LANES + l])
     # f_iI = -(sigma_ij - q delta_ij - M_ij / V) dV/dx_jI - sum_a Q_ai Gamma_aI
     for i in range(3):
         for j in range(3):
@@ -281,7 +298,7 @@ def hex_forces(x, v, conn, active, sig, L, rho, c, e_spec, e_av, hg_form, qh, hg
             nl = min(bhi - lo, LANES)
             gather_nodes(x, v, 0.0, conn, lo, nl, S)
             hex_volume_gradient_lanes(S)
-            gather_fields(sig, L, rho, c, hg, lo, nl, stiffness, S)
+            gather_fields(sig, L, rho, c, hg, lo, nl, stiffness, m_node, conn, S)
             force_lanes(S, hg_form, qh, q1, q2, dt)
             for l in range(nl):
                 e = lo + l
@@ -295,7 +312,7 @@ def hex_forces(x, v, conn, active, sig, L, rho, c, e_spec, e_av, hg_form, qh, hg
                 vol[e] = V
                 dt_el[e] = min(S[DT_ * LANES + l],
                                hourglass_step(S[LAM_ * LANES + l], S[COEF_ * LANES + l],
-                                              smallest_node_mass(m_node, conn, e), hg_form))
+                                              S[MMIN_ * LANES + l], hg_form))
                 if S[Q_ * LANES + l] > 0.0 and rho[e] > 0.0:
                     heat = S[HEAT_ * LANES + l]
                     e_spec[e] += heat

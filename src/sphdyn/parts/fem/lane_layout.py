@@ -36,5 +36,7 @@ M_ = 147  #: 9 rows: hourglass share M_ij = sum_a Q_ai h_aj / V [Pa]
 QA_ = 156  #: 12 rows: hourglass generalised forces (a, k) -> QA_ + 3 a + k [N]
 GM_ = 168  #: 32 rows: hourglass shape vectors gamma_aI -> GM_ + 8 a + I
 ROW_ = 200  #: a Gershgorin row sum of their Gram matrix
-LAM_ = 201  #: Gershgorin's bound of the Gram matrix's largest eigenvalue
-ROWS = 202  #: rows in all
+LAM_ = 201  #: the bound of the Gram matrix's largest eigenvalue the step takes
+TR_ = 202  #: the Gram matrix's trace
+MMIN_ = 203  #: the smallest mass of the element's nodes [kg]
+ROWS = 204  #: rows in all

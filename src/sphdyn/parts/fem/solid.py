@@ -94,8 +94,9 @@ a_h \lambda / m` per step (viscous: stable for :math:`\Delta t \le 2m/(a_h
 \lambda)`) or is an oscillator of :math:`\omega^2 = k_h \lambda / m`
 (stiffness: :math:`\Delta t \le 2/\omega`), :math:`\lambda` the largest
 eigenvalue of the Gram matrix :math:`G_{\alpha\beta} = \sum_I
-\gamma_{\alpha I}\gamma_{\beta I}`, bounded by Gershgorin's row sums
-:math:`\lambda \le \max_\alpha \sum_\beta |G_{\alpha\beta}|`, and
+\gamma_{\alpha I}\gamma_{\beta I}`, bounded by its trace and, where the
+trace's step would act, by the smaller of the trace and Gershgorin's row
+sums :math:`\max_\alpha \sum_\beta |G_{\alpha\beta}|` (:func:`hourglass_bound`), and
 :math:`m` the smallest mass of the element's nodes. For an undistorted element
 :math:`\gamma = \Gamma`, :math:`\lambda = n_{en}` (the base vectors are
 orthogonal), and the bound is 2.3 times the element step at
@@ -309,6 +310,30 @@ def bulk_viscosity(rho, c, ell, dkk, q1, q2):
 
 
 @njit(cache=True, error_model="numpy")
+def hourglass_bound(xl, g, V, gam, coef, m_min, hg_form, dt_element):
+    r"""The bound :math:`\lambda` of :func:`hourglass_step`: the trace of the
+    Gram matrix of the shape vectors, :math:`\sum_{\alpha I}\gamma_{\alpha I}^2`
+    (:math:`\ge\lambda_{max}`, the matrix being positive semi-definite), or,
+    where the trace's step is below ``dt_element`` (the element step [s]),
+    the smaller of the trace and :func:`hourglass_gram_bound` (Gershgorin; it
+    can exceed the trace, and both bound :math:`\lambda_{max}`). The trace
+    alone decides for most elements (an undistorted cube's trace 32 against
+    its Gershgorin bound 8: its step is still above the element step wherever
+    a node is shared), so the Gram matrix is formed only where it may act.
+    Arguments as :func:`hourglass_gram_bound` and :func:`hourglass_step`."""
+    nm, nen = gam.shape
+    inv_v = 1.0 / V
+    tr = 0.0
+    for a in range(nm):
+        for I in range(nen):
+            gm = shape_vector(xl, g, inv_v, gam, a, I)
+            tr += gm * gm
+    if hourglass_step(tr, coef, m_min, hg_form) >= dt_element:
+        return tr
+    return min(tr, hourglass_gram_bound(xl, g, V, gam))
+
+
+@njit(cache=True, error_model="numpy")
 def hourglass_gram_bound(xl, g, V, gam):
     r"""Gershgorin's bound :math:`\max_\alpha \sum_\beta |G_{\alpha\beta}|` of the
     largest eigenvalue of the Gram matrix :math:`G_{\alpha\beta} = \sum_I
@@ -513,9 +538,9 @@ def uniform_forces(x, v, conn, active, sig, L, rho, c, e_spec, e_av, dim, tab, g
                     coef = qh * rho[e] * c[e] * c[e] * bb / (V * dim)
                 e_hg[e] += dt * hourglass_resultants(e, vl, xl, g, V, gam, hg_form, coef,
                                                      hg, dt, dim, Q, M)
-                dt_el[e] = min(dt_el[e], hourglass_step(hourglass_gram_bound(xl, g, V, gam),
-                                                        coef, smallest_node_mass(m_node, conn, e),
-                                                        hg_form))
+                m_min = smallest_node_mass(m_node, conn, e)
+                lam = hourglass_bound(xl, g, V, gam, coef, m_min, hg_form, dt_el[e])
+                dt_el[e] = min(dt_el[e], hourglass_step(lam, coef, m_min, hg_form))
             else:
                 M[:] = 0.0
             # f_iI = -(sigma_ij - q delta_ij - M_ij / V) dV/dx_jI - sum_a Q_ai Gamma_aI
