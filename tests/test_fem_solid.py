@@ -600,6 +600,34 @@ def test_an_element_distorted_into_its_hourglass_shape_takes_the_hourglass_step(
         assert 2 * (rho * a ** dim / 2 ** dim) / (coef * 2 ** dim) > 2.2 * dt_cube
 
 
+def test_the_hourglass_bound_is_the_trace_or_the_smaller_of_trace_and_gershgorin():
+    """sphdyn.parts.fem.solid.hourglass_bound on shape vectors given directly
+    (node coordinates at zero, so gamma = the rows passed): where the trace's
+    step is at least the element step it returns the trace; below, the
+    smaller of the trace and Gershgorin's row sums. Undistorted hex modes:
+    trace 32, Gershgorin 8 (exact). Four modes a0 and three times a0/2:
+    Gram [[1, 1/2, 1/2, 1/2], [1/2, 1/4, ...]], trace 1.75, Gershgorin's
+    largest row 2.5, so the trace is the smaller. hourglass_step: 2 m /
+    (a_h lambda) viscous, 2 sqrt(m / (k_h lambda)) stiffness, inf without
+    control."""
+    from sphdyn.parts.fem.solid import (HG_STIFFNESS, HG_VISCOUS, hourglass_bound,
+                                        hourglass_step)
+
+    xl, g = np.zeros((8, 3)), np.ones((8, 3))
+    gam = hourglass_vectors(3)
+    coef, m = 2.0, 3.0  # the trace's step: 2 m / (coef 32) = 0.09375
+    assert hourglass_step(32.0, coef, m, HG_VISCOUS) == pytest.approx(0.09375, rel=1e-15)
+    assert hourglass_bound(xl, g, 1.0, gam, coef, m, HG_VISCOUS, 0.09) == 32.0
+    assert hourglass_bound(xl, g, 1.0, gam, coef, m, HG_VISCOUS, 0.1) == 8.0
+    a0 = np.zeros(8)
+    a0[0] = 1.0
+    skew = np.array([a0, 0.5 * a0, 0.5 * a0, 0.5 * a0])
+    assert hourglass_bound(xl, g, 1.0, skew, coef, m, HG_VISCOUS, 1e9) == 1.75
+    assert hourglass_step(8.0, coef, m, HG_STIFFNESS) == pytest.approx(
+        2.0 * math.sqrt(m / (coef * 8.0)), rel=1e-15)
+    assert hourglass_step(8.0, 0.0, m, HG_VISCOUS) == np.inf
+
+
 @pytest.mark.parametrize("height, qh", [(1.0, 0.1), (0.1, 0.1), (0.02, 0.1), (1.0, 0.15),
                                         (1.0, 0.3)])
 def test_a_crushed_warped_hex_loses_its_hourglass_mode_at_its_own_step(height, qh):

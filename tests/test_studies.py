@@ -165,3 +165,21 @@ def test_punching_study_reads_a_meshed_beam_at_its_elements(tmp_path):
     assert np.allclose(f["displacement"][:, 2], [-0.005, -0.015], rtol=0, atol=1e-15)
     assert f["stress"].shape == (2, 3, 3) and f["stress"][1, 2, 2] == 17.0
     assert f["damage_ductile"].tolist() == [0.1, 0.9] and (f["material"] == 0).all()
+
+
+def test_hourglass_trace_stability_number_of_a_lone_cube():
+    """studies/hourglass_trace.py's measure on one undistorted hex8 (side a,
+    every node the element's only): Gram trace 32 (4 modes x 8 nodes), and
+    dt times the largest eigenvalue of M^-1/2 C M^-1/2 with C = a_h
+    Gamma^T Gamma and node masses m_e / 8: 64 a_h dt / m_e, a_h = Q_hg rho c
+    a^2 / 4 (the hourglass base vectors are orthogonal, |Gamma_a|^2 = 8)."""
+    import hourglass_trace as ht
+    from fem_models import block, part
+
+    a, dt = 0.01, 1e-7
+    x, cells = block([0, 0, 0], [a, a, a], (1, 1, 1), 3)
+    p = part(x, cells, 3, hourglass_coefficient=0.1)
+    trace, number = ht.stability_number(p, 0, dt)
+    assert trace == pytest.approx(32.0, rel=1e-12)
+    coef = 0.1 * p.pts.rho[0] * p.pts.c[0] * a * a / 4.0
+    assert number == pytest.approx(64.0 * coef * dt / p.el.m[0], rel=1e-12)

@@ -35,7 +35,7 @@ LB_ = 138  #: 9 rows: sum_I v_iI dV/dx_jI [m^3/s]
 M_ = 147  #: 9 rows: hourglass share M_ij = sum_a Q_ai h_aj / V [Pa]
 QA_ = 156  #: 12 rows: hourglass generalised forces (a, k) -> QA_ + 3 a + k [N]
 GM_ = 168  #: 32 rows: hourglass shape vectors gamma_aI -> GM_ + 8 a + I
-ROW_ = 200  #: a Gershgorin row sum of their Gram matrix
+ROW_ = 200  #: the largest Gershgorin row sum of their Gram matrix so far
 LAM_ = 201  #: the bound of the Gram matrix's largest eigenvalue the step takes
 TR_ = 202  #: the Gram matrix's trace
 MMIN_ = 203  #: the smallest mass of the element's nodes [kg]

@@ -102,12 +102,15 @@ sums :math:`\max_\alpha \sum_\beta |G_{\alpha\beta}|` (:func:`hourglass_bound`),
 orthogonal), and the bound is 2.3 times the element step at
 :math:`Q_{hg} = 0.1` for a lone cube (more for a node shared by several
 elements): it does not act. In an element distorted towards its hourglass
-modes (a crushed or strongly dilated one: :math:`\sum_I\gamma_{\alpha I}^2`
-grew from 8 to 64 in the Forrestal target, docs/validation.md) :math:`\lambda`
-grows with the distortion and the bound takes over; without it such an
-element's hourglass mode grew by about 1.4 times per step. The element step is the
+modes (a crushed or strongly dilated one: the Gram matrix's trace grew from
+32 to 213 in the Forrestal target, docs/validation.md) :math:`\lambda` grows
+with the distortion and the bound takes over; without it such an element's
+hourglass mode grew by about 1.4 times per step. The element step is the
 smaller of the two (LS-DYNA's element step has no hourglass term; it deletes
-such elements through its erosion criteria instead).
+such elements through its erosion criteria instead). That mode grew at
+:math:`\Delta t\, a_h\lambda/m` = 1.2-1.6, under the damping's own limit:
+in a distorted element the damping and the stiff modes act together, and
+the two limits taken apart are not yet their joint one (docs/theory.md).
 """
 
 from __future__ import annotations
@@ -318,8 +321,9 @@ def hourglass_bound(xl, g, V, gam, coef, m_min, hg_form, dt_element):
     the smaller of the trace and :func:`hourglass_gram_bound` (Gershgorin; it
     can exceed the trace, and both bound :math:`\lambda_{max}`). The trace
     alone decides for most elements (an undistorted cube's trace 32 against
-    its Gershgorin bound 8: its step is still above the element step wherever
-    a node is shared), so the Gram matrix is formed only where it may act.
+    its Gershgorin bound 8: at Q_hg = 0.1 its step is still above the element
+    step unless a node belongs to fewer than four elements, on a mesh's edges
+    and corners), so the Gram matrix is formed only where it may act.
     Arguments as :func:`hourglass_gram_bound` and :func:`hourglass_step`."""
     nm, nen = gam.shape
     inv_v = 1.0 / V
@@ -388,7 +392,7 @@ def hourglass_step(lam, coef, m_min, hg_form):
     r"""Stable step of an element's hourglass control [s] (module docstring):
     viscous :math:`2 m / (a_h\lambda)`, stiffness :math:`2\sqrt{m / (k_h
     \lambda)}`; ``inf`` without hourglass control (``coef`` <= 0). ``lam`` the
-    bound of :func:`hourglass_gram_bound`, ``coef`` :math:`a_h` [kg/s] or
+    bound of :func:`hourglass_bound`, ``coef`` :math:`a_h` [kg/s] or
     :math:`k_h` [N/m], ``m_min`` the smallest mass of the element's nodes
     [kg]."""
     if coef <= 0.0 or lam <= 0.0:
