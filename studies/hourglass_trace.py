@@ -10,8 +10,9 @@ shape vectors (``nen`` x modes for an undistorted element: 32 for a hex8)
 and the stability number of its viscous hourglass force, ``dt a_h
 lambda_max / m`` (the largest eigenvalue of ``M^-1/2 C M^-1/2`` of the
 element's own hourglass damping matrix with its nodes' masses, times the
-step: the explicit update of a mode is stable below 2; docs/theory.md,
-"The hourglass control's own step"); and, for every element eroded in the
+step: the explicit update of a mode is stable below 2 without the
+element's own stiffness; docs/theory.md, "The element step with the
+hourglass control"); and, for every element eroded in the
 step, its points' work and its hourglass work, and the internal energy of
 the particles it became.
 
@@ -25,9 +26,9 @@ This found why the Forrestal target made energy (docs/validation.md):
 
 both with the code of 289a237, before the hourglass step (``git worktree add
 OLD 289a237``, then ``PYTHONPATH=OLD/src`` for both commands); and the full
-version's eroded elements carrying their hourglass work, with today's code
-(``--set run.t_end="178 us" --set output.checkpoint_every=200`` on the deck
-as it stands, then ``--steps 20``).
+version's eroded elements carrying their hourglass work, with the code of
+e4213d4 (the two limits taken apart; ``--set run.t_end="178 us" --set
+output.checkpoint_every=200`` on the deck, then ``--steps 20``).
 """
 
 from __future__ import annotations

@@ -295,10 +295,11 @@ def test_bulk_viscosity_pressure_and_heat_match_their_formula():
 
 def test_stable_step_of_a_cube_and_of_the_bound():
     """Cube at rest: dt = 0.9 l / (Q + sqrt(Q^2 + c^2)), l = a / sqrt 3,
-    Q = Q2 c; compressed at the rate r: Q = Q2 c + Q1 l |r|."""
+    Q = Q2 c; compressed at the rate r: Q = Q2 c + Q1 l |r| (without
+    hourglass control, whose terms the step takes too: the test above)."""
     a = 0.01
     x, cells = block([0, 0, 0], [a, a, a], (1, 1, 1), 3)
-    p = part(x, cells, 3)
+    p = part(x, cells, 3, hourglass_coefficient=0.0)
     c = p.pts.c[0]
     Q = 0.06 * c
     dt, k = p.stable_dt()
@@ -539,9 +540,8 @@ def test_simd_sqrt_is_the_ieee_square_root():
 def hourglass_bound_by_hand(x, gam, dim):
     """The smaller of the trace and Gershgorin's bound of the Gram matrix of
     the Flanagan-Belytschko shape vectors of one element (node coordinates
-    ``x`` (nen, 3)), formed with NumPy from the volume derivatives (the bound
-    the step takes where the trace's step would act); also the Gram matrix's
-    largest eigenvalue and its trace."""
+    ``x`` (nen, 3)), formed with NumPy from the volume derivatives; also the
+    Gram matrix's largest eigenvalue and its trace."""
     g = np.zeros((x.shape[0], 3))
     V = volume_gradient(x - x[0], dim, volume_table(dim), g)
     h = gam @ (x - x[0]) / V  # (modes, 3)
@@ -551,30 +551,104 @@ def hourglass_bound_by_hand(x, gam, dim):
     return bound, np.linalg.eigvalsh(gram).max(), V, g, np.trace(gram)
 
 
+def damped_oscillator_step(A, omega2):
+    """The central-difference limit 2 / (A + sqrt(A^2 + omega^2)) of
+    u'' + 2 A u' + omega^2 u = 0 (Belytschko, Liu & Moran 2000, sec. 6.2)."""
+    return 2.0 / (A + math.sqrt(A * A + omega2))
+
+
+def joint_step_by_hand(g, V, c, rho, m, lam, qh, form, dim, q2=0.06):
+    """An element's step with its hourglass terms, from the formulas of the
+    module docstring of sphdyn.parts.fem.solid written out here: element
+    A = 2 q2 c / ell, omega^2 = 4 c^2 / ell^2, ell = 2 / sqrt(nen sum b^2)
+    (no compression); viscous a_h = qh rho c V^((d-1)/d) / 4 adds
+    a_h lam / (2 m) to A, stiffness k_h = qh rho c^2 sum g^2 / (V d) adds
+    k_h lam / m to omega^2. Returns it and the element's own step."""
+    nen = g.shape[0]
+    ell = 2.0 / math.sqrt(nen * np.sum((g / V) ** 2))
+    A, w2 = 2 * q2 * c / ell, 4 * c * c / ell ** 2
+    if form == "viscous":
+        A_h, w2_h = qh * rho * c * V ** ((dim - 1) / dim) / 4 * lam / (2 * m), 0.0
+    else:
+        A_h, w2_h = 0.0, qh * rho * c * c * np.sum(g * g) / (V * dim) * lam / m
+    return damped_oscillator_step(A + A_h, w2 + w2_h), damped_oscillator_step(A, w2)
+
+
+@pytest.mark.parametrize("A, omega", [(0.0, 1.0), (1.0, 0.0), (0.3, 2.0), (5.0, 1.0),
+                                      (0.06, 2.0)])
+def test_the_damped_oscillator_limit_is_the_stability_edge_of_the_scheme(A, omega):
+    """The velocity-lagged central difference the parts step with (v^(n+1/2) =
+    v^(n-1/2) + dt (-omega^2 u^n - 2 A v^(n-1/2)), u^(n+1) = u^n + dt
+    v^(n+1/2): the damping force of the viscous hourglass control and the
+    linear bulk viscosity on the last half-step's velocity) has its
+    amplification matrix's spectral radius <= 1 at 0.999 of
+    2 / (A + sqrt(A^2 + omega^2)) and > 1 at 1.001 of it: the formula the
+    element step takes (sphdyn.parts.fem.solid.element_step) is the edge,
+    neither safe by a margin nor past it."""
+    dt0 = damped_oscillator_step(A, omega ** 2)
+
+    def radius(dt):
+        M = np.array([[1 - dt * dt * omega ** 2, dt * (1 - 2 * A * dt)],
+                      [-omega ** 2 * dt, 1 - 2 * A * dt]])
+        return np.abs(np.linalg.eigvals(M)).max()
+
+    assert radius(0.999 * dt0) <= 1.0 + 1e-12
+    assert radius(1.001 * dt0) > 1.0 + 1e-4
+
+
+def test_element_step_with_hourglass_terms_is_the_damped_oscillator_limit():
+    """sphdyn.parts.fem.solid.element_step with the terms a_h, w2_h equals
+    2 / (A + sqrt(A^2 + omega^2)) with A = 2 Q / ell + a_h, omega^2 = 4 c^2 /
+    ell^2 + w2_h (rel. 1e-14: the same formula rearranged), Q = q2 c + q1 ell
+    |dkk| in compression; with both 0 its bits are those of ell / (Q +
+    sqrt(Q^2 + c^2))."""
+    from sphdyn.parts.fem.solid import element_step
+
+    ell, c, q1, q2 = 0.01, 3000.0, 1.5, 0.06
+    for dkk in (0.0, -2e4, 3e3):
+        Q = q2 * c + (q1 * ell * -dkk if dkk < 0 else 0.0)
+        assert element_step(ell, c, dkk, q1, q2, 0.0, 0.0) == ell / (Q + math.sqrt(Q * Q + c * c))
+        for a_h, w2_h in ((1e5, 0.0), (0.0, 3e11), (4e4, 1e10)):
+            want = damped_oscillator_step(2 * Q / ell + a_h, 4 * c * c / ell ** 2 + w2_h)
+            got = element_step(ell, c, dkk, q1, q2, a_h, w2_h)
+            assert got == pytest.approx(want, rel=1e-14)
+            assert got < element_step(ell, c, dkk, q1, q2, 0.0, 0.0)
+
+
 @pytest.mark.parametrize("dim", [2, 3])
 @pytest.mark.parametrize("form", ["viscous", "stiffness"])
-def test_an_element_distorted_into_its_hourglass_shape_takes_the_hourglass_step(dim, form):
+def test_an_element_distorted_into_its_hourglass_shape_takes_the_joint_step(dim, form):
     """An element whose nodes are moved by 0.8 of its side along its first
     hourglass mode (x_I += 0.8 a Gamma_1I e_x, the shape a crushed element of
-    the Forrestal target took), beside an undistorted one: its step is the hourglass control's
-    (module docstring of sphdyn.parts.fem.solid), 2 m / (a_h lambda) (viscous)
-    or 2 sqrt(m / (k_h lambda)) (stiffness) with m the smallest node mass and
-    lambda the smaller of the trace and Gershgorin's bound of the shape
-    vectors' Gram matrix formed here with NumPy (rel. 1e-12: the same
-    formula, other operation order), smaller
-    than the element step (at Q_hg = 1, so that it acts in all four cases; at
-    0.1 it does here for the viscous hex only); the bound is at least the Gram
-    matrix's largest eigenvalue. An undistorted cube: lambda = 2^d exactly (orthogonal base
-    vectors) and its own element step, 2.3x (3D; 7.5x in 2D) below the bound
-    at Q_hg = 0.1 (viscous)."""
-    a, qh = 0.1, 1.0  # (at 0.1 the bound acts here for the viscous hex only)
+    the Forrestal target took), beside an undistorted one: its step is the
+    damped oscillator's limit with the hourglass control's damping (viscous)
+    or stiffness (stiffness form) added to the element's
+    (:func:`joint_step_by_hand`), m the smallest node mass and lambda the
+    smaller of the trace and Gershgorin's bound of the shape vectors' Gram
+    matrix formed here with NumPy (rel. 1e-12: the same formula, other
+    operation order), and at Q_hg = 1 far below the element's own step; the
+    bound is at least the Gram matrix's largest eigenvalue. An undistorted
+    cube: lambda = 2^d exactly (orthogonal base vectors), its step the joint
+    one too; at Q_hg = 0.1, viscous, a lone cube (each node an eighth of its
+    mass) steps 20.3 % below its element step, a cube inside a mesh (each
+    node the mass of one element) 2.84 % (a square: 6.8 and 1.75 %): the
+    module docstring's numbers."""
+    a, qh = 0.1, 1.0
     gam = hourglass_vectors(dim)
     x, cells = block([0, 0, 0], [a, a, a], (1, 1, 1)[:dim], dim)
     cube = part(x.copy(), cells, dim, hourglass=form, hourglass_coefficient=qh)
     lam, eig, V, g, trace = hourglass_bound_by_hand(x[cells[0]], gam, dim)
     assert lam == 2 ** dim and eig == pytest.approx(2 ** dim, rel=1e-12)
     assert trace == 2 ** dim * gam.shape[0]  # the trace alone: 4x too high (hex)
-    dt_cube = cube.el.dt_el[0]
+    rho, c = cube.pts.rho[0], cube.pts.c[0]
+    want, own = joint_step_by_hand(g, V, c, rho, cube.nodes.m.min(), lam, qh, form, dim)
+    assert cube.el.dt_el[0] == pytest.approx(want, rel=1e-12)
+    if form == "viscous":
+        m_el = rho * V
+        drops = {3: (0.203, 0.0284), 2: (0.068, 0.0175)}[dim]
+        for m, drop in zip((m_el / 2 ** dim, m_el), drops):
+            w, o = joint_step_by_hand(g, V, c, rho, m, lam, 0.1, form, dim)
+            assert 1 - w / o == pytest.approx(drop, abs=0.001)
     # two elements side by side, the first distorted: its nodes' masses differ
     x, cells = block([0, 0, 0], [2 * a, a, a], (2, 1, 1)[:dim], dim)
     x[cells[0], 0] += 0.8 * a * gam[0]
@@ -585,47 +659,47 @@ def test_an_element_distorted_into_its_hourglass_shape_takes_the_hourglass_step(
     assert lam >= eig > 1.5 * 2 ** dim  # distorted: larger than the cube's
     m_nodes = p.nodes.m[cells[0]]
     assert m_nodes.max() > 1.5 * m_nodes.min()  # the smallest is the one taken
-    rho, c, m = p.pts.rho[0], p.pts.c[0], m_nodes.min()
-    if form == "viscous":
-        coef = qh * rho * c * V ** ((dim - 1) / dim) / 4
-        expected = 2 * m / (coef * lam)
-    else:
-        coef = qh * rho * c * c * np.sum(g * g) / (V * dim)
-        expected = 2 * math.sqrt(m / (coef * lam))
-    assert p.el.dt_el[0] == pytest.approx(expected, rel=1e-12)
-    # the element's own step (the cube's scaled by its shorter length) is larger
-    assert expected < dt_cube
-    if form == "viscous":  # the cube's own step is 2.3x under its bound at Q_hg 0.1
-        coef = 0.1 * rho * c * a ** (dim - 1) / 4
-        assert 2 * (rho * a ** dim / 2 ** dim) / (coef * 2 ** dim) > 2.2 * dt_cube
+    rho, c = p.pts.rho[0], p.pts.c[0]
+    want, own = joint_step_by_hand(g, V, c, rho, m_nodes.min(), lam, qh, form, dim)
+    assert p.el.dt_el[0] == pytest.approx(want, rel=1e-12)
+    assert want < 0.5 * own
+    # the diagnosis of a step collapse names the share the hourglass terms took
+    import re
+    share = re.search(r"its step ([0-9.e+-]+) of what it would be without the hourglass "
+                      r"control's terms \(shape vectors' Gram bound ([0-9.e+-]+), "
+                      rf"{2 ** dim} undistorted", p.describe_limit(0))
+    assert float(share[1]) == pytest.approx(want / own, rel=5e-3)  # 3 digits: < 0.5 %
+    assert float(share[2]) == pytest.approx(lam, rel=5e-3)
+    # the same step from the volumes pass (setup and restart) as from the force pass
+    forces_step = p.el.dt_el.copy()
+    p._element_geometry()
+    assert np.array_equal(p.el.dt_el, forces_step)
 
 
-def test_the_hourglass_bound_is_the_trace_or_the_smaller_of_trace_and_gershgorin():
+def test_the_hourglass_bound_and_rates():
     """sphdyn.parts.fem.solid.hourglass_bound on shape vectors given directly
-    (node coordinates at zero, so gamma = the rows passed): where the trace's
-    step is at least the element step it returns the trace; below, the
-    smaller of the trace and Gershgorin's row sums. Undistorted hex modes:
-    trace 32, Gershgorin 8 (exact). Four modes a0 and three times a0/2:
-    Gram [[1, 1/2, 1/2, 1/2], [1/2, 1/4, ...]], trace 1.75, Gershgorin's
-    largest row 2.5, so the trace is the smaller. hourglass_step: 2 m /
-    (a_h lambda) viscous, 2 sqrt(m / (k_h lambda)) stiffness, inf without
-    control."""
+    (node coordinates at zero, so gamma = the rows passed) is the smaller of
+    the trace and Gershgorin's row sums. Undistorted hex modes: trace 32,
+    Gershgorin 8 (exact). Four modes a0 and three times a0/2: Gram [[1, 1/2,
+    1/2, 1/2], [1/2, 1/4, ...]], trace 1.75, Gershgorin's largest row 2.5, so
+    the trace is the smaller. hourglass_rates: (a_h lambda / (2 m), 0)
+    viscous, (0, k_h lambda / m) stiffness, (0, 0) without control."""
     from sphdyn.parts.fem.solid import (HG_STIFFNESS, HG_VISCOUS, hourglass_bound,
-                                        hourglass_step)
+                                        hourglass_rates)
 
     xl, g = np.zeros((8, 3)), np.ones((8, 3))
     gam = hourglass_vectors(3)
-    coef, m = 2.0, 3.0  # the trace's step: 2 m / (coef 32) = 0.09375
-    assert hourglass_step(32.0, coef, m, HG_VISCOUS) == pytest.approx(0.09375, rel=1e-15)
-    assert hourglass_bound(xl, g, 1.0, gam, coef, m, HG_VISCOUS, 0.09) == 32.0
-    assert hourglass_bound(xl, g, 1.0, gam, coef, m, HG_VISCOUS, 0.1) == 8.0
+    assert hourglass_bound(xl, g, 1.0, gam) == 8.0
     a0 = np.zeros(8)
     a0[0] = 1.0
     skew = np.array([a0, 0.5 * a0, 0.5 * a0, 0.5 * a0])
-    assert hourglass_bound(xl, g, 1.0, skew, coef, m, HG_VISCOUS, 1e9) == 1.75
-    assert hourglass_step(8.0, coef, m, HG_STIFFNESS) == pytest.approx(
-        2.0 * math.sqrt(m / (coef * 8.0)), rel=1e-15)
-    assert hourglass_step(8.0, 0.0, m, HG_VISCOUS) == np.inf
+    assert hourglass_bound(xl, g, 1.0, skew) == 1.75
+    coef, m = 2.0, 3.0
+    assert hourglass_rates(8.0, coef, m, HG_VISCOUS) == (pytest.approx(8.0 / 3.0, rel=1e-15),
+                                                         0.0)
+    assert hourglass_rates(8.0, coef, m, HG_STIFFNESS) == (0.0, pytest.approx(16.0 / 3.0,
+                                                                                rel=1e-15))
+    assert hourglass_rates(8.0, 0.0, m, HG_VISCOUS) == (0.0, 0.0)
 
 
 @pytest.mark.parametrize("height, qh", [(1.0, 0.1), (0.1, 0.1), (0.02, 0.1), (1.0, 0.15),
@@ -641,9 +715,10 @@ def test_a_crushed_warped_hex_loses_its_hourglass_mode_at_its_own_step(height, q
     explicit viscous term multiplies the mode by |1 - k| per step, k = 8 coef
     dt / m_I = 16 Q_hg c dt / V^(1/3) = 8.3 Q_hg for a cube at the element
     step and CFL 0.9 (k = 2, the limit, at Q_hg = 0.24): at 0.15 the cube
-    still loses its mode at the element step; at 0.3 the hourglass control's
-    own step is the smaller (k = 2 x 0.9 at CFL 0.9) and it loses it too (it
-    grew to 9 m/s in 12 steps at the element step, before the hourglass step). The
+    still loses its mode at the element step; at 0.3 the step with the
+    hourglass control's damping in it (k < 2 x 0.9 at CFL 0.9) loses it too
+    (it grew to 9 m/s in 12 steps at the element step, before the hourglass
+    control's terms were in the step). The
     deck still takes Q_hg <= 0.15 (LS-DYNA's advice for its viscous forms)."""
     a = 2e-3
     x, cells = block([0, 0, 0], [a, a, a], (1, 1, 1), 3)

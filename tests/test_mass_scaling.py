@@ -236,17 +236,33 @@ vtk = false
 
 
 def test_every_hexahedron_scaled_gives_its_nodes_its_share():
-    """Target 1.5 times the mesh's step: g = 1.5 on every element, so every
-    node takes 1.25 times its own mass (its elements' 1/8 shares, 1e-12)."""
-    plain = build_stepper(loads_deck(BLOCK.format(materials=STEEL, scaling="")))
-    target = 1.5 * plain.dt0
-    st = build_stepper(loads_deck(BLOCK.format(materials=STEEL,
-                                               scaling=_scaling(f"{target!r} s",
-                                                                "max_added = 2"))))
-    q = st.part("block").kin
-    assert st.dt0 == pytest.approx(target, rel=1e-12)
-    assert np.allclose(st.part("block").el.dt_mass, 1.5, rtol=1e-12)
-    assert np.allclose(q.m_added, 1.25 * q.m, rtol=1e-12)
+    """Target 1.5 times the mesh's step: each element takes g_e = target /
+    (C dt_e) (1.5 on the controlling ones; its step includes the hourglass
+    control's terms, which differ between the block's corner and inner
+    elements), and each node (g_e^2 - 1) m_e / 8 from each of its elements
+    (1e-12); with the same g on every element (hourglass control off: a
+    regular block's elements then share one step) every node takes 1.25
+    times its own mass."""
+    for hourglass in ("", "hourglass_coefficient = 0.0\n"):
+        text = BLOCK.replace('velocity = ["1 m/s", 0, 0]\n',
+                             'velocity = ["1 m/s", 0, 0]\n' + hourglass)
+        plain = build_stepper(loads_deck(text.format(materials=STEEL, scaling="")))
+        target = 1.5 * plain.dt0
+        st = build_stepper(loads_deck(text.format(materials=STEEL, scaling=_scaling(
+            f"{target!r} s", "max_added = 2"))))
+        part, p0 = st.part("block"), plain.part("block")
+        q, el = part.kin, part.el
+        assert st.dt0 == pytest.approx(target, rel=1e-12)
+        g = np.maximum(target / (p0.s.cfl * p0.el.dt_el), 1.0)
+        assert np.allclose(el.dt_mass, g, rtol=1e-12) and g.max() == pytest.approx(1.5)
+        share = np.zeros(q.n)
+        np.add.at(share, el.conn.ravel(), np.repeat((g * g - 1.0) * el.m / 8, 8))
+        assert np.allclose(q.m_added, share, rtol=1e-12)
+        if hourglass:
+            assert np.allclose(g, 1.5, rtol=1e-12)
+            assert np.allclose(q.m_added, 1.25 * q.m, rtol=1e-12)
+        else:
+            assert g.min() < 1.45  # the inner elements' steps are longer
 
 
 # --------------------------------------------------------------- slaves

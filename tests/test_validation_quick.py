@@ -47,6 +47,7 @@ REL_FLOOR = {"umax": 0.01, "peak_load": 0.01}
 #: every step) moved by one ulp
 PERTURB = {
     "leppanen2004_fragment": "body.fragment.velocity.2=-1879.0000000000002",
+    "forrestal1994_ogive": "body.projectile.velocity.2=-277.00000000000006",
     "lozano2017_dropweight_2.5m": "mesh.rod.velocity.2=-6.900000000000001",
     "lozano2017_dropweight_5.0m": "mesh.rod.velocity.2=-9.800000000000002",
     "lozano2017_dropweight_fem_2.5m": "mesh.rod.velocity.2=-6.900000000000001",

@@ -363,7 +363,8 @@ def _bounce(halve: bool):
     """An elastic cube of 2 x 2 x 2 hexahedra (20 mm, 2400 kg/m^3, 30 GPa)
     dropped at 5 m/s on a mass-spring wall (eq. 8, alpha 0.1), its step
     halved while in contact when ``halve``; run until it has left the wall
-    and 200 steps more. Returns (initial kinetic energy, final record)."""
+    and 200 steps more. Returns (initial kinetic energy, final record, the
+    mean of E_total over the 200 steps)."""
     from sphdyn.geometry.mesh import block_mesh
     from sphdyn.materials import get_model
     from sphdyn.parts.fem import solid_part
@@ -387,9 +388,11 @@ def _bounce(halve: bool):
         if touched and wall.count == 0 and part.nodes.v[:, 2].mean() > 0.0:
             break
     assert touched and wall.count == 0
+    totals = []
     for _ in range(200):
         s.step()
-    return e0, s.record()
+        totals.append(s.record()["E_total"])
+    return e0, s.record(), float(np.mean(totals))
 
 
 def test_a_bounce_with_the_step_halved_under_load_makes_no_energy():
@@ -400,14 +403,17 @@ def test_a_bounce_with_the_step_halved_under_load_makes_no_energy():
     halved while in contact (the springs' k x4 under load) the energy rule
     keeps it from making energy: E_contact >= 0 (measured +1.7e-2 E0; without
     the rule -6e-3 E0, energy made, measured before issue 57 gave every node
-    of the face the same thickness). E_total closes either way (1e-2), as it
-    books the contact's work, so the sign of E_contact is what tells. (The
+    of the face the same thickness). E_total closes either way (its mean
+    over the 200 steps after the bounce within 1e-2; measured 2e-3 and
+    3.5e-3), as it books the contact's work, so the sign of E_contact is what
+    tells; a single record swings by up to 6 % in the halved case, the
+    kinetic energy being taken at the last kick while the cube rings. (The
     whole face now meets the wall in one step, so the sign at a constant step
     depends on where in the step it does: -4e-3 with the cube 0.3 mm
     higher; the cube starts where it is +2.3e-3. The bound 3e-2 on what the
     contact takes: the rule gives up what a stiffer spring cannot keep, 1.7e-2
     here with the whole face in one phase.)"""
     for halve in (False, True):
-        e0, rec = _bounce(halve)
+        e0, rec, total = _bounce(halve)
         assert 0.0 <= rec["E_contact"] < 3e-2 * e0
-        assert abs(rec["E_total"] - e0) < 1e-2 * e0
+        assert abs(total - e0) < 1e-2 * e0

@@ -204,6 +204,43 @@ register(Case(
 ))
 
 
+# --------------------------------------------------------------------------
+# Forrestal et al. (1994): an ogive-nose steel projectile into plain concrete
+# --------------------------------------------------------------------------
+
+FORRESTAL = "forrestal1994_ogive_penetration.csv"
+
+
+def _forrestal_references(data_dir: Path) -> list[Reference]:
+    row = data.read(data_dir / FORRESTAL).row(v_s_m_per_s="277")
+    return [Reference("dop", "depth of penetration", "mm", data.number(row, "dop_m"),
+                      data.number(row, "dop_m"), data.number(row, "dop_m"),
+                      f"{FORRESTAL}: the 277 m/s shot (Leppanen 2002, Table 6.2, p. 55)",
+                      scatter="one shot")]
+
+
+def _forrestal_measure(run: Path, deck: dict) -> dict[str, float]:
+    dx = _named(deck["body"], "projectile")["dx"]
+    return {"dop": depth_of_penetration(run, "projectile", face=0.0, dx=dx)}
+
+
+register(Case(
+    name="forrestal1994_ogive",
+    title="Ogive-nose steel projectile (0.906 kg, 26.9 mm) at 277 m/s into plain "
+          "concrete (Forrestal et al. 1994)",
+    deck="validation/cases/forrestal1994_ogive.toml",
+    # the quick target's elements are 15 mm (6 mm in the full one), the
+    # projectile's particles 6.7 mm (4 across; 2.69 mm, 10 across); the
+    # crushed-element rule keeps its fraction of the initial step (150 ns x
+    # 15 / 6)
+    quick=("mesh.target.block.divisions=[20,20,24]", "body.projectile.dx=0.006725",
+           "material.concrete.erosion.min_time_step=3.75e-07"),
+    references=_forrestal_references,
+    measure=_forrestal_measure,
+    mesh="target",
+))
+
+
 _BARS = tuple(f"mesh.bar_{b}.line.element_length=0.01" for b in ("b1", "b2", "t1", "t2"))
 #: the drop-weight beams' variants: (name's infix, the concrete's words in the
 #: title, deck, quick overrides). The concrete as particles; or meshed (hex8,

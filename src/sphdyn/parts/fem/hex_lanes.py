@@ -31,11 +31,12 @@ from numba import njit, prange
 
 from ...geometry.shapes import hourglass_vectors
 from .hex_gradient import hex_volume_gradient_lanes
-from .lane_layout import (C_, COEF_, DKK_, DT_, F_, FACE_, G_, GM_, HEAT_, HG_, INV_, INVV_, L_,
-                          LAM_, LANES, LB_, M_, MMIN_, POWER_, Q_, QA_, RHO_, ROW_, ROWS, SIG_, TR_,
-                          VN_, VOL_, X_)
+from .lane_layout import (C_, COEF_, DKK_, DT_, ELL_, F_, FACE_, G_, GM_, HEAT_, HG_, INV_, INVV_,
+                          L_, LAM_, LANES, LB_, M_, MMIN_, POWER_, Q_, QA_, RHO_, ROW_, ROWS, SIG_,
+                          TR_, VN_, VOL_, X_)
 from .solid import (HG_VISCOUS, block_count, block_span, bulk_viscosity, element_step,
-                     hourglass_step, length_from_gradient, smallest_node_mass)
+                     hourglass_coefficient, hourglass_face, hourglass_rates,
+                     length_from_gradient, smallest_node_mass)
 
 #: hourglass base vectors (4, 8) of the hex8, a compile-time constant
 GAMMA = hourglass_vectors(3)
@@ -130,7 +131,7 @@ def gather_fields(sig, L, rho, c, hg, lo, nl, stiffness, m_node, conn, S):
         S[RHO_ * LANES + l] = rho[e]
         S[C_ * LANES + l] = c[e]
         if not stiffness:  # V^(2/3) of the viscous form (a libm call: only if used)
-            S[FACE_ * LANES + l] = np.cbrt(S[VOL_ * LANES + l]) ** 2
+            S[FACE_ * LANES + l] = hourglass_face(S[VOL_ * LANES + l], 3)
         else:
             for a in range(4):
                 for k in range(3):
@@ -162,15 +163,12 @@ def force_lanes(S, hg_form, qh, q1, q2, dt):
             g2 = S[(G_ + 3 * I + 2) * LANES + l]
             bb += g0 * g0 + g1 * g1 + g2 * g2
         ell = length_from_gradient(V, 8, bb)
-        S[DT_ * LANES + l] = element_step(ell, c, dkk, q1, q2)
+        S[ELL_ * LANES + l] = ell
         q = bulk_viscosity(rho, c, ell, dkk, q1, q2)
         S[Q_ * LANES + l] = q
         S[HEAT_ * LANES + l] = -dt * q * dkk / rho if q > 0.0 and rho > 0.0 else 0.0
         hourglass = qh > 0.0 and V > 0.0
-        if hg_form == HG_VISCOUS:
-            coef = qh * rho * c * S[FACE_ * LANES + l] / 4.0
-        else:
-            coef = qh * rho * c * c * bb / (V * 3)
+        coef = hourglass_coefficient(hg_form, qh, rho, c, S[FACE_ * LANES + l], bb, V, 3)
         S[COEF_ * LANES + l] = coef if hourglass else 0.0
         S[INVV_ * LANES + l] = 1.0 / V if hourglass else 0.0
         S[POWER_ * LANES + l] = 0.0
@@ -235,30 +233,26 @@ def force_lanes(S, hg_form, qh, q1, q2, dt):
             S[(M_ + 6) * LANES + l] += Q2 * h0
             S[(M_ + 7) * LANES + l] += Q2 * h1
             S[(M_ + 8) * LANES + l] += Q2 * h2
-    # .solid.hourglass_bound: the trace, or where its step is below the element
-    # step, the smaller of it and Gershgorin's max_a sum_b |sum_I gamma_aI gamma_bI|
-    need = False
+    # .solid.hourglass_bound: the smaller of the trace and Gershgorin's
+    # max_a sum_b |sum_I gamma_aI gamma_bI|, then the element step with the
+    # hourglass control's terms (.solid.hourglass_rates, .solid.element_step)
     for l in range(LANES):
-        S[LAM_ * LANES + l] = S[TR_ * LANES + l]
-        need |= hourglass_step(S[TR_ * LANES + l], S[COEF_ * LANES + l],
-                               S[MMIN_ * LANES + l], hg_form) < S[DT_ * LANES + l]
-    if need:  # (rarely: a group with a strongly distorted element, or a corner)
+        S[ROW_ * LANES + l] = 0.0  # the largest row sum so far
+    for a in range(4 if qh > 0.0 else 0):
         for l in range(LANES):
-            S[ROW_ * LANES + l] = 0.0  # the largest row sum so far
-        for a in range(4):
-            for l in range(LANES):
-                row = 0.0
-                for b in range(4):
-                    s = 0.0
-                    for I in range(8):
-                        s += S[(GM_ + 8 * a + I) * LANES + l] * S[(GM_ + 8 * b + I) * LANES + l]
-                    row += abs(s)
-                S[ROW_ * LANES + l] = max(S[ROW_ * LANES + l], row)
-        for l in range(LANES):
-            tr = S[TR_ * LANES + l]
-            if hourglass_step(tr, S[COEF_ * LANES + l], S[MMIN_ * LANES + l],
-                              hg_form) < S[DT_ * LANES + l]:
-                S[LAM_ * LANES + l] = min(tr, S[ROW_ * LANES + l])
+            row = 0.0
+            for b in range(4):
+                s = 0.0
+                for I in range(8):
+                    s += S[(GM_ + 8 * a + I) * LANES + l] * S[(GM_ + 8 * b + I) * LANES + l]
+                row += abs(s)
+            S[ROW_ * LANES + l] = max(S[ROW_ * LANES + l], row)
+    for l in range(LANES):
+        lam = min(S[TR_ * LANES + l], S[ROW_ * LANES + l])
+        S[LAM_ * LANES + l] = lam
+        a_h, w2_h = hourglass_rates(lam, S[COEF_ * LANES + l], S[MMIN_ * LANES + l], hg_form)
+        S[DT_ * LANES + l] = element_step(S[ELL_ * LANES + l], S[C_ * LANES + l],
+                                          S[DKK_ * LANES + l], q1, q2, a_h, w2_h)
     # f_iI = -(sigma_ij - q delta_ij - M_ij / V) dV/dx_jI - sum_a Q_ai Gamma_aI
     for i in range(3):
         for j in range(3):
@@ -286,8 +280,8 @@ def hex_forces(x, v, conn, active, sig, L, rho, c, e_spec, e_av, hg_form, qh, hg
     at :math:`n+1` with ``vol`` and ``dt_el`` written on the way, bulk
     viscosity heating ``e_spec`` and ``e_av``, hourglass forces with their work
     in ``e_hg`` and the stiffness form's ``hg`` (E, 4, 3) updated; the
-    element step the smaller of the element's and its hourglass control's,
-    :func:`.solid.hourglass_step` with the node masses ``m_node`` (N,) [kg]).
+    element step with its hourglass control's terms,
+    :func:`.solid.hourglass_rates` with the node masses ``m_node`` (N,) [kg]).
     ``work``: :func:`lane_scratch`."""
     ne = conn.shape[0]
     stiffness = hg_form != HG_VISCOUS
@@ -310,9 +304,7 @@ def hex_forces(x, v, conn, active, sig, L, rho, c, e_spec, e_av, hg_form, qh, hg
                     continue
                 V = S[VOL_ * LANES + l]
                 vol[e] = V
-                dt_el[e] = min(S[DT_ * LANES + l],
-                               hourglass_step(S[LAM_ * LANES + l], S[COEF_ * LANES + l],
-                                              S[MMIN_ * LANES + l], hg_form))
+                dt_el[e] = S[DT_ * LANES + l]
                 if S[Q_ * LANES + l] > 0.0 and rho[e] > 0.0:
                     heat = S[HEAT_ * LANES + l]
                     e_spec[e] += heat

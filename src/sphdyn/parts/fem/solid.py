@@ -84,33 +84,41 @@ form with the bulk viscosity). For a cube of side a: :math:`\ell = a/\sqrt3`
 (the odd-even dilatational mode of a cube mesh has :math:`\omega^2 = 12K/\rho
 a^2`, which this bound covers for any Poisson ratio).
 
-**Stable step of the hourglass control** (:func:`hourglass_step`): the
+**Stable step with the hourglass control** (:func:`hourglass_rates`): the
 hourglass forces are explicit too. On the nodes of one element they act as
 :math:`\mathbf f = -\,a_h\, \Gamma^{\gamma T}\Gamma^{\gamma}\,\mathbf v` (viscous;
 :math:`k_h` on the displacements for the stiffness form), with
-:math:`\Gamma^\gamma` the shape vectors :math:`\gamma_{\alpha I}` above, so the
-central-difference update of a mode multiplies it by :math:`1 - \Delta t\,
-a_h \lambda / m` per step (viscous: stable for :math:`\Delta t \le 2m/(a_h
-\lambda)`) or is an oscillator of :math:`\omega^2 = k_h \lambda / m`
-(stiffness: :math:`\Delta t \le 2/\omega`), :math:`\lambda` the largest
-eigenvalue of the Gram matrix :math:`G_{\alpha\beta} = \sum_I
-\gamma_{\alpha I}\gamma_{\beta I}`, bounded by its trace and, where the
-trace's step would act, by the smaller of the trace and Gershgorin's row
-sums :math:`\max_\alpha \sum_\beta |G_{\alpha\beta}|` (:func:`hourglass_bound`), and
-:math:`m` the smallest mass of the element's nodes. For an undistorted element
-:math:`\gamma = \Gamma`, :math:`\lambda = n_{en}` (the base vectors are
-orthogonal), and the bound is 2.3 times the element step at
-:math:`Q_{hg} = 0.1` for a lone cube (more for a node shared by several
-elements): it does not act. In an element distorted towards its hourglass
-modes (a crushed or strongly dilated one: the Gram matrix's trace grew from
-32 to 213 in the Forrestal target, docs/validation.md) :math:`\lambda` grows
-with the distortion and the bound takes over; without it such an element's
-hourglass mode grew by about 1.4 times per step. The element step is the
-smaller of the two (LS-DYNA's element step has no hourglass term; it deletes
-such elements through its erosion criteria instead). That mode grew at
-:math:`\Delta t\, a_h\lambda/m` = 1.2-1.6, under the damping's own limit:
-in a distorted element the damping and the stiff modes act together, and
-the two limits taken apart are not yet their joint one (docs/theory.md).
+:math:`\Gamma^\gamma` the shape vectors :math:`\gamma_{\alpha I}` above: on
+a node of mass :math:`m` a damping rate :math:`2A_h = a_h\lambda/m` (viscous)
+or a stiffness :math:`\omega_h^2 = k_h\lambda/m`, :math:`\lambda` the largest
+eigenvalue of the Gram matrix :math:`G_{\alpha\beta} = \sum_I \gamma_{\alpha
+I}\gamma_{\beta I}`, bounded by the smaller of its trace and Gershgorin's row
+sums :math:`\max_\alpha \sum_\beta |G_{\alpha\beta}|` (:func:`hourglass_bound`),
+and :math:`m` the smallest mass of the element's nodes. The element's step
+is that of one damped oscillator :math:`\ddot u + 2A\dot u + \omega^2 u = 0`
+holding both: the central-difference limit :math:`\Delta t \le 2/(A +
+\sqrt{A^2 + \omega^2})` (Belytschko, Liu & Moran 2000, sec. 6.2: :math:`(2/\omega)
+(\sqrt{1+\xi^2} - \xi)` with :math:`A = \xi\omega`) with :math:`A = 2Q/\ell + A_h`,
+:math:`\omega^2 = 4c^2/\ell^2 + \omega_h^2`, which is the element step above
+with :math:`Q \to Q + A_h\ell/2`, :math:`c^2 \to c^2 + \omega_h^2\ell^2/4`
+(:func:`element_step`; a sum of stiffnesses' and of dampings' largest
+eigenvalues bounds those of their sums). Alone, the viscous term's limit is
+:math:`2m/(a_h\lambda)` (its update multiplies a mode by :math:`1 - \Delta
+t\,a_h\lambda/m`), the stiffness form's :math:`2\sqrt{m/(k_h\lambda)}`.
+For an undistorted element :math:`\gamma = \Gamma`, :math:`\lambda = n_{en}`
+(the base vectors are orthogonal, Gershgorin exact, the trace 4 times too
+high): at :math:`Q_{hg} = 0.1` the joint step is 2.8 % below the element's
+own inside a regular hex mesh (each node the mass of one element) and 20 %
+on a lone cube (each node an eighth; quads: 1.75 and 6.8 %). In an element distorted towards its
+hourglass modes (a crushed or strongly dilated one: the Gram matrix's trace
+grew from 32 to 213 in the Forrestal target, docs/validation.md) :math:`\lambda`
+grows with the distortion and the hourglass terms take over the step:
+without them such an element's hourglass mode grew by about 1.4 times per
+step, and with the two limits taken apart (the smaller of the element's and
+the hourglass term's alone) it still grew at :math:`\Delta t\,a_h\lambda/m`
+= 1.2-1.6, where the damping and the element's stiffness act together.
+LS-DYNA's element step has no hourglass term; it deletes such elements
+through its erosion criteria instead.
 """
 
 from __future__ import annotations
@@ -235,21 +243,31 @@ def block_scratch(n: int, nen: int, modes: int) -> np.ndarray:
 
 
 @njit(cache=True, error_model="numpy")
-def element_step(ell, c, dkk, q1, q2):
+def element_step(ell, c, dkk, q1, q2, a_h, w2_h):
     r"""Stable step :math:`\ell/(Q + \sqrt{Q^2 + c^2})` of one element [s] with
-    :math:`Q = Q_2 c + Q_1\ell|\dot\varepsilon_{kk}|` in compression (module
-    docstring; the factor ``cfl`` is applied by the part)."""
-    Q = q2 * c + (q1 * ell * -dkk if dkk < 0.0 else 0.0)
-    return ell / (Q + sqrt(Q * Q + c * c) + 1e-300)
+    :math:`Q = Q_2 c + Q_1\ell|\dot\varepsilon_{kk}|` in compression, and with
+    the hourglass control's damping rate ``a_h`` :math:`A_h` [1/s] and stiffness
+    ``w2_h`` :math:`\omega_h^2` [1/s^2] (:func:`hourglass_rates`; 0 without it):
+    :math:`Q + A_h\ell/2` and :math:`c^2 + \omega_h^2\ell^2/4` in their places,
+    the limit :math:`2/(A + \sqrt{A^2+\omega^2})` of the module docstring
+    (the same bits as the plain form where both are 0). ``ell`` [m], ``c``
+    [m/s], ``dkk`` the volumetric strain rate [1/s]; the factor ``cfl`` is
+    applied by the part."""
+    Q = q2 * c + (q1 * ell * -dkk if dkk < 0.0 else 0.0) + 0.5 * a_h * ell
+    c2 = c * c + 0.25 * w2_h * ell * ell
+    return ell / (Q + sqrt(Q * Q + c2) + 1e-300)
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def element_volumes(x, conn, active, dim, tab, c, L, ngp, q1, q2, vol, dt_el, work):
+def element_volumes(x, conn, active, dim, tab, c, L, rho, ngp, q1, q2, gam, hg_form, qh,
+                    m_node, vol, dt_el, work):
     r"""Volumes ``vol`` (E,) [m^3] at ``x`` and the element steps ``dt_el`` (E,) [s]
     of :func:`element_step` (the element's largest point wave speed ``c``
-    (P,), its first point's rate ``L`` (P, 3, 3)); the state a part needs
-    before its first force pass or after a restart. ``work``:
-    :func:`block_scratch`."""
+    (P,), its first point's rate ``L`` (P, 3, 3)) with the hourglass terms of
+    one-point elements (``ngp`` 1, ``qh`` > 0: density ``rho`` (P,), base
+    vectors ``gam``, node masses ``m_node`` (N,), as :func:`uniform_forces`);
+    the state a part needs before its first force pass or after a restart,
+    the same bits as the force pass's. ``work``: :func:`block_scratch`."""
     ne = conn.shape[0]
     nen = conn.shape[1]
     for b in prange(block_count(ne)):
@@ -258,14 +276,40 @@ def element_volumes(x, conn, active, dim, tab, c, L, ngp, q1, q2, vol, dt_el, wo
         lo, hi = block_span(b, ne)
         for e in range(lo, hi):
             local_coordinates(x, x, 0.0, conn, e, xl)
-            vol[e] = volume_gradient(xl, dim, tab, g)
+            V = volume_gradient(xl, dim, tab, g)
+            vol[e] = V
+            if not active[e]:
+                dt_el[e] = np.inf
+                continue
             ce = 0.0
             for j in range(ngp):
                 ce = max(ce, c[e * ngp + j])
             p = e * ngp
             dkk = L[p, 0, 0] + L[p, 1, 1] + L[p, 2, 2]
-            dt_el[e] = (element_step(char_length(g, vol[e]), ce, dkk, q1, q2)
-                        if active[e] else np.inf)
+            _, a_h, w2_h = element_hourglass_rates(xl, g, V, gam, hg_form,
+                                                   qh if ngp == 1 else 0.0, rho[p], ce, dim,
+                                                   m_node, conn, e)
+            dt_el[e] = element_step(char_length(g, V), ce, dkk, q1, q2, a_h, w2_h)
+
+
+@njit(cache=True, error_model="numpy")
+def element_hourglass_rates(xl, g, V, gam, hg_form, qh, rho, c, dim, m_node, conn, e):
+    """The hourglass coefficient (:func:`hourglass_coefficient`) and
+    :func:`hourglass_rates` of element ``e`` (coordinates ``xl``, volume
+    derivatives ``g`` (nen, 3), volume ``V``, density ``rho``, wave speed
+    ``c``, node masses ``m_node`` (N,)); (0, 0, 0) without hourglass control
+    (``qh`` 0) or at ``V`` <= 0."""
+    if not (qh > 0.0 and V > 0.0):
+        return 0.0, 0.0, 0.0
+    bb = 0.0
+    if hg_form != HG_VISCOUS:
+        for I in range(g.shape[0]):
+            bb += g[I, 0] ** 2 + g[I, 1] ** 2 + g[I, 2] ** 2
+    face = hourglass_face(V, dim) if hg_form == HG_VISCOUS else 0.0
+    coef = hourglass_coefficient(hg_form, qh, rho, c, face, bb, V, dim)
+    a_h, w2_h = hourglass_rates(hourglass_bound(xl, g, V, gam), coef,
+                                smallest_node_mass(m_node, conn, e), hg_form)
+    return coef, a_h, w2_h
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
@@ -313,18 +357,14 @@ def bulk_viscosity(rho, c, ell, dkk, q1, q2):
 
 
 @njit(cache=True, error_model="numpy")
-def hourglass_bound(xl, g, V, gam, coef, m_min, hg_form, dt_element):
-    r"""The bound :math:`\lambda` of :func:`hourglass_step`: the trace of the
-    Gram matrix of the shape vectors, :math:`\sum_{\alpha I}\gamma_{\alpha I}^2`
-    (:math:`\ge\lambda_{max}`, the matrix being positive semi-definite), or,
-    where the trace's step is below ``dt_element`` (the element step [s]),
-    the smaller of the trace and :func:`hourglass_gram_bound` (Gershgorin; it
-    can exceed the trace, and both bound :math:`\lambda_{max}`). The trace
-    alone decides for most elements (an undistorted cube's trace 32 against
-    its Gershgorin bound 8: at Q_hg = 0.1 its step is still above the element
-    step unless a node belongs to fewer than four elements, on a mesh's edges
-    and corners), so the Gram matrix is formed only where it may act.
-    Arguments as :func:`hourglass_gram_bound` and :func:`hourglass_step`."""
+def hourglass_bound(xl, g, V, gam):
+    r"""The bound :math:`\lambda` of :func:`hourglass_rates`: the smaller of the
+    trace of the Gram matrix of the shape vectors, :math:`\sum_{\alpha
+    I}\gamma_{\alpha I}^2` (:math:`\ge\lambda_{max}`, the matrix being positive
+    semi-definite), and :func:`hourglass_gram_bound` (Gershgorin; it can exceed
+    the trace, and both bound :math:`\lambda_{max}`; for an undistorted
+    element it is exact, :math:`n_{en}`, the trace 4 times that for a hex).
+    Arguments as :func:`hourglass_gram_bound`."""
     nm, nen = gam.shape
     inv_v = 1.0 / V
     tr = 0.0
@@ -332,8 +372,6 @@ def hourglass_bound(xl, g, V, gam, coef, m_min, hg_form, dt_element):
         for I in range(nen):
             gm = shape_vector(xl, g, inv_v, gam, a, I)
             tr += gm * gm
-    if hourglass_step(tr, coef, m_min, hg_form) >= dt_element:
-        return tr
     return min(tr, hourglass_gram_bound(xl, g, V, gam))
 
 
@@ -388,18 +426,40 @@ def hourglass_moment(xl, gam, a, inv_v):
 
 
 @njit(cache=True, error_model="numpy")
-def hourglass_step(lam, coef, m_min, hg_form):
-    r"""Stable step of an element's hourglass control [s] (module docstring):
-    viscous :math:`2 m / (a_h\lambda)`, stiffness :math:`2\sqrt{m / (k_h
-    \lambda)}`; ``inf`` without hourglass control (``coef`` <= 0). ``lam`` the
-    bound of :func:`hourglass_bound`, ``coef`` :math:`a_h` [kg/s] or
-    :math:`k_h` [N/m], ``m_min`` the smallest mass of the element's nodes
-    [kg]."""
+def hourglass_rates(lam, coef, m_min, hg_form):
+    r"""The hourglass control's terms of :func:`element_step` (module
+    docstring): the damping rate :math:`A_h = a_h\lambda/(2m)` [1/s] (viscous)
+    and the stiffness :math:`\omega_h^2 = k_h\lambda/m` [1/s^2] (stiffness
+    form), the other 0; both 0 without hourglass control (``coef`` <= 0).
+    ``lam`` the bound of :func:`hourglass_bound`, ``coef`` :math:`a_h` [kg/s]
+    or :math:`k_h` [N/m], ``m_min`` the smallest mass of the element's nodes
+    [kg]. Alone, :math:`A_h` allows the step :math:`1/A_h = 2m/(a_h\lambda)`
+    and :math:`\omega_h^2` allows :math:`2/\omega_h`."""
     if coef <= 0.0 or lam <= 0.0:
-        return np.inf
+        return 0.0, 0.0
     if hg_form == HG_VISCOUS:
-        return 2.0 * m_min / (coef * lam)
-    return 2.0 * sqrt(m_min / (coef * lam))
+        return 0.5 * coef * lam / m_min, 0.0
+    return 0.0, coef * lam / m_min
+
+
+@njit(cache=True, error_model="numpy")
+def hourglass_face(V, dim):
+    r""":math:`V^{(d-1)/d}` [m^2 in 3D, m in 2D] of the viscous hourglass
+    coefficient (:func:`hourglass_coefficient`), without a general power."""
+    return np.cbrt(V) ** 2 if dim == 3 else math.sqrt(V)
+
+
+@njit(cache=True, error_model="numpy")
+def hourglass_coefficient(hg_form, qh, rho, c, face, bb, V, dim):
+    r"""The hourglass control's coefficient: viscous :math:`a_h = Q_{hg}\rho c
+    V^{(d-1)/d}/4` [kg/s] (``face`` :func:`hourglass_face`), stiffness
+    :math:`k_h = Q_{hg}\rho c^2 \sum b^2/(V d)` [N/m] (``bb``
+    :math:`\sum_{iI} (\partial V/\partial x_{iI})^2` [m^4], ``V`` [m^3] > 0;
+    LS-DYNA's forms 1 and 4, Flanagan & Belytschko 1981). ``qh`` :math:`Q_{hg}`,
+    ``rho`` [kg/m^3], ``c`` [m/s]."""
+    if hg_form == HG_VISCOUS:
+        return qh * rho * c * face / 4.0
+    return qh * rho * c * c * bb / (V * dim)
 
 
 @njit(cache=True, error_model="numpy")
@@ -498,8 +558,8 @@ def uniform_forces(x, v, conn, active, sig, L, rho, c, e_spec, e_av, dim, tab, g
     work [J] (updated); bulk viscosity ``q1`` (quadratic), ``q2`` (linear),
     whose heat goes to ``e_spec`` and ``e_av`` (E,) [J/kg]; ``work``:
     :func:`block_scratch`; ``m_node`` (N,) the node masses [kg] of the
-    hourglass control's step (:func:`hourglass_step`: the element step is the
-    smaller of the two). Equations: module docstring and
+    hourglass control's terms in the element step (:func:`hourglass_rates`).
+    Equations: module docstring and
     :func:`hourglass_resultants`.
     """
     ne = conn.shape[0]
@@ -524,27 +584,18 @@ def uniform_forces(x, v, conn, active, sig, L, rho, c, e_spec, e_av, dim, tab, g
             vol[e] = V
             ell = char_length(g, V)
             dkk = L[e, 0, 0] + L[e, 1, 1] + L[e, 2, 2]
-            dt_el[e] = element_step(ell, c[e], dkk, q1, q2)
             q = bulk_viscosity(rho[e], c[e], ell, dkk, q1, q2)
             if q > 0.0 and rho[e] > 0.0:
                 heat = -dt * q * dkk / rho[e]
                 e_spec[e] += heat
                 e_av[e] += heat
+            coef, a_h, w2_h = element_hourglass_rates(xl, g, V, gam, hg_form, qh, rho[e], c[e],
+                                                      dim, m_node, conn, e)
+            dt_el[e] = element_step(ell, c[e], dkk, q1, q2, a_h, w2_h)
             hourglass = qh > 0.0 and V > 0.0
             if hourglass:
-                if hg_form == HG_VISCOUS:  # V^((d-1)/d) without a general power
-                    face = np.cbrt(V) ** 2 if dim == 3 else math.sqrt(V)
-                    coef = qh * rho[e] * c[e] * face / 4.0
-                else:
-                    bb = 0.0
-                    for I in range(nen):
-                        bb += g[I, 0] ** 2 + g[I, 1] ** 2 + g[I, 2] ** 2
-                    coef = qh * rho[e] * c[e] * c[e] * bb / (V * dim)
                 e_hg[e] += dt * hourglass_resultants(e, vl, xl, g, V, gam, hg_form, coef,
                                                      hg, dt, dim, Q, M)
-                m_min = smallest_node_mass(m_node, conn, e)
-                lam = hourglass_bound(xl, g, V, gam, coef, m_min, hg_form, dt_el[e])
-                dt_el[e] = min(dt_el[e], hourglass_step(lam, coef, m_min, hg_form))
             else:
                 M[:] = 0.0
             # f_iI = -(sigma_ij - q delta_ij - M_ij / V) dV/dx_jI - sum_a Q_ai Gamma_aI
@@ -695,7 +746,7 @@ def reduced_forces(conn, active, sig, L, rho, c, e_spec, e_av, g, vol, Bg, wg, q
         cmax = 0.0
         for k in range(ngp):
             cmax = max(cmax, c[p0 + k])
-        dt_el[e] = element_step(ell, cmax, dkk, q1, q2)
+        dt_el[e] = element_step(ell, cmax, dkk, q1, q2, 0.0, 0.0)
         for k in range(ngp):
             if wg[p0 + k] <= 0.0:
                 dt_el[e] = 0.0

@@ -30,9 +30,10 @@ from ...state import BC_FIXED, STATE, Elements, MaterialPoints, Nodes
 from ..base import register_part
 from .gather import gather_loads, node_element_list
 from .hex_lanes import hex_forces, hex_strain_rate, lane_scratch
-from .solid import (DT_BLOCKS, HG_STIFFNESS, HG_VISCOUS, block_scratch, element_volumes,
+from .solid import (DT_BLOCKS, HG_STIFFNESS, HG_VISCOUS, block_scratch, char_length,
+                    element_step, element_volumes, hourglass_bound, local_coordinates,
                     min_time_step, reduced_forces, reduced_strain_rate, uniform_forces,
-                    uniform_strain_rate, weigh_point_work)
+                    uniform_strain_rate, volume_gradient, weigh_point_work)
 
 INTEGRATIONS = ("one_point", "selective_reduced")
 HOURGLASS_FORMS = {"viscous": HG_VISCOUS, "stiffness": HG_STIFFNESS}
@@ -182,8 +183,9 @@ class SolidPart:
     def _element_geometry(self) -> None:
         """Volumes and element steps at the current positions (no forces)."""
         q, el, p, s = self.nodes, self.el, self.pts, self.s
-        element_volumes(q.x, el.conn, el.active, self.dim, self.tab, p.c, p.L, self.ngp,
-                        s.q1, s.q2, el.vol, el.dt_el, self.work)
+        element_volumes(q.x, el.conn, el.active, self.dim, self.tab, p.c, p.L, p.rho, self.ngp,
+                        s.q1, s.q2, self.gam, self.hg_form, s.hourglass_coefficient, q.m,
+                        el.vol, el.dt_el, self.work)
 
     def _forces(self, dt: float) -> None:
         """Element nodal forces (and element steps) gathered into the nodes'
@@ -239,7 +241,28 @@ class SolidPart:
                 inverted = (f", {int(np.sum(w <= 0.0))} of its {self.ngp} integration "
                             "points inverted (det J <= 0)")
         return (f"element {k} of mesh '{self.name}' at ({', '.join(f'{c:.4g}' for c in centre)})"
-                f", volume {el.vol[k] / el.vol0[k]:.3g} of its initial{inverted}")
+                f", volume {el.vol[k] / el.vol0[k]:.3g} of its initial{inverted}"
+                f"{self._hourglass_share(k)}")
+
+    def _hourglass_share(self, k: int) -> str:
+        """How much the hourglass control's terms shortened element ``k``'s step
+        (:func:`.solid.element_step`), and its shape vectors' Gram bound
+        against an undistorted element's; empty without hourglass control."""
+        el, q, p, s = self.el, self.nodes, self.pts, self.s
+        if self.reduced or s.hourglass_coefficient <= 0.0 or not el.active[k]:
+            return ""
+        xl, g = np.empty((el.nen, 3)), np.empty((el.nen, 3))
+        local_coordinates(q.x, q.x, 0.0, el.conn, k, xl)
+        V = volume_gradient(xl, self.dim, self.tab, g)
+        if V <= 0.0:
+            return ""
+        dkk = float(np.trace(p.L[k]))
+        plain = element_step(char_length(g, V), p.c[k], dkk, s.q1, s.q2, 0.0, 0.0)
+        lam = hourglass_bound(xl, g, V, self.gam)
+        return (f"; its step {el.dt_el[k] / plain:.3g} of what it would be without the "
+                f"hourglass control's terms (shape vectors' Gram bound {lam:.3g}, "
+                f"{el.nen} undistorted: docs/theory.md, \"The element step with the "
+                "hourglass control\")")
 
     def hotspot(self) -> str:
         """The element of the largest specific internal energy (the energy
