@@ -70,6 +70,22 @@ def test_leppanen_references_are_the_data_file_s(tmp_path):
     assert (moved["dop"].value, moved["crater"].value) == (61.0, 99.0)
 
 
+def test_forrestal_reference_is_the_277_m_per_s_shot_in_millimetres(tmp_path):
+    """The Forrestal depth is tabulated in metres (0.173 m at 277 m/s);
+    the reference is in the table's unit, mm (a missing factor 1e3 would
+    compare 99 mm with 0.173), and comes from the file: another number there
+    gives another reference."""
+    refs = cases.CASES["forrestal1994_ogive"].references(ROOT / "validation" / "data")
+    assert [r.key for r in refs] == ["dop"] and refs[0].unit == "mm"
+    assert refs[0].value == pytest.approx(173.0, rel=1e-12)
+    row = report.compare(refs, {"dop": 0.0992})[0]
+    assert row["sphdyn"] == pytest.approx(99.2) and row["verdict"] == "poor"
+    text = (ROOT / "validation" / "data" / cases.FORRESTAL).read_text(encoding="utf-8")
+    (tmp_path / cases.FORRESTAL).write_text(text.replace("0.76,0.173,", "0.76,0.180,"))
+    moved = cases.CASES["forrestal1994_ogive"].references(tmp_path)
+    assert moved[0].value == pytest.approx(180.0, rel=1e-12)
+
+
 def test_every_case_has_its_deck_and_its_data():
     for case in cases.CASES.values():
         assert (ROOT / case.deck).is_file(), case.deck

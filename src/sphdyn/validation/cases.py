@@ -213,8 +213,8 @@ FORRESTAL = "forrestal1994_ogive_penetration.csv"
 
 def _forrestal_references(data_dir: Path) -> list[Reference]:
     row = data.read(data_dir / FORRESTAL).row(v_s_m_per_s="277")
-    return [Reference("dop", "depth of penetration", "mm", data.number(row, "dop_m"),
-                      data.number(row, "dop_m"), data.number(row, "dop_m"),
+    dop = data.number(row, "dop_m") * UNITS["mm"]  # tabulated in metres
+    return [Reference("dop", "depth of penetration", "mm", dop, dop, dop,
                       f"{FORRESTAL}: the 277 m/s shot (Leppanen 2002, Table 6.2, p. 55)",
                       scatter="one shot")]
 
