@@ -45,7 +45,8 @@ def stability_number(part, e: int, dt: float) -> tuple[float, float]:
     """Trace of the Gram matrix of element ``e``'s shape vectors, and ``dt``
     times the largest eigenvalue of its viscous hourglass damping with its
     nodes' masses (module docstring), both formed with NumPy."""
-    from sphdyn.parts.fem.solid import volume_gradient
+    from sphdyn.parts.fem.solid import (HG_VISCOUS, hourglass_coefficient, hourglass_face,
+                                        volume_gradient)
 
     el, q, pts = part.el, part.nodes, part.pts
     conn = el.conn[e]
@@ -53,8 +54,8 @@ def stability_number(part, e: int, dt: float) -> tuple[float, float]:
     g = np.zeros((len(conn), 3))
     V = volume_gradient(xl, part.dim, part.tab, g)
     shape = part.gam - (part.gam @ xl / V) @ g.T  # (modes, nen)
-    face = np.cbrt(V) ** 2 if part.dim == 3 else np.sqrt(V)
-    coef = part.s.hourglass_coefficient * pts.rho[e] * pts.c[e] * face / 4.0
+    coef = hourglass_coefficient(HG_VISCOUS, part.s.hourglass_coefficient, pts.rho[e],
+                                 pts.c[e], hourglass_face(V, part.dim), 0.0, V, part.dim)
     scale = 1.0 / np.sqrt(q.m[conn])
     damping = scale[:, None] * (coef * shape.T @ shape) * scale[None, :]
     return float(np.sum(shape * shape)), float(dt * np.linalg.eigvalsh(damping).max())

@@ -32,7 +32,7 @@ from numba import njit, prange
 from ...geometry.shapes import hourglass_vectors
 from .hex_gradient import hex_volume_gradient_lanes
 from .lane_layout import (C_, COEF_, DKK_, DT_, ELL_, F_, FACE_, G_, GM_, HEAT_, HG_, INV_, INVV_,
-                          L_, LAM_, LANES, LB_, M_, MMIN_, POWER_, Q_, QA_, RHO_, ROW_, ROWS, SIG_,
+                          L_, LANES, LB_, M_, MMIN_, POWER_, Q_, QA_, RHO_, ROW_, ROWS, SIG_,
                           TR_, VN_, VOL_, X_)
 from .solid import (HG_VISCOUS, block_count, block_span, bulk_viscosity, element_step,
                      hourglass_coefficient, hourglass_face, hourglass_rates,
@@ -249,7 +249,6 @@ def force_lanes(S, hg_form, qh, q1, q2, dt):
             S[ROW_ * LANES + l] = max(S[ROW_ * LANES + l], row)
     for l in range(LANES):
         lam = min(S[TR_ * LANES + l], S[ROW_ * LANES + l])
-        S[LAM_ * LANES + l] = lam
         a_h, w2_h = hourglass_rates(lam, S[COEF_ * LANES + l], S[MMIN_ * LANES + l], hg_form)
         S[DT_ * LANES + l] = element_step(S[ELL_ * LANES + l], S[C_ * LANES + l],
                                           S[DKK_ * LANES + l], q1, q2, a_h, w2_h)

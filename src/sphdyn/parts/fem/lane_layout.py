@@ -36,8 +36,7 @@ M_ = 147  #: 9 rows: hourglass share M_ij = sum_a Q_ai h_aj / V [Pa]
 QA_ = 156  #: 12 rows: hourglass generalised forces (a, k) -> QA_ + 3 a + k [N]
 GM_ = 168  #: 32 rows: hourglass shape vectors gamma_aI -> GM_ + 8 a + I
 ROW_ = 200  #: the largest Gershgorin row sum of their Gram matrix so far
-LAM_ = 201  #: the bound of the Gram matrix's largest eigenvalue (smaller of TR_, ROW_)
+ELL_ = 201  #: characteristic length of the element step [m]
 TR_ = 202  #: the Gram matrix's trace
 MMIN_ = 203  #: the smallest mass of the element's nodes [kg]
-ELL_ = 204  #: characteristic length of the element step [m]
-ROWS = 205  #: rows in all
+ROWS = 204  #: rows in all
