@@ -14,7 +14,8 @@ step: the explicit update of a mode is stable below 2 without the
 element's own stiffness; docs/theory.md, "The element step with the
 hourglass control"); and, for every element eroded in the
 step, its points' work and its hourglass work, and the internal energy of
-the particles it became.
+the particles it became; and the step's change of the model's E_total and
+E_kinetic.
 
 This found why the Forrestal target made energy (docs/validation.md):
 
@@ -81,6 +82,7 @@ def main(argv=None) -> int:
     st = sim.stepper
     part = next(p for p in st.parts if p.name == args.mesh)
     el, pts, p = part.el, part.pts, st.particles
+    books = st.record()
     for _ in range(args.steps):
         e_hg, active = el.e_hg.copy(), el.active.copy()
         work = (pts.m * pts.e).reshape(el.n, part.ngp).sum(axis=1)
@@ -88,10 +90,13 @@ def main(argv=None) -> int:
         sim.run(t_end=st.t + 1.0, max_steps=1, progress=False)
         k = int(np.argmax(el.e_hg - e_hg))
         trace, number = stability_number(part, k, st.dt_step)
+        r = st.record()
         print(f"t {st.t * 1e6:.3f} us: element {k} hourglass work +{el.e_hg[k] - e_hg[k]:.3g} J "
               f"(in all {el.e_hg.sum():.1f} J), V/V0 {el.vol[k] / el.vol0[k]:.3f}, damage "
               f"{pts.damage[k * part.ngp]:.3f}, Gram trace {trace:.1f}, dt a_h lambda/m "
-              f"{number:.2f}", flush=True)
+              f"{number:.2f}; E_total {r['E_total'] - books['E_total']:+.1f} J, E_kinetic "
+              f"{r['E_kinetic'] - books['E_kinetic']:+.1f} J", flush=True)
+        books = r
         for e in np.flatnonzero((active == 1) & (el.active == 0)):
             print(f"    eroded {e}: its work {work[e]:.1f} J, hourglass work {e_hg[e]:.1f} J",
                   flush=True)

@@ -64,7 +64,7 @@ SKIP = {
     "sphdyn bench hvi --steps 20": "builds the 280,000-particle drop-weight model",
     # the validation cases: tests/test_validation_quick.py runs the quick ones
     # and holds their numbers; the full ones take hours
-    "sphdyn validate --quick": "runs the quick validation cases (about 20 minutes)",
+    "sphdyn validate --quick": "runs the quick validation cases (about 24 minutes)",
     "sphdyn validate --docs": "runs the full validation cases (hours)",
     "sphdyn plot out/validation/lozano2017_dropweight_2.5m-quick --snapshots damage":
         "needs the quick validation run (tests/test_validation_quick.py makes it)",

@@ -183,3 +183,22 @@ def test_hourglass_trace_stability_number_of_a_lone_cube():
     assert trace == pytest.approx(32.0, rel=1e-12)
     coef = 0.1 * p.pts.rho[0] * p.pts.c[0] * a * a / 4.0
     assert number == pytest.approx(64.0 * coef * dt / p.el.m[0], rel=1e-12)
+
+
+def test_forrestal_rollers_hold_each_lateral_face_in_its_normal_only():
+    """studies/forrestal_lateral_faces.py: the case's deck with the rollers
+    builds (the quick block), each of the four sets holds one lateral face's
+    nodes (21 x 25 of the 20 x 20 x 24 block), held in that face's normal
+    component only."""
+    import forrestal_lateral_faces as flf
+
+    root = Path(__file__).resolve().parent.parent
+    text = (root / "validation" / "cases" / "forrestal1994_ogive.toml").read_text() + flf.ROLLERS
+    text = text.replace("divisions = [50, 50, 60]", "divisions = [20, 20, 24]")
+    deck = loads_deck(text)
+    model = build_model(deck)
+    sets = {b.set: b for b in deck.boundary}
+    for name, axis in (("side_x_lo", 0), ("side_x_hi", 0), ("side_y_lo", 1), ("side_y_hi", 1)):
+        mesh, nodes = model.mesh_sets[name]
+        assert mesh == "target" and len(nodes) == 21 * 25, name
+        assert list(sets[name].components) == ["xyz"[axis]]
