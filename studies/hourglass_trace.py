@@ -9,8 +9,9 @@ one, its damage, the trace of the Gram matrix of its Flanagan-Belytschko
 shape vectors (``nen`` x modes for an undistorted element: 32 for a hex8)
 and the stability number of its viscous hourglass force, ``dt a_h
 lambda_max / m`` (the largest eigenvalue of ``M^-1/2 C M^-1/2`` of the
-element's own hourglass damping matrix with its nodes' masses, times the
-step: the explicit update of a mode is stable below 2 without the
+element's own hourglass damping matrix with its nodes' whole masses, as
+the element step of 68efeb8 took them (only each element's shares bound the
+assembled number: studies/hourglass_patch.py), times the step: the explicit update of a mode is stable below 2 without the
 element's own stiffness; docs/theory.md, "The element step with the
 hourglass control"); and, for every element eroded in the
 step, its points' work and its hourglass work, and the internal energy of
@@ -46,20 +47,11 @@ def stability_number(part, e: int, dt: float) -> tuple[float, float]:
     """Trace of the Gram matrix of element ``e``'s shape vectors, and ``dt``
     times the largest eigenvalue of its viscous hourglass damping with its
     nodes' masses (module docstring), both formed with NumPy."""
-    from sphdyn.parts.fem.solid import (HG_VISCOUS, hourglass_coefficient, hourglass_face,
-                                        volume_gradient)
+    from hourglass_patch import largest, shape_vectors
 
-    el, q, pts = part.el, part.nodes, part.pts
-    conn = el.conn[e]
-    xl = q.x[conn] - q.x[conn[0]]
-    g = np.zeros((len(conn), 3))
-    V = volume_gradient(xl, part.dim, part.tab, g)
-    shape = part.gam - (part.gam @ xl / V) @ g.T  # (modes, nen)
-    coef = hourglass_coefficient(HG_VISCOUS, part.s.hourglass_coefficient, pts.rho[e],
-                                 pts.c[e], hourglass_face(V, part.dim), 0.0, V, part.dim)
-    scale = 1.0 / np.sqrt(q.m[conn])
-    damping = scale[:, None] * (coef * shape.T @ shape) * scale[None, :]
-    return float(np.sum(shape * shape)), float(dt * np.linalg.eigvalsh(damping).max())
+    shape, coef = shape_vectors(part, e)
+    damping = coef * shape.T @ shape
+    return float(np.sum(shape * shape)), dt * largest(damping, part.nodes.m[part.el.conn[e]])
 
 
 def main(argv=None) -> int:

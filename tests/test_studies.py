@@ -185,6 +185,37 @@ def test_hourglass_trace_stability_number_of_a_lone_cube():
     assert number == pytest.approx(64.0 * coef * dt / p.el.m[0], rel=1e-12)
 
 
+def test_hourglass_patch_damping_of_a_block_of_cubes():
+    """studies/hourglass_patch.py's measures on a 2 x 2 x 2 block of cubes (side
+    a): every element's damping a_h Gamma^T Gamma (a_h = Q_hg rho c a^2 / 4)
+    has largest eigenvalue 8 a_h; with its own shares m_e / 8 of the nodes'
+    masses its number is 64 a_h / m_e, and the block's checkerboard mode (every
+    element in its mode Gamma_4, sharing the centre node) reaches the same
+    64 a_h / m_e assembled with the nodes' whole masses, which each element's
+    own whole node masses put lower (by 0.72 here): the shares bound it, the
+    whole masses do not (docs/theory.md)."""
+    import hourglass_patch as hp
+    from fem_models import block, part
+
+    a = 0.01
+    x, cells = block([0, 0, 0], [2 * a, 2 * a, 2 * a], (2, 2, 2), 3)
+    p = part(x, cells, 3, hourglass_coefficient=0.1)
+    coef = 0.1 * p.pts.rho[0] * p.pts.c[0] * a * a / 4.0
+    m_e = p.el.m[0]
+    C = np.zeros((p.nodes.n, p.nodes.n))
+    whole = []
+    for e in range(p.el.n):
+        Ce = hp.element_damping(p, e)
+        assert hp.largest(Ce, np.ones(8)) == pytest.approx(8.0 * coef, rel=1e-12)
+        assert hp.largest(Ce, np.full(8, m_e / 8)) == pytest.approx(64.0 * coef / m_e,
+                                                                     rel=1e-12)
+        C[np.ix_(p.el.conn[e], p.el.conn[e])] += Ce
+        whole.append(hp.largest(Ce, p.nodes.m[p.el.conn[e]]))
+    assembled = hp.largest(C, p.nodes.m)
+    assert assembled == pytest.approx(64.0 * coef / m_e, rel=1e-12)
+    assert max(whole) < 0.75 * assembled  # 0.717: the corner nodes are an eighth
+
+
 def test_forrestal_rollers_hold_each_lateral_face_in_its_normal_only():
     """studies/forrestal_lateral_faces.py: the case's deck with the rollers
     builds (the quick block), each of the four sets holds one lateral face's

@@ -395,9 +395,9 @@ class Mesh(Section):
     hourglass_coefficient: real("hourglass coefficient", lo=0, hi=0.15) = Field(
         0.1, description="Hourglass coefficient Q_hg (LS-DYNA QH; 0 = off). At most "
                          "0.15 (LS-DYNA's advice for its viscous forms). The element "
-                         "step includes its damping or stiffness: at 0.1 2.8 % "
-                         "shorter inside a regular hex mesh, 20 % on a lone cube "
-                         "(docs/theory.md).")
+                         "step includes its damping or stiffness: none in an "
+                         "undistorted element up to 0.15, a joint step in a "
+                         "distorted one (docs/theory.md).")
     q1: real("quadratic bulk viscosity", lo=0) = Field(
         1.5, description="Quadratic bulk-viscosity coefficient.")
     q2: real("linear bulk viscosity", lo=0) = Field(

@@ -32,11 +32,11 @@ from numba import njit, prange
 from ...geometry.shapes import hourglass_vectors
 from .hex_gradient import hex_volume_gradient_lanes
 from .lane_layout import (C_, COEF_, DKK_, DT_, ELL_, F_, FACE_, G_, GM_, HEAT_, HG_, INV_, INVV_,
-                          L_, LANES, LB_, M_, MMIN_, POWER_, Q_, QA_, RHO_, ROW_, ROWS, SIG_,
-                          TR_, VN_, VOL_, X_)
+                          L_, LANES, LB_, M_, MSH_, MX_, OV_, POWER_, PX_, Q_, QA_, RG_, RHO_, ROW_,
+                          ROWS, SIG_, TR_, VN_, VOL_, X_)
 from .solid import (HG_VISCOUS, block_count, block_span, bulk_viscosity, element_step,
                      hourglass_coefficient, hourglass_face, hourglass_rates,
-                     length_from_gradient, smallest_node_mass)
+                     length_from_gradient, overlap_from_moments)
 
 #: hourglass base vectors (4, 8) of the hex8, a compile-time constant
 GAMMA = hourglass_vectors(3)
@@ -117,13 +117,13 @@ def hex_strain_rate(x, v, conn, active, m_el, dt, L, rho, work):
 
 
 @njit(cache=True, error_model="numpy")
-def gather_fields(sig, L, rho, c, hg, lo, nl, stiffness, m_node, conn, S):
-    """Rows SIG_, DKK_, RHO_, C_, MMIN_ (the smallest node mass of ``m_node``)
-    and FACE_ (viscous form) or HG_ (stiffness form) of elements ``lo`` ..
-    ``lo + nl - 1``, padded as :func:`gather_nodes`."""
+def gather_fields(sig, L, rho, c, hg, lo, nl, stiffness, m_el, S):
+    """Rows SIG_, DKK_, RHO_, C_, MSH_ (each node's share of the element mass
+    ``m_el``) and FACE_ (viscous form) or HG_ (stiffness form) of elements
+    ``lo`` .. ``lo + nl - 1``, padded as :func:`gather_nodes`."""
     for l in range(LANES):
         e = lo + min(l, nl - 1)
-        S[MMIN_ * LANES + l] = smallest_node_mass(m_node, conn, e)
+        S[MSH_ * LANES + l] = m_el[e] / 8
         for i in range(3):
             for j in range(3):
                 S[(SIG_ + 3 * i + j) * LANES + l] = sig[e, i, j]
@@ -136,6 +136,50 @@ def gather_fields(sig, L, rho, c, hg, lo, nl, stiffness, m_node, conn, S):
             for a in range(4):
                 for k in range(3):
                     S[(HG_ + 3 * a + k) * LANES + l] = hg[e, a, k]
+
+
+@njit(cache=True, error_model="numpy")
+def overlap_lanes(S):
+    """Row OV_: :func:`.solid.hourglass_overlap` of every lane from rows X_, G_,
+    VOL_ (the same operations in the same order, lane by lane; rows MX_,
+    PX_ and RG_ hold the mean coordinates and the moments on the way)."""
+    for r in range(15):
+        for l in range(LANES):
+            S[(MX_ + r) * LANES + l] = 0.0
+    for I in range(8):
+        for k in range(3):
+            for l in range(LANES):
+                S[(MX_ + k) * LANES + l] += S[(X_ + 3 * I + k) * LANES + l]
+    for k in range(3):
+        for l in range(LANES):
+            S[(MX_ + k) * LANES + l] /= 8
+    for I in range(8):
+        for l in range(LANES):
+            y0 = S[(X_ + 3 * I) * LANES + l] - S[MX_ * LANES + l]
+            y1 = S[(X_ + 3 * I + 1) * LANES + l] - S[(MX_ + 1) * LANES + l]
+            y2 = S[(X_ + 3 * I + 2) * LANES + l] - S[(MX_ + 2) * LANES + l]
+            g0 = S[(G_ + 3 * I) * LANES + l]
+            g1 = S[(G_ + 3 * I + 1) * LANES + l]
+            g2 = S[(G_ + 3 * I + 2) * LANES + l]
+            S[PX_ * LANES + l] += y0 * y0
+            S[(PX_ + 1) * LANES + l] += y0 * y1
+            S[(PX_ + 2) * LANES + l] += y0 * y2
+            S[(PX_ + 3) * LANES + l] += y1 * y1
+            S[(PX_ + 4) * LANES + l] += y1 * y2
+            S[(PX_ + 5) * LANES + l] += y2 * y2
+            S[RG_ * LANES + l] += g0 * g0
+            S[(RG_ + 1) * LANES + l] += g0 * g1
+            S[(RG_ + 2) * LANES + l] += g0 * g2
+            S[(RG_ + 3) * LANES + l] += g1 * g1
+            S[(RG_ + 4) * LANES + l] += g1 * g2
+            S[(RG_ + 5) * LANES + l] += g2 * g2
+    for l in range(LANES):
+        S[OV_ * LANES + l] = overlap_from_moments(
+            S[PX_ * LANES + l], S[(PX_ + 1) * LANES + l], S[(PX_ + 2) * LANES + l],
+            S[(PX_ + 3) * LANES + l], S[(PX_ + 4) * LANES + l], S[(PX_ + 5) * LANES + l],
+            S[RG_ * LANES + l], S[(RG_ + 1) * LANES + l], S[(RG_ + 2) * LANES + l],
+            S[(RG_ + 3) * LANES + l], S[(RG_ + 4) * LANES + l], S[(RG_ + 5) * LANES + l],
+            S[VOL_ * LANES + l], 3)
 
 
 @njit(cache=True, error_model="numpy")
@@ -247,11 +291,14 @@ def force_lanes(S, hg_form, qh, q1, q2, dt):
                     s += S[(GM_ + 8 * a + I) * LANES + l] * S[(GM_ + 8 * b + I) * LANES + l]
                 row += abs(s)
             S[ROW_ * LANES + l] = max(S[ROW_ * LANES + l], row)
+    if qh > 0.0:
+        overlap_lanes(S)
     for l in range(LANES):
         lam = min(S[TR_ * LANES + l], S[ROW_ * LANES + l])
-        a_h, w2_h = hourglass_rates(lam, S[COEF_ * LANES + l], S[MMIN_ * LANES + l], hg_form)
+        a_h, w2_h = hourglass_rates(lam, S[COEF_ * LANES + l], S[MSH_ * LANES + l], hg_form)
+        ov = S[OV_ * LANES + l] if S[COEF_ * LANES + l] > 0.0 else 0.0
         S[DT_ * LANES + l] = element_step(S[ELL_ * LANES + l], S[C_ * LANES + l],
-                                          S[DKK_ * LANES + l], q1, q2, a_h, w2_h)
+                                          S[DKK_ * LANES + l], q1, q2, a_h, w2_h, ov)
     # f_iI = -(sigma_ij - q delta_ij - M_ij / V) dV/dx_jI - sum_a Q_ai Gamma_aI
     for i in range(3):
         for j in range(3):
@@ -273,14 +320,14 @@ def force_lanes(S, hg_form, qh, q1, q2, dt):
 
 @njit(cache=True, error_model="numpy", parallel=True)
 def hex_forces(x, v, conn, active, sig, L, rho, c, e_spec, e_av, hg_form, qh, hg, e_hg,
-               q1, q2, dt, vol, dt_el, fe, work, m_node):
+               q1, q2, dt, vol, dt_el, fe, work, m_el):
     r"""Nodal forces ``fe`` (E, 8, 3) [N] of one-point hex8 elements, lane by lane:
     :func:`.solid.uniform_forces` (same arguments and equations: the geometry
     at :math:`n+1` with ``vol`` and ``dt_el`` written on the way, bulk
     viscosity heating ``e_spec`` and ``e_av``, hourglass forces with their work
     in ``e_hg`` and the stiffness form's ``hg`` (E, 4, 3) updated; the
     element step with its hourglass control's terms,
-    :func:`.solid.hourglass_rates` with the node masses ``m_node`` (N,) [kg]).
+    :func:`.solid.hourglass_rates` with the element masses ``m_el`` (E,) [kg]).
     ``work``: :func:`lane_scratch`."""
     ne = conn.shape[0]
     stiffness = hg_form != HG_VISCOUS
@@ -291,7 +338,7 @@ def hex_forces(x, v, conn, active, sig, L, rho, c, e_spec, e_av, hg_form, qh, hg
             nl = min(bhi - lo, LANES)
             gather_nodes(x, v, 0.0, conn, lo, nl, S)
             hex_volume_gradient_lanes(S)
-            gather_fields(sig, L, rho, c, hg, lo, nl, stiffness, m_node, conn, S)
+            gather_fields(sig, L, rho, c, hg, lo, nl, stiffness, m_el, S)
             force_lanes(S, hg_form, qh, q1, q2, dt)
             for l in range(nl):
                 e = lo + l

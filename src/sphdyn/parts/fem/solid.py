@@ -84,41 +84,37 @@ form with the bulk viscosity). For a cube of side a: :math:`\ell = a/\sqrt3`
 (the odd-even dilatational mode of a cube mesh has :math:`\omega^2 = 12K/\rho
 a^2`, which this bound covers for any Poisson ratio).
 
-**Stable step with the hourglass control** (:func:`hourglass_rates`): the
+**Stable step with the hourglass control** (:func:`hourglass_rates`,
+:func:`hourglass_overlap`, :func:`element_step`; docs/theory.md): the
 hourglass forces are explicit too. On the nodes of one element they act as
 :math:`\mathbf f = -\,a_h\, \Gamma^{\gamma T}\Gamma^{\gamma}\,\mathbf v` (viscous;
 :math:`k_h` on the displacements for the stiffness form), with
-:math:`\Gamma^\gamma` the shape vectors :math:`\gamma_{\alpha I}` above: on
-a node of mass :math:`m` a damping rate :math:`2A_h = a_h\lambda/m` (viscous)
-or a stiffness :math:`\omega_h^2 = k_h\lambda/m`, :math:`\lambda` the largest
-eigenvalue of the Gram matrix :math:`G_{\alpha\beta} = \sum_I \gamma_{\alpha
-I}\gamma_{\beta I}`, bounded by the smaller of its trace and Gershgorin's row
-sums :math:`\max_\alpha \sum_\beta |G_{\alpha\beta}|` (:func:`hourglass_bound`),
-and :math:`m` the smallest mass of the element's nodes. The element's step
-is that of one damped oscillator :math:`\ddot u + 2A\dot u + \omega^2 u = 0`
-holding both: the central-difference limit :math:`\Delta t \le 2/(A +
-\sqrt{A^2 + \omega^2})` (Belytschko, Liu & Moran 2000, sec. 6.2: :math:`(2/\omega)
-(\sqrt{1+\xi^2} - \xi)` with :math:`A = \xi\omega`) with :math:`A = 2Q/\ell + A_h`,
-:math:`\omega^2 = 4c^2/\ell^2 + \omega_h^2`, which is the element step above
-with :math:`Q \to Q + A_h\ell/2`, :math:`c^2 \to c^2 + \omega_h^2\ell^2/4`
-(:func:`element_step`; a sum of stiffnesses' and of dampings' largest
-eigenvalues bounds those of their sums). Alone, the viscous term's limit is
-:math:`2m/(a_h\lambda)` (its update multiplies a mode by :math:`1 - \Delta
-t\,a_h\lambda/m`), the stiffness form's :math:`2\sqrt{m/(k_h\lambda)}`.
-For an undistorted element :math:`\gamma = \Gamma`, :math:`\lambda = n_{en}`
-(the base vectors are orthogonal, Gershgorin exact, the trace 4 times too
-high): at :math:`Q_{hg} = 0.1` the joint step is 2.8 % below the element's
-own inside a regular hex mesh (each node the mass of one element) and 20 %
-on a lone cube (each node an eighth; quads: 1.75 and 6.8 %). In an element distorted towards its
-hourglass modes (a crushed or strongly dilated one: the Gram matrix's trace
-grew from 32 to 213 in the Forrestal target, docs/validation.md) :math:`\lambda`
-grows with the distortion and the hourglass terms take over the step:
-without them such an element's hourglass mode grew by about 1.4 times per
-step, and with the two limits taken apart (the smaller of the element's and
-the hourglass term's alone) it still grew at :math:`\Delta t\,a_h\lambda/m`
-= 1.2-1.6, where the damping and the element's stiffness act together.
-LS-DYNA's element step has no hourglass term; it deletes such elements
-through its erosion criteria instead.
+:math:`\Gamma^\gamma` the shape vectors :math:`\gamma_{\alpha I}` above. The
+velocity-lagged central difference is stable where :math:`\lambda_{max}(M^{-1}
+(\Delta t\,C/2 + \Delta t^2 K/4)) \le 1` (for one mode the damped
+oscillator's limit :math:`\Delta t \le 2/(A + \sqrt{A^2 + \omega^2})`,
+Belytschko, Liu & Moran 2000, sec. 6.2), and the assembled
+:math:`\lambda_{max}` is at most the largest element's formed with the
+element's own share :math:`m = m_e/n_{en}` of each node's mass (Irons'
+bound; a node's whole mass is not a bound where several distorted elements
+share it). So on the element: a damping rate :math:`A_h = a_h\lambda/(2m)`
+(viscous) or a stiffness :math:`\omega_h^2 = k_h\lambda/m`, :math:`\lambda`
+the largest eigenvalue of the Gram matrix :math:`G_{\alpha\beta} = \sum_I
+\gamma_{\alpha I}\gamma_{\beta I}`, bounded by the smaller of its trace and
+Gershgorin's row sums (:func:`hourglass_bound`; :math:`n_{en}`, exact, for
+an undistorted element). The stress acts on the nodal fields
+:math:`\mathbf u_I = S\mathbf b_I`, the hourglass control on the span of the
+shape vectors, orthogonal to the linear fields; with :math:`c_\theta` the
+cosine of the smallest angle between the two (:func:`hourglass_overlap`),
+:math:`x = \Delta t A_h + \Delta t^2\omega_h^2/4` and :math:`y = \Delta t\,
+2Q/\ell + \Delta t^2 c^2/\ell^2` the condition holds where :math:`x +
+c_\theta y \le 1` and :math:`y + c_\theta x \le 1`: the smaller of two
+damped-oscillator limits (:func:`element_step`). An undistorted element
+(:math:`c_\theta = 0`) takes the smaller of its own step and the hourglass
+term's own (:math:`2m/(a_h\lambda)`, :math:`2/\omega_h`), which at
+:math:`Q_{hg} \le 0.15` is its own; a distorted one a joint step (the limit
+of the sum at :math:`c_\theta = 1`). LS-DYNA's element step has no
+hourglass term; it deletes distorted elements through its erosion criteria.
 """
 
 from __future__ import annotations
@@ -243,29 +239,105 @@ def block_scratch(n: int, nen: int, modes: int) -> np.ndarray:
 
 
 @njit(cache=True, error_model="numpy")
-def element_step(ell, c, dkk, q1, q2, a_h, w2_h):
-    r"""Stable step :math:`\ell/(Q + \sqrt{Q^2 + c^2})` of one element [s] with
-    :math:`Q = Q_2 c + Q_1\ell|\dot\varepsilon_{kk}|` in compression, and with
-    the hourglass control's damping rate ``a_h`` :math:`A_h` [1/s] and stiffness
-    ``w2_h`` :math:`\omega_h^2` [1/s^2] (:func:`hourglass_rates`; 0 without it):
-    :math:`Q + A_h\ell/2` and :math:`c^2 + \omega_h^2\ell^2/4` in their places,
-    the limit :math:`2/(A + \sqrt{A^2+\omega^2})` of the module docstring
-    (the same bits as the plain form where both are 0). ``ell`` [m], ``c``
-    [m/s], ``dkk`` the volumetric strain rate [1/s]; the factor ``cfl`` is
-    applied by the part."""
-    Q = q2 * c + (q1 * ell * -dkk if dkk < 0.0 else 0.0) + 0.5 * a_h * ell
-    c2 = c * c + 0.25 * w2_h * ell * ell
-    return ell / (Q + sqrt(Q * Q + c2) + 1e-300)
+def element_step(ell, c, dkk, q1, q2, a_h, w2_h, overlap):
+    r"""Stable step of one element [s]: the plain form :math:`\ell/(Q + \sqrt{Q^2 +
+    c^2})` with :math:`Q = Q_2 c + Q_1\ell|\dot\varepsilon_{kk}|` in compression,
+    and with the hourglass control's damping rate ``a_h`` :math:`A_h` [1/s]
+    and stiffness ``w2_h`` :math:`\omega_h^2` [1/s^2] (:func:`hourglass_rates`;
+    0 without it) the smaller of two damped-oscillator limits
+    :math:`2/(A + \sqrt{A^2+\omega^2})` (module docstring, "Stable step with the
+    hourglass control"): the element's own terms with the hourglass terms
+    times ``overlap`` :math:`c_\theta` (:func:`hourglass_overlap`) added,
+    :math:`Q + c_\theta A_h\ell/2`, :math:`c^2 + c_\theta\omega_h^2\ell^2/4`,
+    and the hourglass terms with the element's times :math:`c_\theta` added,
+    :math:`A_h\ell/2 + c_\theta Q`, :math:`\omega_h^2\ell^2/4 + c_\theta c^2`.
+    At :math:`c_\theta = 0` (an undistorted element) the two limits taken apart,
+    at 1 their sum's; the plain form's bits where both terms are 0. ``ell``
+    [m], ``c`` [m/s], ``dkk`` the volumetric strain rate [1/s]; the factor
+    ``cfl`` is applied by the part."""
+    Q = q2 * c + (q1 * ell * -dkk if dkk < 0.0 else 0.0)
+    Qe = Q + overlap * 0.5 * a_h * ell
+    ce2 = c * c + overlap * 0.25 * w2_h * ell * ell
+    dt = ell / (Qe + sqrt(Qe * Qe + ce2) + 1e-300)
+    if a_h > 0.0 or w2_h > 0.0:
+        Qh = 0.5 * a_h * ell + overlap * Q
+        ch2 = 0.25 * w2_h * ell * ell + overlap * c * c
+        dt = min(dt, ell / (Qh + sqrt(Qh * Qh + ch2) + 1e-300))
+    return dt
+
+
+#: ``mu - 1`` of :func:`overlap_from_moments` below which the overlap is 0: a
+#: parallelepiped's ``mu`` is 1 up to round-off (about 1e-15), whose square
+#: root (3e-8) would pass one ulp of a node's position on to the step as a
+#: change of 1e-8; an overlap under 1e-5 changes the step by less than that
+OVERLAP_ROUNDOFF = 1e-10
+
+
+@njit(cache=True, error_model="numpy")
+def hourglass_overlap(xl, g, V, dim):
+    r"""The bound :math:`c_\theta` of :func:`element_step` on the cosine of the
+    smallest angle between the element's stiffness and hourglass subspaces
+    [-] (module docstring, "Stable step with the hourglass control"):
+    :math:`c_\theta^2 = 1 - 1/\mu`, :math:`\mu = \mathrm{tr}(G_x G_b) - (d - 1)`
+(0 where :math:`\mu \le 1 +` :data:`OVERLAP_ROUNDOFF`), :math:`G_x = \sum_I \tilde{\mathbf x}_I
+    \otimes\tilde{\mathbf x}_I` of the node coordinates about their mean,
+    :math:`G_b = \sum_I \mathbf b_I\otimes\mathbf b_I`, :math:`\mathbf b_I =
+    \partial V/\partial\mathbf x_I / V`. 0 for a parallelepiped
+    (:math:`G_x G_b = \mathbf 1`). ``xl``, ``g`` (nen, 3) node coordinates [m]
+    and volume derivatives [m^2], ``V`` > 0 [m^3], ``dim`` 2 or 3. The
+    reference of the lane pass (:func:`.hex_lanes.force_lanes`, the same
+    operations in the same order)."""
+    nen = xl.shape[0]
+    m0 = m1 = m2 = 0.0
+    for I in range(nen):
+        m0 += xl[I, 0]
+        m1 += xl[I, 1]
+        m2 += xl[I, 2]
+    m0 /= nen
+    m1 /= nen
+    m2 /= nen
+    p00 = p01 = p02 = p11 = p12 = p22 = 0.0
+    r00 = r01 = r02 = r11 = r12 = r22 = 0.0
+    for I in range(nen):
+        y0 = xl[I, 0] - m0
+        y1 = xl[I, 1] - m1
+        y2 = xl[I, 2] - m2
+        p00 += y0 * y0
+        p01 += y0 * y1
+        p02 += y0 * y2
+        p11 += y1 * y1
+        p12 += y1 * y2
+        p22 += y2 * y2
+        r00 += g[I, 0] * g[I, 0]
+        r01 += g[I, 0] * g[I, 1]
+        r02 += g[I, 0] * g[I, 2]
+        r11 += g[I, 1] * g[I, 1]
+        r12 += g[I, 1] * g[I, 2]
+        r22 += g[I, 2] * g[I, 2]
+    return overlap_from_moments(p00, p01, p02, p11, p12, p22, r00, r01, r02, r11, r12, r22,
+                                V, dim)
+
+
+@njit(cache=True, error_model="numpy")
+def overlap_from_moments(p00, p01, p02, p11, p12, p22, r00, r01, r02, r11, r12, r22, V,
+                         dim):
+    r""":math:`c_\theta` of :func:`hourglass_overlap` from the six entries of
+    :math:`G_x` (``p``) [m^2] and of :math:`V^2 G_b` (``r``) [m^4]."""
+    t = (p00 * r00 + p11 * r11 + p22 * r22 + 2.0 * (p01 * r01 + p02 * r02 + p12 * r12))
+    mu = t / (V * V) - (dim - 1)
+    c2 = 1.0 - 1.0 / mu if mu > 1.0 + OVERLAP_ROUNDOFF else 0.0
+    return sqrt(c2)
+
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
 def element_volumes(x, conn, active, dim, tab, c, L, rho, ngp, q1, q2, gam, hg_form, qh,
-                    m_node, vol, dt_el, work):
+                    m_el, vol, dt_el, work):
     r"""Volumes ``vol`` (E,) [m^3] at ``x`` and the element steps ``dt_el`` (E,) [s]
     of :func:`element_step` (the element's largest point wave speed ``c``
     (P,), its first point's rate ``L`` (P, 3, 3)) with the hourglass terms of
     one-point elements (``ngp`` 1, ``qh`` > 0: density ``rho`` (P,), base
-    vectors ``gam``, node masses ``m_node`` (N,), as :func:`uniform_forces`);
+    vectors ``gam``, element masses ``m_el`` (E,), as :func:`uniform_forces`);
     the state a part needs before its first force pass or after a restart,
     the same bits as the force pass's. ``work``: :func:`block_scratch`."""
     ne = conn.shape[0]
@@ -286,30 +358,31 @@ def element_volumes(x, conn, active, dim, tab, c, L, rho, ngp, q1, q2, gam, hg_f
                 ce = max(ce, c[e * ngp + j])
             p = e * ngp
             dkk = L[p, 0, 0] + L[p, 1, 1] + L[p, 2, 2]
-            _, a_h, w2_h = element_hourglass_rates(xl, g, V, gam, hg_form,
-                                                   qh if ngp == 1 else 0.0, rho[p], ce, dim,
-                                                   m_node, conn, e)
-            dt_el[e] = element_step(char_length(g, V), ce, dkk, q1, q2, a_h, w2_h)
+            _, a_h, w2_h, ov = element_hourglass_rates(xl, g, V, gam, hg_form,
+                                                       qh if ngp == 1 else 0.0, rho[p], ce,
+                                                       dim, m_el[e])
+            dt_el[e] = element_step(char_length(g, V), ce, dkk, q1, q2, a_h, w2_h, ov)
 
 
 @njit(cache=True, error_model="numpy")
-def element_hourglass_rates(xl, g, V, gam, hg_form, qh, rho, c, dim, m_node, conn, e):
-    """The hourglass coefficient (:func:`hourglass_coefficient`) and
-    :func:`hourglass_rates` of element ``e`` (coordinates ``xl``, volume
-    derivatives ``g`` (nen, 3), volume ``V``, density ``rho``, wave speed
-    ``c``, node masses ``m_node`` (N,)); (0, 0, 0) without hourglass control
-    (``qh`` 0) or at ``V`` <= 0."""
+def element_hourglass_rates(xl, g, V, gam, hg_form, qh, rho, c, dim, m_el):
+    """The hourglass coefficient (:func:`hourglass_coefficient`),
+    :func:`hourglass_rates` and :func:`hourglass_overlap` of an element
+    (coordinates ``xl``, volume derivatives ``g`` (nen, 3), volume ``V``,
+    density ``rho``, wave speed ``c``, mass ``m_el`` [kg], each node's share
+    ``m_el / nen``); (0, 0, 0, 0) without hourglass control (``qh`` 0) or at
+    ``V`` <= 0."""
     if not (qh > 0.0 and V > 0.0):
-        return 0.0, 0.0, 0.0
+        return 0.0, 0.0, 0.0, 0.0
     bb = 0.0
     if hg_form != HG_VISCOUS:
         for I in range(g.shape[0]):
             bb += g[I, 0] ** 2 + g[I, 1] ** 2 + g[I, 2] ** 2
     face = hourglass_face(V, dim) if hg_form == HG_VISCOUS else 0.0
     coef = hourglass_coefficient(hg_form, qh, rho, c, face, bb, V, dim)
-    a_h, w2_h = hourglass_rates(hourglass_bound(xl, g, V, gam), coef,
-                                smallest_node_mass(m_node, conn, e), hg_form)
-    return coef, a_h, w2_h
+    a_h, w2_h = hourglass_rates(hourglass_bound(xl, g, V, gam), coef, m_el / g.shape[0],
+                                hg_form)
+    return coef, a_h, w2_h, hourglass_overlap(xl, g, V, dim)
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
@@ -426,20 +499,20 @@ def hourglass_moment(xl, gam, a, inv_v):
 
 
 @njit(cache=True, error_model="numpy")
-def hourglass_rates(lam, coef, m_min, hg_form):
+def hourglass_rates(lam, coef, m_share, hg_form):
     r"""The hourglass control's terms of :func:`element_step` (module
     docstring): the damping rate :math:`A_h = a_h\lambda/(2m)` [1/s] (viscous)
     and the stiffness :math:`\omega_h^2 = k_h\lambda/m` [1/s^2] (stiffness
     form), the other 0; both 0 without hourglass control (``coef`` <= 0).
     ``lam`` the bound of :func:`hourglass_bound`, ``coef`` :math:`a_h` [kg/s]
-    or :math:`k_h` [N/m], ``m_min`` the smallest mass of the element's nodes
-    [kg]. Alone, :math:`A_h` allows the step :math:`1/A_h = 2m/(a_h\lambda)`
+    or :math:`k_h` [N/m], ``m_share`` the element's share of each node's mass
+    [kg] (its mass over ``nen``, not the node's whole mass: module docstring). Alone, :math:`A_h` allows the step :math:`1/A_h = 2m/(a_h\lambda)`
     and :math:`\omega_h^2` allows :math:`2/\omega_h`."""
     if coef <= 0.0 or lam <= 0.0:
         return 0.0, 0.0
     if hg_form == HG_VISCOUS:
-        return 0.5 * coef * lam / m_min, 0.0
-    return 0.0, coef * lam / m_min
+        return 0.5 * coef * lam / m_share, 0.0
+    return 0.0, coef * lam / m_share
 
 
 @njit(cache=True, error_model="numpy")
@@ -460,15 +533,6 @@ def hourglass_coefficient(hg_form, qh, rho, c, face, bb, V, dim):
     if hg_form == HG_VISCOUS:
         return qh * rho * c * face / 4.0
     return qh * rho * c * c * bb / (V * dim)
-
-
-@njit(cache=True, error_model="numpy")
-def smallest_node_mass(m_node, conn, e):
-    """The smallest of the masses ``m_node`` (N,) [kg] of element ``e``'s nodes."""
-    m = m_node[conn[e, 0]]
-    for I in range(1, conn.shape[1]):
-        m = min(m, m_node[conn[e, I]])
-    return m
 
 
 @njit(cache=True, error_model="numpy")
@@ -544,7 +608,7 @@ def hourglass_resultants(e, vl, xl, g, V, gam, hg_form, coef, hg, dt, dim, Q, M)
 
 @njit(cache=True, error_model="numpy", parallel=True)
 def uniform_forces(x, v, conn, active, sig, L, rho, c, e_spec, e_av, dim, tab, gam,
-                   hg_form, qh, hg, e_hg, q1, q2, dt, vol, dt_el, fe, work, m_node):
+                   hg_form, qh, hg, e_hg, q1, q2, dt, vol, dt_el, fe, work, m_el):
     r"""Nodal forces (E, nen, 3) of one-point elements: stress, bulk viscosity, hourglass.
 
     The geometry at :math:`n+1` (``x`` (N, 3)) is computed here, element by
@@ -557,7 +621,7 @@ def uniform_forces(x, v, conn, active, sig, L, rho, c, e_spec, e_av, dim, tab, g
     stiffness-form generalised forces [N] (updated); ``e_hg`` (E,) hourglass
     work [J] (updated); bulk viscosity ``q1`` (quadratic), ``q2`` (linear),
     whose heat goes to ``e_spec`` and ``e_av`` (E,) [J/kg]; ``work``:
-    :func:`block_scratch`; ``m_node`` (N,) the node masses [kg] of the
+    :func:`block_scratch`; ``m_el`` (E,) the element masses [kg] of the
     hourglass control's terms in the element step (:func:`hourglass_rates`).
     Equations: module docstring and
     :func:`hourglass_resultants`.
@@ -589,9 +653,9 @@ def uniform_forces(x, v, conn, active, sig, L, rho, c, e_spec, e_av, dim, tab, g
                 heat = -dt * q * dkk / rho[e]
                 e_spec[e] += heat
                 e_av[e] += heat
-            coef, a_h, w2_h = element_hourglass_rates(xl, g, V, gam, hg_form, qh, rho[e], c[e],
-                                                      dim, m_node, conn, e)
-            dt_el[e] = element_step(ell, c[e], dkk, q1, q2, a_h, w2_h)
+            coef, a_h, w2_h, ov = element_hourglass_rates(xl, g, V, gam, hg_form, qh, rho[e],
+                                                          c[e], dim, m_el[e])
+            dt_el[e] = element_step(ell, c[e], dkk, q1, q2, a_h, w2_h, ov)
             hourglass = qh > 0.0 and V > 0.0
             if hourglass:
                 e_hg[e] += dt * hourglass_resultants(e, vl, xl, g, V, gam, hg_form, coef,
@@ -746,7 +810,7 @@ def reduced_forces(conn, active, sig, L, rho, c, e_spec, e_av, g, vol, Bg, wg, q
         cmax = 0.0
         for k in range(ngp):
             cmax = max(cmax, c[p0 + k])
-        dt_el[e] = element_step(ell, cmax, dkk, q1, q2, 0.0, 0.0)
+        dt_el[e] = element_step(ell, cmax, dkk, q1, q2, 0.0, 0.0, 0.0)
         for k in range(ngp):
             if wg[p0 + k] <= 0.0:
                 dt_el[e] = 0.0

@@ -31,9 +31,9 @@ from ..base import register_part
 from .gather import gather_loads, node_element_list
 from .hex_lanes import hex_forces, hex_strain_rate, lane_scratch
 from .solid import (DT_BLOCKS, HG_STIFFNESS, HG_VISCOUS, block_scratch, char_length,
-                    element_step, element_volumes, hourglass_bound, local_coordinates,
-                    min_time_step, reduced_forces, reduced_strain_rate, uniform_forces,
-                    uniform_strain_rate, volume_gradient, weigh_point_work)
+                    element_step, element_volumes, hourglass_bound, hourglass_overlap,
+                    local_coordinates, min_time_step, reduced_forces, reduced_strain_rate,
+                    uniform_forces, uniform_strain_rate, volume_gradient, weigh_point_work)
 
 INTEGRATIONS = ("one_point", "selective_reduced")
 HOURGLASS_FORMS = {"viscous": HG_VISCOUS, "stiffness": HG_STIFFNESS}
@@ -184,7 +184,7 @@ class SolidPart:
         """Volumes and element steps at the current positions (no forces)."""
         q, el, p, s = self.nodes, self.el, self.pts, self.s
         element_volumes(q.x, el.conn, el.active, self.dim, self.tab, p.c, p.L, p.rho, self.ngp,
-                        s.q1, s.q2, self.gam, self.hg_form, s.hourglass_coefficient, q.m,
+                        s.q1, s.q2, self.gam, self.hg_form, s.hourglass_coefficient, el.m,
                         el.vol, el.dt_el, self.work)
 
     def _forces(self, dt: float) -> None:
@@ -197,12 +197,12 @@ class SolidPart:
         elif self.lanes is not None:
             hex_forces(q.x, q.v, el.conn, el.active, p.sig, p.L, p.rho, p.c, p.e, p.e_av,
                        self.hg_form, s.hourglass_coefficient, el.hg, el.e_hg, s.q1, s.q2, dt,
-                       el.vol, el.dt_el, el.fe, self.lanes, q.m)
+                       el.vol, el.dt_el, el.fe, self.lanes, el.m)
         else:
             uniform_forces(q.x, q.v, el.conn, el.active, p.sig, p.L, p.rho, p.c, p.e,
                            p.e_av, self.dim, self.tab, self.gam, self.hg_form,
                            s.hourglass_coefficient, el.hg, el.e_hg, s.q1, s.q2, dt, el.vol,
-                           el.dt_el, el.fe, self.work, q.m)
+                           el.dt_el, el.fe, self.work, el.m)
         gather_loads(el.fe, 0, self.offsets, self.slots, q.m, q.a)
 
     # ----------------------------------------------------------- protocol
@@ -257,12 +257,13 @@ class SolidPart:
         if V <= 0.0:
             return ""
         dkk = float(np.trace(p.L[k]))
-        plain = element_step(char_length(g, V), p.c[k], dkk, s.q1, s.q2, 0.0, 0.0)
+        plain = element_step(char_length(g, V), p.c[k], dkk, s.q1, s.q2, 0.0, 0.0, 0.0)
         lam = hourglass_bound(xl, g, V, self.gam)
+        overlap = hourglass_overlap(xl, g, V, self.dim)
         return (f"; its step {el.dt_el[k] / plain:.3g} of what it would be without the "
                 f"hourglass control's terms (shape vectors' Gram bound {lam:.3g}, "
-                f"{el.nen} undistorted: docs/theory.md, \"The element step with the "
-                "hourglass control\")")
+                f"{el.nen} undistorted; subspace overlap {overlap:.3g}, 0 undistorted: "
+                "docs/theory.md, \"The element step with the hourglass control\")")
 
     def hotspot(self) -> str:
         """The element of the largest specific internal energy (the energy
