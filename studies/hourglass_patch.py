@@ -1,12 +1,11 @@
-"""Study: the assembled hourglass damping of a patch of elements against each element's bound (issue 53).
+"""Study: a patch of elements' assembled hourglass damping against each element's (issue 53).
 
 Restarts a run from its checkpoint (``RUN/checkpoint.h5``; nothing is
 written) and takes ``--steps`` steps. Every ``--every`` steps it forms, with
 NumPy, the viscous hourglass damping matrix ``C = sum_e a_h gamma^T gamma``
-of every element sharing a node with ``--elements`` and prints
-the model's E_total and ``dt lambda_max(M^-1 C)`` of the patch with the
-nodes' whole masses (the
-explicit update of a damped mode is stable below 2), and, per element,
+of every element sharing a node with ``--elements`` and prints the model's
+E_total and ``dt lambda_max(M^-1 C)`` of the patch with the nodes' whole
+masses (the explicit update of a damped mode is stable below 2), and, per element,
 ``dt lambda_max`` of its own damping with its nodes' whole masses and with
 its own share ``m_e / nen`` of each (docs/theory.md, "The element step with
 the hourglass control": only the shares bound the assembled number).

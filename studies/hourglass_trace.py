@@ -11,8 +11,8 @@ and the stability number of its viscous hourglass force, ``dt a_h
 lambda_max / m`` (the largest eigenvalue of ``M^-1/2 C M^-1/2`` of the
 element's own hourglass damping matrix with its nodes' whole masses, as
 the element step of 68efeb8 took them (only each element's shares bound the
-assembled number: studies/hourglass_patch.py), times the step: the explicit update of a mode is stable below 2 without the
-element's own stiffness; docs/theory.md, "The element step with the
+assembled number: studies/hourglass_patch.py), times the step: the explicit
+update of a mode is stable below 2 without the element's own stiffness; docs/theory.md, "The element step with the
 hourglass control"); and, for every element eroded in the
 step, its points' work and its hourglass work, and the internal energy of
 the particles it became; and the step's change of the model's E_total and

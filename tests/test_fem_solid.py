@@ -659,9 +659,11 @@ def test_the_overlap_bounds_the_angle_between_stiffness_and_hourglass_subspaces(
     smallest principal angle between span(b) and span(gamma) computed from
     orthonormal bases (:func:`overlap_by_hand`): never below it (1e-12:
     round-off of the two routes), equal to the formula written out (1e-12);
-    exact in 2D (one hourglass mode, so one angle); about 0 for the
-    parallelepipeds (< 1e-7: sqrt of a round-off in mu = 1; gamma orthogonal
-    to b there). The distorted ones reach 0.4 (the bound stays below 1)."""
+    exact in 2D (one hourglass mode, so one angle); 0 for the parallelepipeds
+    (gamma orthogonal to b there; their mu - 1, a round-off, is below
+    OVERLAP_ROUNDOFF), and the formula's for an element distorted by 1e-3
+    (mu - 1 far above it). The distorted ones reach 0.4 (the bound stays
+    below 1)."""
     from sphdyn.parts.fem.solid import hourglass_overlap
 
     rng = np.random.default_rng(3)
@@ -689,10 +691,19 @@ def test_the_overlap_bounds_the_angle_between_stiffness_and_hourglass_subspaces(
         if dim == 2:
             assert got == pytest.approx(exact, abs=1e-7)
         if trial < 20:
-            assert got < 1e-7
+            assert got == 0.0  # mu - 1 is round-off: under OVERLAP_ROUNDOFF
         else:
             seen.append(exact)
     assert max(seen) > 0.4 and len(seen) > 150
+    # one node moved by 1e-3 of the side: mu - 1 about 1e-6, above the
+    # round-off threshold, so the overlap is the formula's (about 1e-3), not 0
+    x = x0.copy()
+    x[0, 0] += 1e-3
+    g = np.zeros((x.shape[0], 3))
+    V = volume_gradient(x - x[0], dim, volume_table(dim), g)
+    exact, formula = overlap_by_hand(x, dim)
+    got = hourglass_overlap(x - x[0], g, V, dim)
+    assert 1e-4 < got == pytest.approx(formula, rel=1e-6) and got >= exact - 1e-12
 
 
 def test_the_matrix_condition_of_the_step_is_sufficient():

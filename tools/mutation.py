@@ -242,6 +242,11 @@ MUTANTS: tuple[Mutant, ...] = (
            ("tests/test_fem_solid.py::test_the_overlap_bounds_the_angle_between_stiffness_"
             "and_hourglass_subspaces[3]",),
            "subspace overlap: mu = tr(Gx Gb) - (d - 1) -> - d (below the true angle)"),
+    Mutant("overlap_roundoff_wide", "issue 53", "sphdyn/parts/fem/solid.py",
+           "OVERLAP_ROUNDOFF = 1e-10", "OVERLAP_ROUNDOFF = 1e-4",
+           ("tests/test_fem_solid.py::test_the_overlap_bounds_the_angle_between_stiffness_"
+            "and_hourglass_subspaces[3]",),
+           "subspace overlap: the round-off threshold on mu - 1 widened to 1e-4"),
     Mutant("hex_lanes_node_share", "issue 53", "sphdyn/parts/fem/hex_lanes.py",
            "S[MSH_ * LANES + l] = m_el[e] / 8", "S[MSH_ * LANES + l] = m_el[e] / 4",
            ("tests/test_fem_solid.py::test_an_element_distorted_into_its_hourglass_shape_"

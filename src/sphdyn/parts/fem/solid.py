@@ -279,13 +279,14 @@ def hourglass_overlap(xl, g, V, dim):
     smallest angle between the element's stiffness and hourglass subspaces
     [-] (module docstring, "Stable step with the hourglass control"):
     :math:`c_\theta^2 = 1 - 1/\mu`, :math:`\mu = \mathrm{tr}(G_x G_b) - (d - 1)`
-(0 where :math:`\mu \le 1 +` :data:`OVERLAP_ROUNDOFF`), :math:`G_x = \sum_I \tilde{\mathbf x}_I
-    \otimes\tilde{\mathbf x}_I` of the node coordinates about their mean,
+    (0 where :math:`\mu \le 1 +` :data:`OVERLAP_ROUNDOFF`), :math:`G_x =
+    \sum_I \tilde{\mathbf x}_I\otimes\tilde{\mathbf x}_I` of the node
+    coordinates about their mean,
     :math:`G_b = \sum_I \mathbf b_I\otimes\mathbf b_I`, :math:`\mathbf b_I =
     \partial V/\partial\mathbf x_I / V`. 0 for a parallelepiped
     (:math:`G_x G_b = \mathbf 1`). ``xl``, ``g`` (nen, 3) node coordinates [m]
     and volume derivatives [m^2], ``V`` > 0 [m^3], ``dim`` 2 or 3. The
-    reference of the lane pass (:func:`.hex_lanes.force_lanes`, the same
+    reference of the lane pass (:func:`.hex_lanes.overlap_lanes`, the same
     operations in the same order)."""
     nen = xl.shape[0]
     m0 = m1 = m2 = 0.0
@@ -327,7 +328,6 @@ def overlap_from_moments(p00, p01, p02, p11, p12, p22, r00, r01, r02, r11, r12, 
     mu = t / (V * V) - (dim - 1)
     c2 = 1.0 - 1.0 / mu if mu > 1.0 + OVERLAP_ROUNDOFF else 0.0
     return sqrt(c2)
-
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
@@ -506,8 +506,9 @@ def hourglass_rates(lam, coef, m_share, hg_form):
     form), the other 0; both 0 without hourglass control (``coef`` <= 0).
     ``lam`` the bound of :func:`hourglass_bound`, ``coef`` :math:`a_h` [kg/s]
     or :math:`k_h` [N/m], ``m_share`` the element's share of each node's mass
-    [kg] (its mass over ``nen``, not the node's whole mass: module docstring). Alone, :math:`A_h` allows the step :math:`1/A_h = 2m/(a_h\lambda)`
-    and :math:`\omega_h^2` allows :math:`2/\omega_h`."""
+    [kg] (its mass over ``nen``, not the node's whole mass: module docstring).
+    Alone, :math:`A_h` allows the step :math:`1/A_h = 2m/(a_h\lambda)` and
+    :math:`\omega_h^2` allows :math:`2/\omega_h`."""
     if coef <= 0.0 or lam <= 0.0:
         return 0.0, 0.0
     if hg_form == HG_VISCOUS:
