@@ -1,10 +1,16 @@
-"""Study: the Forrestal quick target's lateral faces, free or on rollers (issue 53).
+"""Study: the Forrestal target's cut faces: free, on rollers or non-reflecting (issue 53).
 
 The case's target (validation/cases/forrestal1994_ogive.toml) is cut to
-300 x 300 mm with free lateral faces; the experiment's concrete went on to a
-1.37 m culvert. This runs the quick version (the case's quick overrides)
-with the four lateral faces' nodes held in their normal direction
-(`[[set]]` boxes and `[[boundary]]` type "fixed" with one component: rollers)
+300 x 300 mm and 360 mm deep with free faces; the experiment's concrete went
+on to a 1.37 m culvert, 0.76 m long. This runs the case (its quick version
+unless ``--full``) with the four lateral faces' nodes (`[[set]]` boxes)
+
+* ``--faces rollers``: held in their normal direction (`[[boundary]]` type
+  "fixed" with one component);
+* ``--faces non_reflecting``: on Lysmer-Kuhlemeyer dashpots
+  (`[[boundary]]` type "non_reflecting"), and the back face too (the
+  concrete went on beyond it);
+
 and prints the depth of penetration as `sphdyn validate` measures it, and
 the eroded elements. Extra ``--set`` values pass on (e.g.
 ``material.concrete.erosion.effective_strain=0.5``). The numbers in
@@ -13,6 +19,7 @@ docs/validation.md (2026-11-30):
     python studies/forrestal_lateral_faces.py --out OUT
     python studies/forrestal_lateral_faces.py --out OUT2 \\
         --set material.concrete.erosion.effective_strain=0.5
+    python studies/forrestal_lateral_faces.py --out OUT3 --faces non_reflecting
 """
 
 from __future__ import annotations
@@ -21,19 +28,31 @@ import argparse
 import csv
 import subprocess
 import sys
+import tomllib
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-ROLLERS = ""
-for name, axis, lo, hi in (("side_x_lo", "x", -151, -149), ("side_x_hi", "x", 149, 151),
-                           ("side_y_lo", "y", -151, -149), ("side_y_hi", "y", 149, 151)):
-    box_lo = [f'"{lo} mm"' if axis == "x" else '"-151 mm"',
-              f'"{lo} mm"' if axis == "y" else '"-151 mm"', '"-361 mm"']
-    box_hi = [f'"{hi} mm"' if axis == "x" else '"151 mm"',
-              f'"{hi} mm"' if axis == "y" else '"151 mm"', '"1 mm"']
-    ROLLERS += (f'\n[[set]]\nname = "{name}"\nmesh = "target"\nregion = {{ shape = "box", '
+
+
+def cut_faces(kind: str) -> str:
+    """The deck tables that put the target's lateral faces on rollers, or its
+    lateral and back faces on a non-reflecting boundary (``kind``)."""
+    out = ""
+    sides = [("side_x_lo", "x", -151, -149), ("side_x_hi", "x", 149, 151),
+             ("side_y_lo", "y", -151, -149), ("side_y_hi", "y", 149, 151)]
+    if kind == "non_reflecting":
+        sides.append(("back", "z", -361, -359))
+    for name, axis, lo, hi in sides:
+        box_lo = [f'"{lo} mm"' if axis == a else f'"{wide[0]} mm"'
+                  for a, wide in zip("xyz", ((-151, 151), (-151, 151), (-361, 1)))]
+        box_hi = [f'"{hi} mm"' if axis == a else f'"{wide[1]} mm"'
+                  for a, wide in zip("xyz", ((-151, 151), (-151, 151), (-361, 1)))]
+        held = (f'type = "fixed"\ncomponents = ["{axis}"]' if kind == "rollers"
+                else 'type = "non_reflecting"')
+        out += (f'\n[[set]]\nname = "{name}"\nmesh = "target"\nregion = {{ shape = "box", '
                 f'lo = [{", ".join(box_lo)}], hi = [{", ".join(box_hi)}] }}\n'
-                f'\n[[boundary]]\nset = "{name}"\ntype = "fixed"\ncomponents = ["{axis}"]\n')
+                f'\n[[boundary]]\nset = "{name}"\n{held}\n')
+    return out
 
 
 def main(argv=None) -> int:
@@ -44,18 +63,24 @@ def main(argv=None) -> int:
     ap.add_argument("--out", required=True, type=Path)
     ap.add_argument("--set", action="append", default=[])
     ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--faces", choices=("rollers", "non_reflecting"), default="rollers")
+    ap.add_argument("--full", action="store_true",
+                    help="the case at its full resolution (hours), not the quick one")
     args = ap.parse_args(argv)
     case = CASES["forrestal1994_ogive"]
     args.out.mkdir(parents=True, exist_ok=True)
-    deck = args.out / "forrestal_rollers.toml"
-    deck.write_text((ROOT / case.deck).read_text(encoding="utf-8") + ROLLERS, encoding="utf-8")
+    deck = args.out / f"forrestal_{args.faces}.toml"
+    deck.write_text((ROOT / case.deck).read_text(encoding="utf-8") + cut_faces(args.faces),
+                    encoding="utf-8")
     run = args.out / "run"
     cmd = [sys.executable, "-m", "sphdyn", "run", str(deck), "--out", str(run), "-q",
            "--threads", str(args.threads)]
-    for override in (*case.quick, *args.set):
+    quick = () if args.full else case.quick
+    for override in (*quick, *args.set):
         cmd += ["--set", override]
     subprocess.run(cmd, check=True)
-    dx = float(next(o for o in case.quick if o.startswith("body.projectile.dx=")).split("=")[1])
+    resolved = tomllib.loads((run / "deck.resolved.toml").read_text(encoding="utf-8"))
+    dx = next(b for b in resolved["body"] if b["name"] == "projectile")["dx"]
     rows = list(csv.DictReader(open(run / "history.csv", encoding="utf-8")))
     print(f"depth of penetration {1e3 * depth_of_penetration(run, 'projectile', 0.0, dx):.1f} mm, "
           f"eroded elements {float(rows[-1]['eroded_target']):.0f}")

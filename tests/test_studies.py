@@ -216,20 +216,41 @@ def test_hourglass_patch_damping_of_a_block_of_cubes():
     assert max(whole) < 0.75 * assembled  # 0.717: the corner nodes are an eighth
 
 
+def _forrestal_quick_block(faces: str):
+    import forrestal_lateral_faces as flf
+
+    root = Path(__file__).resolve().parent.parent
+    text = ((root / "validation" / "cases" / "forrestal1994_ogive.toml").read_text()
+            + flf.cut_faces(faces))
+    return loads_deck(text.replace("divisions = [50, 50, 60]", "divisions = [20, 20, 24]"))
+
+
 def test_forrestal_rollers_hold_each_lateral_face_in_its_normal_only():
     """studies/forrestal_lateral_faces.py: the case's deck with the rollers
     builds (the quick block), each of the four sets holds one lateral face's
     nodes (21 x 25 of the 20 x 20 x 24 block), held in that face's normal
     component only."""
-    import forrestal_lateral_faces as flf
-
-    root = Path(__file__).resolve().parent.parent
-    text = (root / "validation" / "cases" / "forrestal1994_ogive.toml").read_text() + flf.ROLLERS
-    text = text.replace("divisions = [50, 50, 60]", "divisions = [20, 20, 24]")
-    deck = loads_deck(text)
+    deck = _forrestal_quick_block("rollers")
     model = build_model(deck)
     sets = {b.set: b for b in deck.boundary}
+    assert len(sets) == 4
     for name, axis in (("side_x_lo", 0), ("side_x_hi", 0), ("side_y_lo", 1), ("side_y_hi", 1)):
         mesh, nodes = model.mesh_sets[name]
         assert mesh == "target" and len(nodes) == 21 * 25, name
         assert list(sets[name].components) == ["xyz"[axis]]
+
+
+def test_forrestal_non_reflecting_faces_are_the_four_sides_and_the_back():
+    """--faces non_reflecting: the four lateral faces (20 x 24 element faces
+    each) and the back face (20 x 20) of the quick block on dashpots, the
+    impact face free."""
+    from sphdyn.assembly import build_stepper
+    from sphdyn.interactions.non_reflecting import NonReflectingBoundary
+
+    st = build_stepper(_forrestal_quick_block("non_reflecting"))
+    nrb = {i.name: i for i in st.interactions if isinstance(i, NonReflectingBoundary)}
+    assert sorted(nrb) == ["back", "side_x_hi", "side_x_lo", "side_y_hi", "side_y_lo"]
+    for name, b in nrb.items():
+        assert b.n_faces == (20 * 20 if name == "back" else 20 * 24), name
+    x = st.part("target").kin.x
+    assert np.all(x[nrb["back"].nodes, 2] == pytest.approx(-0.36, abs=1e-12))

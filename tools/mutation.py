@@ -247,6 +247,29 @@ MUTANTS: tuple[Mutant, ...] = (
            ("tests/test_fem_solid.py::test_the_overlap_bounds_the_angle_between_stiffness_"
             "and_hourglass_subspaces[3]",),
            "subspace overlap: the round-off threshold on mu - 1 widened to 1e-4"),
+    Mutant("nrb_lagged", "issue 53", "sphdyn/interactions/non_reflecting.py",
+           "        b0 = v[i, 0] + 0.5 * dt * a_int[i, 0]\n"
+           "        b1 = v[i, 1] + 0.5 * dt * a_int[i, 1]\n"
+           "        b2 = v[i, 2] + 0.5 * dt * a_int[i, 2]\n",
+           "        b0 = v[i, 0]\n        b1 = v[i, 1]\n        b2 = v[i, 2]\n"
+           "        s = 0.0\n        a00 = a11 = a22 = 1.0\n        a01 = a02 = a12 = 0.0\n",
+           ("tests/test_non_reflecting.py::test_the_ends_absorb_at_the_courant_number_one_"
+            "along_the_bar[hex8]",),
+           "non-reflecting boundary: the dashpots on v^(n+1/2) (lagged) instead of the "
+           "centred v^(n+1)"),
+    Mutant("nrb_shear_impedance", "issue 53", "sphdyn/interactions/non_reflecting.py",
+           "C[r, i, i] += z_s[f] * area", "C[r, i, i] += z_d[f] * area",
+           ("tests/test_non_reflecting.py::test_flat_face_gives_each_corner_a_quarter_of_"
+            "its_area_times_the_impedances",
+            "tests/test_non_reflecting.py::test_a_plane_pulse_leaves_through_the_absorbing_"
+            "ends[S-hex8]"),
+           "non-reflecting boundary: the shear dashpot with rho c_d instead of rho c_s"),
+    Mutant("nrb_shear_speed", "issue 53", "sphdyn/interactions/non_reflecting.py",
+           "z_s[rows] = math.sqrt(rho0 * g.model.shear_modulus(g.params))",
+           "z_s[rows] = math.sqrt(g.model.shear_modulus(g.params))",
+           ("tests/test_non_reflecting.py::test_a_plane_pulse_leaves_through_the_absorbing_"
+            "ends[S-quad4]",),
+           "non-reflecting boundary: rho c_s = sqrt(rho G) -> sqrt(G)"),
     Mutant("hex_lanes_node_share", "issue 53", "sphdyn/parts/fem/hex_lanes.py",
            "S[MSH_ * LANES + l] = m_el[e] / 8", "S[MSH_ * LANES + l] = m_el[e] / 4",
            ("tests/test_fem_solid.py::test_an_element_distorted_into_its_hourglass_shape_"

@@ -24,6 +24,7 @@ from .events import ElementErosion, ErosionRules
 from .interactions import HybridCoupling, PenaltyCoupling, TiedCoupling, Wall
 from .interactions.nodal import MassDamping, NodalLoad, PrescribedMotion
 from .interactions.blast import BlastLoad
+from .interactions.non_reflecting import NonReflectingBoundary
 from .interactions.pressure import PressureLoad
 from .interactions.embedded import EmbeddedNodes
 from .interactions.sublayer import SublayerCoupling
@@ -110,6 +111,13 @@ def mesh_interactions(deck, model, sph_part, meshes: dict) -> list:
     out, taken = [], set()
     for k, bnd in enumerate(deck.boundary):
         part, idx = _target(model, sph_part, meshes, bnd.set)
+        if bnd.type == "non_reflecting":
+            faces, elements = pressure_faces(model.meshes, model.mesh_sets, bnd.set,
+                                             f"boundary[{k}].set",
+                                             "a non-reflecting boundary")
+            out.append(NonReflectingBoundary(_unique(bnd.set, taken), part, faces,
+                                             elements))
+            continue
         value = {"fixed": (0.0, 0.0, 0.0), "velocity": bnd.velocity,
                  "displacement": bnd.displacement}[bnd.type]
         out.append(PrescribedMotion(_unique(bnd.set, taken), part, idx, kind=bnd.type,

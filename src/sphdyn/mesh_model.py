@@ -249,25 +249,27 @@ def set_faces(meshes: list[MeshModel], mesh_sets: dict, set_name: str, where: st
 
 
 def pressure_faces(meshes: list[MeshModel], mesh_sets: dict, set_name: str,
-                   where: str) -> tuple[np.ndarray, np.ndarray]:
-    """The faces a pressure on the set ``set_name`` loads (:func:`set_faces`);
-    DeckError naming ``where`` if the set holds particles, nodes of a line, or no
-    whole exterior face."""
+                   where: str, what: str = "a pressure") -> tuple[np.ndarray, np.ndarray]:
+    """The faces a pressure (or, ``what``, a non-reflecting boundary) on the set
+    ``set_name`` acts on (:func:`set_faces`); DeckError naming ``where`` if the
+    set holds particles, nodes of a line, or no whole exterior face."""
+    other = (", or give force = [...] (shared by the {})" if what == "a pressure"
+             else " (particles and lines have no faces to absorb waves on{})")
     if set_name not in mesh_sets:
         raise DeckError([format_problem(
-            where, f"set '{set_name}' holds particles; a pressure acts on the faces of a "
+            where, f"set '{set_name}' holds particles; {what} acts on the faces of a "
                    "solid mesh", "name a [[set]] with mesh = \"<name>\" whose nodes "
-                   "cover the loaded surface, or give force = [...] (shared by the "
-                   "particles)")])
+                   "cover the surface" + other.format("particles" if what == "a pressure"
+                                                      else ""))])
     faces, elements = set_faces(meshes, mesh_sets, set_name, where,
-                                "name a set of a solid mesh's nodes, or give force = "
-                                "[...] (shared by the nodes)")
+                                "name a set of a solid mesh's nodes"
+                                + other.format("nodes" if what == "a pressure" else ""))
     if faces.shape[0] == 0:
         mesh, idx = mesh_sets[set_name]
         face = "edge" if faces.shape[1] == 2 else "face"
         raise DeckError([format_problem(
             where, f"set '{set_name}' holds {idx.size} node(s) of mesh '{mesh}' but no "
                    f"exterior {face} of the mesh has all its nodes in the set",
-            f"select whole {face}s: a region around the loaded surface that contains "
+            f"select whole {face}s: a region around the surface that contains "
             f"every node of its {face}s (or a group of the mesh file that does)")])
     return faces, elements

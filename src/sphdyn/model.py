@@ -323,6 +323,10 @@ def build_model(deck) -> Model:
     for k, load in enumerate(deck.load):  # refused here, so that check refuses them
         if load.pressure is not None:
             pressure_faces(meshes, mesh_sets, load.set, f"load[{k}].set")
+    for k, bnd in enumerate(deck.boundary):
+        if bnd.type == "non_reflecting":
+            pressure_faces(meshes, mesh_sets, bnd.set, f"boundary[{k}].set",
+                           "a non-reflecting boundary")
     probes = []
     for k, pr in enumerate(deck.probe):
         if pr.set in mesh_sets:

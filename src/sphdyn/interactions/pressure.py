@@ -61,9 +61,54 @@ from .nodal import TimeFactor, set_work
 
 
 @njit(cache=True, error_model="numpy")
+def face_area_vectors(x, faces, f, S):
+    r"""The vectors :math:`\mathbf S_a = \int_\Gamma N_a\,\mathbf n\,dA` [m^2]
+    (m in 2D, per unit thickness) of the nodes of face ``f`` on the current
+    positions ``x`` (N, 3), written to ``S`` (nf, 3) (module docstring: a
+    quadrilateral's :math:`\mathbf e_1\times\mathbf e_2 + \tfrac{\xi_a}{3}
+    \mathbf e_1\times\mathbf h + \tfrac{\eta_a}{3}\mathbf h\times\mathbf e_2`,
+    a segment's :math:`\tfrac12 (t_y, -t_x, 0)`). ``faces`` (F, 4) or (F, 2),
+    outward order; they add up to the face's area vector."""
+    if faces.shape[1] == 2:
+        i, j = faces[f, 0], faces[f, 1]
+        for a in range(2):
+            S[a, 0] = 0.5 * (x[j, 1] - x[i, 1])
+            S[a, 1] = -(0.5 * (x[j, 0] - x[i, 0]))
+            S[a, 2] = 0.0
+        return
+    i0, i1, i2, i3 = faces[f, 0], faces[f, 1], faces[f, 2], faces[f, 3]
+    e1_0 = 0.25 * (-x[i0, 0] + x[i1, 0] + x[i2, 0] - x[i3, 0])
+    e1_1 = 0.25 * (-x[i0, 1] + x[i1, 1] + x[i2, 1] - x[i3, 1])
+    e1_2 = 0.25 * (-x[i0, 2] + x[i1, 2] + x[i2, 2] - x[i3, 2])
+    e2_0 = 0.25 * (-x[i0, 0] - x[i1, 0] + x[i2, 0] + x[i3, 0])
+    e2_1 = 0.25 * (-x[i0, 1] - x[i1, 1] + x[i2, 1] + x[i3, 1])
+    e2_2 = 0.25 * (-x[i0, 2] - x[i1, 2] + x[i2, 2] + x[i3, 2])
+    h_0 = 0.25 * (x[i0, 0] - x[i1, 0] + x[i2, 0] - x[i3, 0])
+    h_1 = 0.25 * (x[i0, 1] - x[i1, 1] + x[i2, 1] - x[i3, 1])
+    h_2 = 0.25 * (x[i0, 2] - x[i1, 2] + x[i2, 2] - x[i3, 2])
+    # e1 x e2, e1 x h, h x e2
+    s0 = e1_1 * e2_2 - e1_2 * e2_1
+    s1 = e1_2 * e2_0 - e1_0 * e2_2
+    s2 = e1_0 * e2_1 - e1_1 * e2_0
+    b0 = (e1_1 * h_2 - e1_2 * h_1) / 3.0
+    b1 = (e1_2 * h_0 - e1_0 * h_2) / 3.0
+    b2 = (e1_0 * h_1 - e1_1 * h_0) / 3.0
+    c0 = (h_1 * e2_2 - h_2 * e2_1) / 3.0
+    c1 = (h_2 * e2_0 - h_0 * e2_2) / 3.0
+    c2 = (h_0 * e2_1 - h_1 * e2_0) / 3.0
+    for a in range(4):
+        xi = -1.0 if a == 0 or a == 3 else 1.0
+        eta = -1.0 if a < 2 else 1.0
+        S[a, 0] = s0 + xi * b0 + eta * c0
+        S[a, 1] = s1 + xi * b1 + eta * c1
+        S[a, 2] = s2 + xi * b2 + eta * c2
+
+
+@njit(cache=True, error_model="numpy")
 def face_pressure_forces(x, faces, local, elements, active, p, force):
     r"""Consistent nodal forces of the pressure ``p`` [Pa] on the faces (module
-    docstring), written to ``force`` (k, 3) [N] (N/m in 2D).
+    docstring), :math:`\mathbf f_a = -p\,\mathbf S_a` (:func:`face_area_vectors`),
+    written to ``force`` (k, 3) [N] (N/m in 2D).
 
     ``x`` (N, 3) current node positions [m]; ``faces`` (F, 4) quadrilaterals
     or (F, 2) segments (node indices into ``x``, outward order); ``local``
@@ -73,44 +118,16 @@ def face_pressure_forces(x, faces, local, elements, active, p, force):
     for k in range(force.shape[0]):
         force[k, 0] = force[k, 1] = force[k, 2] = 0.0
     nf = faces.shape[1]
+    S = np.empty((nf, 3))
     for f in range(faces.shape[0]):
         if active[elements[f]] == 0:
             continue
-        if nf == 2:
-            i, j = faces[f, 0], faces[f, 1]
-            g0 = -0.5 * p * (x[j, 1] - x[i, 1])
-            g1 = 0.5 * p * (x[j, 0] - x[i, 0])
-            for a in range(2):
-                force[local[f, a], 0] += g0
-                force[local[f, a], 1] += g1
-            continue
-        i0, i1, i2, i3 = faces[f, 0], faces[f, 1], faces[f, 2], faces[f, 3]
-        e1_0 = 0.25 * (-x[i0, 0] + x[i1, 0] + x[i2, 0] - x[i3, 0])
-        e1_1 = 0.25 * (-x[i0, 1] + x[i1, 1] + x[i2, 1] - x[i3, 1])
-        e1_2 = 0.25 * (-x[i0, 2] + x[i1, 2] + x[i2, 2] - x[i3, 2])
-        e2_0 = 0.25 * (-x[i0, 0] - x[i1, 0] + x[i2, 0] + x[i3, 0])
-        e2_1 = 0.25 * (-x[i0, 1] - x[i1, 1] + x[i2, 1] + x[i3, 1])
-        e2_2 = 0.25 * (-x[i0, 2] - x[i1, 2] + x[i2, 2] + x[i3, 2])
-        h_0 = 0.25 * (x[i0, 0] - x[i1, 0] + x[i2, 0] - x[i3, 0])
-        h_1 = 0.25 * (x[i0, 1] - x[i1, 1] + x[i2, 1] - x[i3, 1])
-        h_2 = 0.25 * (x[i0, 2] - x[i1, 2] + x[i2, 2] - x[i3, 2])
-        # e1 x e2, e1 x h, h x e2
-        s0 = e1_1 * e2_2 - e1_2 * e2_1
-        s1 = e1_2 * e2_0 - e1_0 * e2_2
-        s2 = e1_0 * e2_1 - e1_1 * e2_0
-        b0 = (e1_1 * h_2 - e1_2 * h_1) / 3.0
-        b1 = (e1_2 * h_0 - e1_0 * h_2) / 3.0
-        b2 = (e1_0 * h_1 - e1_1 * h_0) / 3.0
-        c0 = (h_1 * e2_2 - h_2 * e2_1) / 3.0
-        c1 = (h_2 * e2_0 - h_0 * e2_2) / 3.0
-        c2 = (h_0 * e2_1 - h_1 * e2_0) / 3.0
-        for a in range(4):
-            xi = -1.0 if a == 0 or a == 3 else 1.0
-            eta = -1.0 if a < 2 else 1.0
+        face_area_vectors(x, faces, f, S)
+        for a in range(nf):
             r = local[f, a]
-            force[r, 0] -= p * (s0 + xi * b0 + eta * c0)
-            force[r, 1] -= p * (s1 + xi * b1 + eta * c1)
-            force[r, 2] -= p * (s2 + xi * b2 + eta * c2)
+            force[r, 0] -= p * S[a, 0]
+            force[r, 1] -= p * S[a, 1]
+            force[r, 2] -= p * S[a, 2]
 
 
 @njit(cache=True, error_model="numpy")
@@ -147,7 +164,55 @@ def nodal_forces(x, faces, p: float) -> np.ndarray:
     return out
 
 
-class PressureLoad(InteractionBase):
+class FaceInteraction(InteractionBase):
+    """Forces on faces of a solid mesh part whose work is external work: the
+    faces, their nodes' rows, the accelerations of the last force pass and
+    their work over the kicks (shared by :class:`PressureLoad` and the
+    non-reflecting boundary).
+
+    ``faces`` (F, 4) quadrilaterals or (F, 2) segments, outward node order;
+    ``elements`` (F,) their elements; ``what`` names the forces in messages.
+    """
+
+    external = True  # its work is external work (W_external)
+
+    def __init__(self, name: str, part, faces, elements, what: str):
+        self.name, self.part = name, part
+        self.faces = np.ascontiguousarray(faces, dtype=np.int64)
+        if (self.faces.ndim != 2 or self.faces.shape[0] == 0
+                or self.faces.shape[1] not in (2, 4)):
+            raise ValueError(f"{name}: no faces for {what} (faces must be (F, 4) or "
+                             "(F, 2), F > 0)")
+        self.elements = np.ascontiguousarray(elements, dtype=np.int64)
+        self.nodes, self.local = face_rows(self.faces)
+        if np.any(part.kin.m[self.nodes] <= 0.0):
+            raise ValueError(f"{name}: {what} on nodes without mass")
+        self._a = np.zeros((self.nodes.size, 3))  # the face nodes' accelerations [m/s^2]
+        self.work = 0.0  # total [J]
+        self._kick = 0.0  # over the last kick [J]
+
+    @property
+    def n_faces(self) -> int:
+        return int(self.faces.shape[0])
+
+    def after_kick(self, dt_kick: float) -> None:
+        q = self.part.kin
+        self._kick = set_work(self.nodes, q.m, self._a, q.v_mid, dt_kick)
+        self.work += self._kick
+
+    def external_work(self) -> float:
+        return self._kick
+
+    def state(self) -> tuple[dict, dict[str, np.ndarray]]:
+        return {"work": self.work, "kick": self._kick}, {"a": self._a}
+
+    def restore(self, scalars: dict, arrays: dict) -> None:
+        self.work = float(scalars["work"])
+        self._kick = float(scalars["kick"])
+        self._a[...] = arrays["a"]
+
+
+class PressureLoad(FaceInteraction):
     """A pressure on faces of a solid mesh part (module docstring).
 
     Parameters
@@ -164,31 +229,13 @@ class PressureLoad(InteractionBase):
     (external work).
     """
 
-    external = True  # its work is external work (W_external)
-
     def __init__(self, name: str, part, faces, elements, pressure: float,
                  ramp_time: float = 0.0, shape: str = "linear", curve=None):
-        self.name, self.part = name, part
-        self.faces = np.ascontiguousarray(faces, dtype=np.int64)
-        if (self.faces.ndim != 2 or self.faces.shape[0] == 0
-                or self.faces.shape[1] not in (2, 4)):
-            raise ValueError(f"{name}: no faces to load (faces must be (F, 4) or (F, 2), "
-                             "F > 0)")
-        self.elements = np.ascontiguousarray(elements, dtype=np.int64)
+        super().__init__(name, part, faces, elements, "a pressure")
         self.pressure = float(pressure)
         self.factor = TimeFactor(ramp_time, shape, curve)
-        self.nodes, self.local = face_rows(self.faces)
-        if np.any(part.kin.m[self.nodes] <= 0.0):
-            raise ValueError(f"{name}: a pressure on nodes without mass")
         self.force = np.zeros((self.nodes.size, 3))  # nodal forces now [N]
-        self._a = np.zeros((self.nodes.size, 3))  # their accelerations [m/s^2]
         self._now = 0.0  # the pressure now [Pa]
-        self.work = 0.0  # total [J]
-        self._kick = 0.0  # over the last kick [J]
-
-    @property
-    def n_faces(self) -> int:
-        return int(self.faces.shape[0])
 
     def forces(self, t: float, dt: float, a_out: np.ndarray) -> None:
         q = self.part.kin
@@ -196,14 +243,6 @@ class PressureLoad(InteractionBase):
         face_pressure_forces(q.x, self.faces, self.local, self.elements,
                              self.part.el.active, self._now, self.force)
         accelerate(self.nodes, q.m, self.force, self._a, a_out)
-
-    def after_kick(self, dt_kick: float) -> None:
-        q = self.part.kin
-        self._kick = set_work(self.nodes, q.m, self._a, q.v_mid, dt_kick)
-        self.work += self._kick
-
-    def external_work(self) -> float:
-        return self._kick
 
     def columns(self, t: float) -> dict[str, float]:
         f = self.force.sum(axis=0)
@@ -213,12 +252,10 @@ class PressureLoad(InteractionBase):
         return out
 
     def state(self) -> tuple[dict, dict[str, np.ndarray]]:
-        return ({"now": self._now, "work": self.work, "kick": self._kick},
-                {"a": self._a, "force": self.force})
+        scalars, arrays = super().state()
+        return {**scalars, "now": self._now}, {**arrays, "force": self.force}
 
     def restore(self, scalars: dict, arrays: dict) -> None:
+        super().restore(scalars, arrays)
         self._now = float(scalars["now"])
-        self.work = float(scalars["work"])
-        self._kick = float(scalars["kick"])
-        self._a[...] = arrays["a"]
         self.force[...] = arrays["force"]

@@ -47,13 +47,19 @@ class ParticleSet(Section):
 
 
 class Boundary(Section):
-    """[[boundary]]: kinematic condition on a set."""
+    """[[boundary]]: kinematic condition on a set, or a non-reflecting boundary on
+    a solid mesh's faces."""
 
     set: reference_to("set") = Field(description="Name of a [[set]].")
-    type: Literal["fixed", "velocity", "displacement"] = Field(
+    type: Literal["fixed", "velocity", "displacement", "non_reflecting"] = Field(
         description="fixed: zero velocity; velocity: prescribed velocity; "
                     "displacement: prescribed displacement reached over ramp_time, "
-                    "then held (a support moved, e.g. a beam end moved down).")
+                    "then held (a support moved, e.g. a beam end moved down); "
+                    "non_reflecting: viscous dashpots on the exterior faces of a "
+                    "solid mesh whose nodes all lie in the set, which let waves "
+                    "leave the model (Lysmer & Kuhlemeyer 1969; LS-DYNA's "
+                    "BOUNDARY_NON_REFLECTING): for a model cut out of a larger "
+                    "body. The set must be a [[set]] of a solid mesh's nodes.")
     velocity: Optional[VelocityVector] = Field(
         None, validate_default=True,
         description="Prescribed velocity; required for type = \"velocity\", "
@@ -99,8 +105,16 @@ class Boundary(Section):
             raise problem("a displacement boundary needs a ramp_time > 0",
                           "add ramp_time = \"10 ms\" (the time to reach the "
                           "displacement)")
-        if self.type == "fixed" and self.ramp_time != 0.0:
-            raise problem("a fixed boundary has no ramp", "remove ramp_time")
+        if self.type in ("fixed", "non_reflecting") and self.ramp_time != 0.0:
+            raise problem(f"a {self.type} boundary has no ramp", "remove ramp_time")
+        if self.type == "non_reflecting":
+            if "components" in self.model_fields_set:
+                raise problem("a non_reflecting boundary acts in every direction "
+                              "(the dilatational wave along the face's normal, the "
+                              "shear waves across it)", "remove components")
+            if self.rotations != "free":
+                raise problem("a non_reflecting boundary acts on solid faces, which "
+                              "have no rotations", "remove rotations")
         if not self.components or len(set(self.components)) != len(self.components):
             raise problem(f"components {list(self.components)} must name each direction "
                           "at most once, and at least one",
