@@ -1,23 +1,25 @@
 """Study: the Forrestal target's cut faces: free, on rollers or non-reflecting (issue 53).
 
 The case's target (validation/cases/forrestal1994_ogive.toml) is cut to
-300 x 300 mm and 360 mm deep with free faces; the experiment's concrete went
-on to a 1.37 m culvert, 0.76 m long. This runs the case (its quick version
-unless ``--full``) with the four lateral faces' nodes (`[[set]]` boxes)
+300 x 300 mm and 360 mm deep; the experiment's concrete went on to a 1.37 m
+culvert, 0.76 m long. The case puts its four lateral faces and its back face
+on a non-reflecting boundary (the tables :func:`cut_faces` writes). This runs
+the case (its quick version unless ``--full``) with those faces
 
-* ``--faces rollers``: held in their normal direction (`[[boundary]]` type
-  "fixed" with one component);
-* ``--faces non_reflecting``: on Lysmer-Kuhlemeyer dashpots
-  (`[[boundary]]` type "non_reflecting"), and the back face too (the
-  concrete went on beyond it);
+* ``--faces free``: free (the case before 2026-11-30);
+* ``--faces rollers``: the four lateral faces' nodes held in their normal
+  direction (`[[boundary]]` type "fixed" with one component), the back free;
+* ``--faces non_reflecting``: as the case has them (Lysmer-Kuhlemeyer
+  dashpots, `[[boundary]]` type "non_reflecting");
 
 and prints the depth of penetration as `sphdyn validate` measures it, and
 the eroded elements. Extra ``--set`` values pass on (e.g.
 ``material.concrete.erosion.effective_strain=0.5``). The numbers in
 docs/validation.md (2026-11-30):
 
-    python studies/forrestal_lateral_faces.py --out OUT
-    python studies/forrestal_lateral_faces.py --out OUT2 \\
+    python studies/forrestal_lateral_faces.py --out OUT --faces free
+    python studies/forrestal_lateral_faces.py --out OUT --faces rollers
+    python studies/forrestal_lateral_faces.py --out OUT2 --faces rollers \\
         --set material.concrete.erosion.effective_strain=0.5
     python studies/forrestal_lateral_faces.py --out OUT3 --faces non_reflecting
 """
@@ -36,8 +38,11 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def cut_faces(kind: str) -> str:
     """The deck tables that put the target's lateral faces on rollers, or its
-    lateral and back faces on a non-reflecting boundary (``kind``)."""
+    lateral and back faces on a non-reflecting boundary (``kind``; "free":
+    none)."""
     out = ""
+    if kind == "free":
+        return out
     sides = [("side_x_lo", "x", -151, -149), ("side_x_hi", "x", 149, 151),
              ("side_y_lo", "y", -151, -149), ("side_y_hi", "y", 149, 151)]
     if kind == "non_reflecting":
@@ -55,6 +60,17 @@ def cut_faces(kind: str) -> str:
     return out
 
 
+def case_with_faces(text: str, kind: str) -> str:
+    """The case's deck ``text`` with its cut faces' tables replaced by those of
+    ``kind``; ValueError if the deck does not hold them as :func:`cut_faces`
+    writes them."""
+    ours = cut_faces("non_reflecting")
+    if text.count(ours) != 1:
+        raise ValueError("the case's deck does not hold the non-reflecting faces' "
+                         "tables as cut_faces writes them")
+    return text.replace(ours, cut_faces(kind))
+
+
 def main(argv=None) -> int:
     from sphdyn.validation.cases import CASES
     from sphdyn.validation.measures import depth_of_penetration
@@ -63,15 +79,16 @@ def main(argv=None) -> int:
     ap.add_argument("--out", required=True, type=Path)
     ap.add_argument("--set", action="append", default=[])
     ap.add_argument("--threads", type=int, default=1)
-    ap.add_argument("--faces", choices=("rollers", "non_reflecting"), default="rollers")
+    ap.add_argument("--faces", choices=("free", "rollers", "non_reflecting"),
+                    default="non_reflecting")
     ap.add_argument("--full", action="store_true",
                     help="the case at its full resolution (hours), not the quick one")
     args = ap.parse_args(argv)
     case = CASES["forrestal1994_ogive"]
     args.out.mkdir(parents=True, exist_ok=True)
     deck = args.out / f"forrestal_{args.faces}.toml"
-    deck.write_text((ROOT / case.deck).read_text(encoding="utf-8") + cut_faces(args.faces),
-                    encoding="utf-8")
+    deck.write_text(case_with_faces((ROOT / case.deck).read_text(encoding="utf-8"),
+                                    args.faces), encoding="utf-8")
     run = args.out / "run"
     cmd = [sys.executable, "-m", "sphdyn", "run", str(deck), "--out", str(run), "-q",
            "--threads", str(args.threads)]

@@ -220,8 +220,8 @@ def _forrestal_quick_block(faces: str):
     import forrestal_lateral_faces as flf
 
     root = Path(__file__).resolve().parent.parent
-    text = ((root / "validation" / "cases" / "forrestal1994_ogive.toml").read_text()
-            + flf.cut_faces(faces))
+    text = flf.case_with_faces(
+        (root / "validation" / "cases" / "forrestal1994_ogive.toml").read_text(), faces)
     return loads_deck(text.replace("divisions = [50, 50, 60]", "divisions = [20, 20, 24]"))
 
 
@@ -241,9 +241,9 @@ def test_forrestal_rollers_hold_each_lateral_face_in_its_normal_only():
 
 
 def test_forrestal_non_reflecting_faces_are_the_four_sides_and_the_back():
-    """--faces non_reflecting: the four lateral faces (20 x 24 element faces
-    each) and the back face (20 x 20) of the quick block on dashpots, the
-    impact face free."""
+    """The case (and --faces non_reflecting): the four lateral faces (20 x 24
+    element faces each) and the back face (20 x 20) of the quick block on
+    dashpots, the impact face free; --faces free takes them all off."""
     from sphdyn.assembly import build_stepper
     from sphdyn.interactions.non_reflecting import NonReflectingBoundary
 
@@ -254,3 +254,4 @@ def test_forrestal_non_reflecting_faces_are_the_four_sides_and_the_back():
         assert b.n_faces == (20 * 20 if name == "back" else 20 * 24), name
     x = st.part("target").kin.x
     assert np.all(x[nrb["back"].nodes, 2] == pytest.approx(-0.36, abs=1e-12))
+    assert not _forrestal_quick_block("free").boundary
