@@ -411,6 +411,35 @@ def _bar_text(source=BLOCK, extra=""):
                       materials=MATERIALS, extra=extra)
 
 
+def test_a_graded_block_from_a_deck_puts_its_small_elements_where_asked():
+    """[mesh.block] grading: the bar's nodes along x are graded_nodes' (bits),
+    and its step is set by its smallest element, the last along x (the
+    element the step names), shorter than the equal bar's."""
+    from sphdyn.geometry.mesh import graded_nodes
+
+    graded = BLOCK.replace("divisions = [10, 1, 1]}",
+                           'divisions = [10, 1, 1], grading = [{ ratio = 4, smallest = '
+                           '"hi" }, { ratio = 1 }, { ratio = 1 }]}')
+    st = build_stepper(loads_deck(_bar_text(source=graded)))
+    eq = build_stepper(loads_deck(_bar_text()))
+    xs = np.unique(st.part("bar").kin.x[:, 0])
+    assert np.array_equal(xs, graded_nodes(0.0, 1.0, 10, 4.0, "hi"))
+    dt, k, part = st.stable_dt()
+    assert part.name == "bar" and k == 9
+    assert dt < eq.stable_dt()[0]
+
+
+@pytest.mark.parametrize("grading, words", [
+    ('[{ ratio = 2 }]', ["grading has 1 entries in a 3D deck"]),
+    ('[{ ratio = 0.5 }, { ratio = 1 }, { ratio = 1 }]', ["size ratio"]),
+    ('[{ ratio = 2, smallest = "middle" }, { ratio = 1 }, { ratio = 1 }]', ["smallest"]),
+])
+def test_bad_grading_is_refused(tmp_path, capsys, grading, words):
+    graded = BLOCK.replace("divisions = [10, 1, 1]}",
+                           f"divisions = [10, 1, 1], grading = {grading}}}")
+    _bad(tmp_path, _bar_text(source=graded), "mesh[0]", words, capsys)
+
+
 def test_missing_mesh_file_is_refused(tmp_path, capsys):
     _bad(tmp_path, _bar_text(source='file = "nowhere.msh"'), "mesh[0].file",
          ["does not exist"], capsys)

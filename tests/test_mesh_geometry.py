@@ -116,6 +116,52 @@ def test_block_mesh_2d():
     assert np.array_equal(m.node_set("ymin"), np.flatnonzero(m.points[:, 1] == -0.02))
 
 
+@pytest.mark.parametrize("smallest", ["lo", "hi", "centre"])
+@pytest.mark.parametrize("n", [1, 2, 5, 8])
+def test_graded_axis_grows_geometrically_from_its_smallest_element(n, smallest):
+    """graded_nodes: the ends exactly lo and hi, the sizes summing to the
+    length (1e-12), the largest `ratio` times the smallest (1e-12) and each
+    neighbour's size ratio the same constant q = ratio^(1/k_max) away from
+    the smallest element(s); ratio 1 gives numpy.linspace's bits."""
+    from sphdyn.geometry.mesh import graded_nodes
+
+    x = graded_nodes(-0.36, 0.12, n, 4.0, smallest)
+    assert x[0] == -0.36 and x[-1] == 0.12 and x.size == n + 1
+    s = np.diff(x)
+    assert np.all(s > 0.0)
+    assert abs(s.sum() - 0.48) <= RTOL * 0.48
+    k = {"lo": np.arange(n), "hi": np.arange(n)[::-1],
+         "centre": np.abs(np.arange(n) - (n - 1) / 2)}[smallest]
+    k = k - k.min()
+    if k.max() == 0:  # one element, or two about the centre: equal
+        assert np.array_equal(x, np.linspace(-0.36, 0.12, n + 1))
+        return
+    assert s.max() / s.min() == pytest.approx(4.0, rel=RTOL)
+    q = 4.0 ** (1.0 / k.max())
+    np.testing.assert_allclose(s / s.min(), q ** k, rtol=1e-12)
+    assert np.array_equal(graded_nodes(-0.36, 0.12, n), np.linspace(-0.36, 0.12, n + 1))
+
+
+def test_a_graded_block_keeps_the_box_its_faces_and_positive_elements():
+    """A 3D block graded on two axes: the same node sets and element count as
+    the equal one, the volume the box's (1e-12), every Jacobian positive, the
+    smallest elements where asked (about the middle in x, at z = hi)."""
+    g = [(3.0, "centre"), (1.0, "lo"), (2.0, "hi")]
+    m = block_mesh([-0.15, 0.0, -0.36], [0.15, 0.1, 0.0], (7, 2, 6), 3, g)
+    e = block_mesh([-0.15, 0.0, -0.36], [0.15, 0.1, 0.0], (7, 2, 6), 3)
+    assert m.cells.shape == e.cells.shape and np.array_equal(m.cells, e.cells)
+    assert set(m.node_sets) == set(e.node_sets)
+    for name in m.node_sets:
+        assert np.array_equal(m.node_set(name), e.node_set(name))
+    assert np.all(element_jacobians(m.points, m.cells, "hex8") > 0.0)
+    vol = hex_volumes(m.points, m.cells)
+    assert abs(vol.sum() - 0.3 * 0.1 * 0.36) <= RTOL * 0.0108
+    xs, zs = np.unique(m.points[:, 0]), np.unique(m.points[:, 2])
+    assert np.argmin(np.diff(xs)) == 3 and np.argmin(np.diff(zs)) == 5
+    with pytest.raises(ValueError, match="grading"):
+        block_mesh([0, 0, 0], [1, 1, 1], (2, 2, 2), 3, [(0.5, "lo")] * 3)
+
+
 def test_line_mesh():
     m = line_mesh([0.0, 0.0, 0.0], [0.3, 0.4, 0.0], 5)
     assert m.kind == "line2" and m.cells.shape == (5, 2) and m.points.shape == (6, 3)

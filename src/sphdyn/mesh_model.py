@@ -91,7 +91,7 @@ def _read(spec, where: str, dim: int) -> MeshData:
     """The mesh of one [[mesh]] table (generated or read); DeckError if unreadable."""
     if spec.block is not None:
         b = spec.block
-        return block_mesh(b.lo, b.hi, b.divisions, dim)
+        return block_mesh(b.lo, b.hi, b.divisions, dim, b.axis_grading)
     if spec.prism is not None:
         m = spec.prism
         return prism_mesh(m.points, m.element_size, dim, m.axis, m.base, m.length)

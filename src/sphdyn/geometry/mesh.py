@@ -298,7 +298,36 @@ def _divisions(divisions, dim: int) -> tuple[int, ...]:
     return n
 
 
-def block_mesh(lo, hi, divisions, dim: int) -> MeshData:
+#: where a graded axis has its smallest elements
+GRADED_FROM = ("lo", "hi", "centre")
+
+
+def graded_nodes(lo: float, hi: float, n: int, ratio: float = 1.0,
+                 smallest: str = "lo") -> np.ndarray:
+    r"""Node coordinates (n + 1,) [m] of ``n`` elements from ``lo`` to ``hi``
+    whose sizes grow geometrically away from ``smallest`` ("lo", "hi" or
+    "centre") by a constant factor, the largest ``ratio`` times the smallest:
+    :math:`s_i = s_0 q^{k_i}`, :math:`q = 	ext{ratio}^{1/k_{max}}`, with
+    :math:`k_i` element i's distance in elements from the smallest one(s)
+    (:math:`k_i = |i - (n-1)/2| - \min_j |j - (n-1)/2|` for "centre": the
+    middle element, or the middle two, smallest; two elements stay equal) and :math:`s_0` set by :math:`\sum s_i = hi - lo`
+    (a bias, as LS-DYNA's and Gmsh's progressions). ``ratio = 1``: equal
+    elements, the same bits as ``numpy.linspace``; the ends are ``lo`` and
+    ``hi`` exactly."""
+    if ratio == 1.0 or n == 1:
+        return np.linspace(lo, hi, n + 1)
+    i = np.arange(n, dtype=float)
+    k = {"lo": i, "hi": n - 1 - i, "centre": np.abs(i - 0.5 * (n - 1))}[smallest]
+    k -= k.min()
+    if k.max() == 0.0:  # two elements about the centre: equal
+        return np.linspace(lo, hi, n + 1)
+    sizes = ratio ** (k / k.max())
+    x = lo + (hi - lo) * np.concatenate(([0.0], np.cumsum(sizes))) / sizes.sum()
+    x[-1] = hi
+    return x
+
+
+def block_mesh(lo, hi, divisions, dim: int, grading=None) -> MeshData:
     """Structured mesh of an axis-aligned box: hex8 in 3D, quad4 in 2D.
 
     Parameters
@@ -309,11 +338,14 @@ def block_mesh(lo, hi, divisions, dim: int) -> MeshData:
     divisions : sequence of int
         ``(nx, ny, nz)`` in 3D, ``(nx, ny)`` in 2D: elements per axis.
     dim : {2, 3}
+    grading : None (equal elements), or one ``(ratio, smallest)`` per axis:
+        :func:`graded_nodes` (``(1.0, "lo")``: equal elements on that axis).
 
     Returns
     -------
     MeshData
-        ``prod(n_a + 1)`` nodes and ``prod(n_a)`` elements, all of equal size.
+        ``prod(n_a + 1)`` nodes and ``prod(n_a)`` elements, of equal size
+        unless graded.
         Nodes and elements are numbered in grid-index order, x slowest
         (``numpy.meshgrid(..., indexing="ij")``, as the particle lattices);
         ids 1-based consecutive. Sets: element set ``"all"``; node sets
@@ -325,7 +357,11 @@ def block_mesh(lo, hi, divisions, dim: int) -> MeshData:
     n = _divisions(divisions, dim)
     if np.any(hi[:dim] <= lo[:dim]):
         raise ValueError(f"block hi must be > lo on every axis, got lo={lo[:dim]}, hi={hi[:dim]}")
-    axes = [np.linspace(lo[a], hi[a], n[a] + 1) for a in range(dim)]
+    grading = [(1.0, "lo")] * dim if grading is None else list(grading)
+    if len(grading) != dim or any(r < 1.0 or w not in GRADED_FROM for r, w in grading):
+        raise ValueError(f"grading must give {dim} (ratio >= 1, one of {GRADED_FROM}) pairs, "
+                         f"got {grading!r}")
+    axes = [graded_nodes(lo[a], hi[a], n[a], *grading[a]) for a in range(dim)]
     grid = np.meshgrid(*axes, indexing="ij")
     points = np.zeros((grid[0].size, 3))
     for a in range(dim):

@@ -74,8 +74,11 @@ def _named(items: list[dict], name: str) -> dict:
 
 
 def block_spacing(deck: dict, mesh: str) -> tuple[float, float, float]:
-    """Element sizes (hx, hy, hz) [m] of a ``[[mesh]]`` block."""
+    """Element sizes (hx, hy, hz) [m] of a ``[[mesh]]`` block of equal elements
+    (ValueError for a graded one: its sizes vary)."""
     b = _named(deck["mesh"], mesh)["block"]
+    if any(g["ratio"] != 1.0 for g in b.get("grading") or ()):
+        raise ValueError(f"mesh {mesh!r} is graded: its element size varies")
     return tuple((hi - lo) / n for lo, hi, n in zip(b["lo"], b["hi"], b["divisions"]))
 
 

@@ -30,6 +30,18 @@ SOLID_ELEMENTS = {3: "hex8", 2: "quad4"}
 LINE_ELEMENTS = ("beam", "truss")
 
 
+class AxisGrading(Section):
+    """One axis of [mesh.block] grading: element sizes growing geometrically
+    away from where they are smallest (a bias, as LS-DYNA's and Gmsh's
+    progressions)."""
+
+    ratio: real("size ratio", lo=1) = Field(
+        description="Largest element size over the smallest on this axis (1: equal).")
+    smallest: Literal["lo", "hi", "centre"] = Field(
+        "lo", description="Where the smallest elements are: at lo, at hi, or in the "
+                          "middle (sizes growing towards both ends).")
+
+
 class BlockMesh(Section):
     """[mesh.block]: a structured block of hexahedra (3D) or quadrilaterals (2D)."""
 
@@ -38,6 +50,15 @@ class BlockMesh(Section):
                                           "component.")
     divisions: tuple[integer("element count", lo=1), ...] = Field(
         description="Elements along x, y (and z in 3D), e.g. [40, 4, 4].")
+    grading: Optional[tuple[AxisGrading, ...]] = Field(
+        None, description="Element sizes graded along each axis (absent: equal "
+                          "elements): one { ratio, smallest } per axis, the "
+                          "sizes growing by a constant factor away from where "
+                          "they are smallest, the largest ratio times the "
+                          "smallest, e.g. a target refined about its shot line "
+                          "and under its face: [{ ratio = 3, smallest = "
+                          "\"centre\" }, { ratio = 3, smallest = \"centre\" }, "
+                          "{ ratio = 3, smallest = \"hi\" }].")
 
     @model_validator(mode="after")
     def _one_per_axis(self):
@@ -45,7 +66,16 @@ class BlockMesh(Section):
         if dim is not None and len(self.divisions) != dim:
             raise problem(f"divisions has {len(self.divisions)} entries in a {dim}D deck",
                           f"give {dim} element counts, one per axis")
+        if dim is not None and self.grading is not None and len(self.grading) != dim:
+            raise problem(f"grading has {len(self.grading)} entries in a {dim}D deck",
+                          f"give {dim}, one per axis ({{ ratio = 1 }} for an equal axis)")
         return self
+
+    @property
+    def axis_grading(self):
+        """(ratio, smallest) per axis, or None (equal elements)."""
+        return None if self.grading is None else [(g.ratio, g.smallest)
+                                                  for g in self.grading]
 
 
 class PrismMesh(PrismKeys):
