@@ -125,12 +125,12 @@ def test_peak_load_averages_the_contact_force_over_its_windows(tmp_path):
         measures.load_deflection(tmp_path, "loader", "mid", window=1.0)
 
 
-def _frame_with_crater(tmp_path, radius, lift_back=None):
-    """A 40 x 40 x 10 mm block of 1 mm hexahedra whose top-layer elements
-    with centres within ``radius`` of the z axis are eroded (left out of the
-    frame), and whose bottom face nodes within ``lift_back`` moved 1.5 mm
-    down (a scab)."""
-    mesh = block_mesh((-0.02, -0.02, -0.01), (0.02, 0.02, 0.0), (40, 40, 10), 3)
+def _frame_with_crater(tmp_path, radius, lift_back=None, grading=None):
+    """A 40 x 40 x 10 mm block of 1 mm hexahedra (graded by ``grading``)
+    whose top-layer elements with centres within ``radius`` of the z axis
+    are eroded (left out of the frame), and whose bottom face nodes within
+    ``lift_back`` moved 1.5 mm down (a scab)."""
+    mesh = block_mesh((-0.02, -0.02, -0.01), (0.02, 0.02, 0.0), (40, 40, 10), 3, grading)
     pts, cells = np.asarray(mesh.points, float), np.asarray(mesh.cells)
     c = pts[cells].mean(axis=1)
     eroded = (c[:, 2] > -0.001) & (np.hypot(c[:, 0], c[:, 1]) < radius)
@@ -163,6 +163,34 @@ def test_crater_diameter_from_the_nodes_no_element_holds(tmp_path):
     assert 0.0095 < d < 0.0115  # about the eroded 10.4 mm, within one element
     assert measures.lost_face_diameter(tmp_path, "block", face=-0.01, normal=-1.0,
                                        h=0.001) == 0.0  # the back face is whole
+
+
+def test_crater_diameter_on_a_graded_face_adds_the_local_half_element(tmp_path):
+    """On a face graded about the shot line (sizes 1.5x from the middle to the
+    sides) the read-off half element is the face's spacing at the farthest
+    lost node, not the smallest size passed as h: 2 (r_max + s/2), s the
+    spacing to the next node outwards along the axis nearer its radius
+    (1e-12)."""
+    from sphdyn.geometry.mesh import graded_nodes
+
+    g = [(1.5, "centre"), (1.5, "centre"), (1.0, "lo")]
+    _frame_with_crater(tmp_path, 0.0085, grading=g)
+    xs = graded_nodes(-0.02, 0.02, 40, 1.5, "centre")
+    h = np.diff(xs).min()
+    d = measures.lost_face_diameter(tmp_path, "block", face=0.0, normal=1.0, h=h)
+    m = block_mesh((-0.02, -0.02, -0.01), (0.02, 0.02, 0.0), (40, 40, 10), 3, g)
+    pts, cells = np.asarray(m.points), np.asarray(m.cells)
+    c = pts[cells].mean(axis=1)
+    live = cells[~((c[:, 2] > -0.001) & (np.hypot(c[:, 0], c[:, 1]) < 0.0085))]
+    top = np.abs(pts[:, 2]) < 1e-12
+    lost = top & ~np.isin(np.arange(len(pts)), live)
+    r = np.hypot(pts[lost, 0], pts[lost, 1])
+    far = pts[np.flatnonzero(lost)[np.argmax(r)]]
+    a = 0 if abs(far[0]) >= abs(far[1]) else 1  # the axis nearer the radius
+    k = int(np.argmin(np.abs(xs - far[a])))
+    s = abs(xs[k + (1 if far[a] >= 0 else -1)] - xs[k])  # the next node outwards
+    assert s > 1.05 * h  # the crater's edge lies where the elements are larger
+    assert d == pytest.approx(2.0 * (r.max() + 0.5 * s), rel=1e-12)
 
 
 def test_scab_diameter_from_the_nodes_moved_out(tmp_path):

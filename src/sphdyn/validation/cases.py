@@ -18,6 +18,9 @@ from functools import partial
 from pathlib import Path
 from typing import Callable
 
+import numpy as np
+
+from ..geometry.mesh import graded_nodes
 from . import data
 from .figures import deflection_figure, load_figure, section_figure
 from .measures import (depth_of_penetration, largest_deflection, lost_face_diameter,
@@ -74,12 +77,13 @@ def _named(items: list[dict], name: str) -> dict:
 
 
 def block_spacing(deck: dict, mesh: str) -> tuple[float, float, float]:
-    """Element sizes (hx, hy, hz) [m] of a ``[[mesh]]`` block of equal elements
-    (ValueError for a graded one: its sizes vary)."""
+    """Element sizes (hx, hy, hz) [m] of a ``[[mesh]]`` block: the smallest on
+    each axis of a graded one (:func:`~sphdyn.geometry.mesh.graded_nodes`)."""
     b = _named(deck["mesh"], mesh)["block"]
-    if any(g["ratio"] != 1.0 for g in b.get("grading") or ()):
-        raise ValueError(f"mesh {mesh!r} is graded: its element size varies")
-    return tuple((hi - lo) / n for lo, hi, n in zip(b["lo"], b["hi"], b["divisions"]))
+    grading = b.get("grading") or [{"ratio": 1.0, "smallest": "lo"}] * len(b["divisions"])
+    return tuple(float(np.diff(graded_nodes(lo, hi, n, g["ratio"], g.get("smallest", "lo")))
+                       .min())
+                 for lo, hi, n, g in zip(b["lo"], b["hi"], b["divisions"], grading))
 
 
 # --------------------------------------------------------------------------

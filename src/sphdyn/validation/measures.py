@@ -58,8 +58,11 @@ def lost_face_diameter(run: Path, mesh: str, face: float, normal: float, h: floa
     """Diameter [m] of the lost area of the mesh face at ``axis = face`` [m]
     (``normal`` = +1 or -1: the face's outward direction along ``axis``),
     about the shot line through ``centre`` (its two other coordinates),
-    for a mesh of element size ``h`` [m] in the face (module docstring);
-    0 when no node of the face is lost."""
+    for a mesh of element size ``h`` [m] in the face (its smallest, on a
+    graded mesh: the face's tolerance and the moved-out distance; the
+    half-element added is the face's node spacing at the farthest lost node,
+    outwards along the axis nearer its radius)
+    (module docstring); 0 when no node of the face is lost."""
     frames = list_frames(Path(run))
     if not frames:
         raise FileNotFoundError(f"{run}: no frames to measure")
@@ -76,7 +79,22 @@ def lost_face_diameter(run: Path, mesh: str, face: float, normal: float, h: floa
         return 0.0
     others = [i for i in range(3) if i != k]
     r = np.hypot(x0[lost, others[0]] - centre[0], x0[lost, others[1]] - centre[1])
-    return float(2.0 * (r.max() + 0.5 * h))
+    return float(2.0 * (r.max() + 0.5 * _spacing_outward(x0[on_face], x0[np.flatnonzero(
+        lost)[np.argmax(r)]], others, centre, h)))
+
+
+def _spacing_outward(face_nodes, node, others, centre, h: float) -> float:
+    """The face's node spacing [m] at ``node`` along the in-face axis nearer
+    to its radial direction from ``centre``, to the next node outwards (inwards
+    at the face's edge): h on an equal grid, the local size on a graded one."""
+    off = [node[i] - c for i, c in zip(others, centre)]
+    a, b = (0, 1) if abs(off[0]) >= abs(off[1]) else (1, 0)
+    row = face_nodes[np.abs(face_nodes[:, others[b]] - node[others[b]]) < 1e-3 * h]
+    step = (row[:, others[a]] - node[others[a]]) * (1.0 if off[a] >= 0.0 else -1.0)
+    out, back = step[step > 1e-3 * h], -step[step < -1e-3 * h]
+    if out.size:
+        return float(out.min())
+    return float(back.min()) if back.size else h
 
 
 def contact_force(h: dict, mesh: str) -> np.ndarray:
