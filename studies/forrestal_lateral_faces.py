@@ -47,11 +47,11 @@ def cut_faces(kind: str) -> str:
              ("side_y_lo", "y", -151, -149), ("side_y_hi", "y", 149, 151)]
     if kind == "non_reflecting":
         sides.append(("back", "z", -361, -359))
+    whole = dict(zip("xyz", ((-151, 151), (-151, 151), (-361, 1))))  # the block, +-1 mm
     for name, axis, lo, hi in sides:
-        box_lo = [f'"{lo} mm"' if axis == a else f'"{wide[0]} mm"'
-                  for a, wide in zip("xyz", ((-151, 151), (-151, 151), (-361, 1)))]
-        box_hi = [f'"{hi} mm"' if axis == a else f'"{wide[1]} mm"'
-                  for a, wide in zip("xyz", ((-151, 151), (-151, 151), (-361, 1)))]
+        box = [(lo, hi) if axis == a else whole[a] for a in "xyz"]
+        box_lo = [f'"{b[0]} mm"' for b in box]
+        box_hi = [f'"{b[1]} mm"' for b in box]
         held = (f'type = "fixed"\ncomponents = ["{axis}"]' if kind == "rollers"
                 else 'type = "non_reflecting"')
         out += (f'\n[[set]]\nname = "{name}"\nmesh = "target"\nregion = {{ shape = "box", '

@@ -35,7 +35,7 @@ def dashpots(x, faces, z_d, z_s, active=None):
     F = faces.shape[0]
     boundary_dashpots(np.asarray(x, float), faces, local, np.arange(F),
                       np.ones(F, np.int8) if active is None else active,
-                      np.full(F, z_d), np.full(F, z_s), C)
+                      np.full(F, z_d), np.full(F, z_s), np.empty((faces.shape[1], 3)), C)
     return nodes, C
 
 

@@ -253,17 +253,17 @@ def pressure_faces(meshes: list[MeshModel], mesh_sets: dict, set_name: str,
     """The faces a pressure (or, ``what``, a non-reflecting boundary) on the set
     ``set_name`` acts on (:func:`set_faces`); DeckError naming ``where`` if the
     set holds particles, nodes of a line, or no whole exterior face."""
-    other = (", or give force = [...] (shared by the {})" if what == "a pressure"
-             else " (particles and lines have no faces to absorb waves on{})")
+    # what else the user may give instead (a pressure: a force shared by the items)
+    instead = ((", or give force = [...] (shared by the particles)",
+                ", or give force = [...] (shared by the nodes)") if what == "a pressure"
+               else ("", ""))
     if set_name not in mesh_sets:
         raise DeckError([format_problem(
             where, f"set '{set_name}' holds particles; {what} acts on the faces of a "
                    "solid mesh", "name a [[set]] with mesh = \"<name>\" whose nodes "
-                   "cover the surface" + other.format("particles" if what == "a pressure"
-                                                      else ""))])
+                   "cover the surface" + instead[0])])
     faces, elements = set_faces(meshes, mesh_sets, set_name, where,
-                                "name a set of a solid mesh's nodes"
-                                + other.format("nodes" if what == "a pressure" else ""))
+                                "name a set of a solid mesh's nodes" + instead[1])
     if faces.shape[0] == 0:
         mesh, idx = mesh_sets[set_name]
         face = "edge" if faces.shape[1] == 2 else "face"

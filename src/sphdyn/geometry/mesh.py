@@ -307,11 +307,11 @@ def graded_nodes(lo: float, hi: float, n: int, ratio: float = 1.0,
     r"""Node coordinates (n + 1,) [m] of ``n`` elements from ``lo`` to ``hi``
     whose sizes grow geometrically away from ``smallest`` ("lo", "hi" or
     "centre") by a constant factor, the largest ``ratio`` times the smallest:
-    :math:`s_i = s_0 q^{k_i}`, :math:`q = 	ext{ratio}^{1/k_{max}}`, with
+    :math:`s_i = s_0 q^{k_i}`, :math:`q = \mathrm{ratio}^{1/k_{max}}`, with
     :math:`k_i` element i's distance in elements from the smallest one(s)
     (:math:`k_i = |i - (n-1)/2| - \min_j |j - (n-1)/2|` for "centre": the
-    middle element, or the middle two, smallest; two elements stay equal) and :math:`s_0` set by :math:`\sum s_i = hi - lo`
-    (a bias, as LS-DYNA's and Gmsh's progressions). ``ratio = 1``: equal
+    middle element, or the middle two, smallest; two elements stay equal)
+    and :math:`s_0` set by :math:`\sum s_i = hi - lo` (a bias, as LS-DYNA's and Gmsh's progressions). ``ratio = 1``: equal
     elements, the same bits as ``numpy.linspace``; the ends are ``lo`` and
     ``hi`` exactly."""
     if ratio == 1.0 or n == 1:

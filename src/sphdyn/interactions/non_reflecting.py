@@ -14,8 +14,9 @@ with the dilatational and shear wave speeds :math:`c_d = \sqrt{(K + 4G/3)/\rho}`
 :math:`c_s = \sqrt{G/\rho}` of the face's element (its material's elastic
 constants and reference density). A plane P or S wave meeting the face at
 normal incidence leaves without reflection; at oblique incidence a part is
-reflected (Lysmer & Kuhlemeyer's Fig. 3: under a few per cent of the energy
-for incidence within about 30 degrees of the normal).
+reflected (a spherical pulse in a cube with six such faces keeps 8e-5 of its
+energy in motion after three crossings, against 4e-2 with free faces:
+tests/test_non_reflecting.py).
 
 **Nodal forces.** Lumped with the face's shape functions: node :math:`a` of
 a face takes :math:`\mathbf f_a = -\mathbf C_a \mathbf v_a` with
@@ -63,7 +64,7 @@ from .pressure import FaceInteraction, face_area_vectors
 
 
 @njit(cache=True, error_model="numpy")
-def boundary_dashpots(x, faces, local, elements, active, z_d, z_s, C):
+def boundary_dashpots(x, faces, local, elements, active, z_d, z_s, S, C):
     r"""Dashpot matrices :math:`\mathbf C_a = \sum_{faces} |\mathbf S_a|(z_s \mathbf I +
     (z_d - z_s)\mathbf n_a\mathbf n_a^T)` [kg/s] of the face nodes (module docstring),
     written to ``C`` (k, 3, 3).
@@ -72,13 +73,12 @@ def boundary_dashpots(x, faces, local, elements, active, z_d, z_s, C):
     order; ``local`` (F, nf) each face node's row in ``C``; ``elements`` (F,) and
     ``active`` (E,) int8: a face of an inactive element adds nothing; ``z_d``,
     ``z_s`` (F,) the impedances :math:`\rho c_d`, :math:`\rho c_s` [kg/(m^2 s)]
-    of each face's element. Serial: faces share nodes."""
+    of each face's element; ``S`` (nf, 3) scratch. Serial: faces share nodes."""
     for k in range(C.shape[0]):
         for i in range(3):
             for j in range(3):
                 C[k, i, j] = 0.0
     nf = faces.shape[1]
-    S = np.empty((nf, 3))
     for f in range(faces.shape[0]):
         if active[elements[f]] == 0:
             continue
@@ -174,7 +174,7 @@ class NonReflectingBoundary(FaceInteraction):
     def forces(self, t: float, dt: float, a_out: np.ndarray) -> None:
         q = self.part.kin
         boundary_dashpots(q.x, self.faces, self.local, self.elements,
-                          self.part.el.active, self.z_d, self.z_s, self.C)
+                          self.part.el.active, self.z_d, self.z_s, self._S, self.C)
         # q.a holds the internal accelerations here (the stepper adds a_ext after
         # every interaction's forces)
         dashpot_accelerations(self.nodes, q.m, self.C, q.v, q.a, dt, self._a, a_out)

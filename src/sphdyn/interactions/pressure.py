@@ -105,7 +105,7 @@ def face_area_vectors(x, faces, f, S):
 
 
 @njit(cache=True, error_model="numpy")
-def face_pressure_forces(x, faces, local, elements, active, p, force):
+def face_pressure_forces(x, faces, local, elements, active, p, S, force):
     r"""Consistent nodal forces of the pressure ``p`` [Pa] on the faces (module
     docstring), :math:`\mathbf f_a = -p\,\mathbf S_a` (:func:`face_area_vectors`),
     written to ``force`` (k, 3) [N] (N/m in 2D).
@@ -114,11 +114,10 @@ def face_pressure_forces(x, faces, local, elements, active, p, force):
     or (F, 2) segments (node indices into ``x``, outward order); ``local``
     (F, nf) the row of each face node in ``force``; ``elements`` (F,) each
     face's element and ``active`` (E,) int8 (a face of an inactive element
-    takes no load). Serial: faces share nodes."""
+    takes no load); ``S`` (nf, 3) scratch. Serial: faces share nodes."""
     for k in range(force.shape[0]):
         force[k, 0] = force[k, 1] = force[k, 2] = 0.0
     nf = faces.shape[1]
-    S = np.empty((nf, 3))
     for f in range(faces.shape[0]):
         if active[elements[f]] == 0:
             continue
@@ -157,8 +156,9 @@ def nodal_forces(x, faces, p: float) -> np.ndarray:
     nodes, local = face_rows(faces)
     n_faces = local.shape[0]
     force = np.zeros((nodes.size, 3))
-    face_pressure_forces(x, np.ascontiguousarray(faces, dtype=np.int64), local,
-                         np.zeros(n_faces, np.int64), np.ones(1, np.int8), float(p), force)
+    faces = np.ascontiguousarray(faces, dtype=np.int64)
+    face_pressure_forces(x, faces, local, np.zeros(n_faces, np.int64), np.ones(1, np.int8),
+                         float(p), np.empty((faces.shape[1], 3)), force)
     out = np.zeros((x.shape[0], 3))
     out[nodes] = force
     return out
@@ -188,6 +188,7 @@ class FaceInteraction(InteractionBase):
         if np.any(part.kin.m[self.nodes] <= 0.0):
             raise ValueError(f"{name}: {what} on nodes without mass")
         self._a = np.zeros((self.nodes.size, 3))  # the face nodes' accelerations [m/s^2]
+        self._S = np.empty((self.faces.shape[1], 3))  # one face's area vectors (scratch)
         self.work = 0.0  # total [J]
         self._kick = 0.0  # over the last kick [J]
 
@@ -241,7 +242,7 @@ class PressureLoad(FaceInteraction):
         q = self.part.kin
         self._now = self.pressure * self.factor(t)
         face_pressure_forces(q.x, self.faces, self.local, self.elements,
-                             self.part.el.active, self._now, self.force)
+                             self.part.el.active, self._now, self._S, self.force)
         accelerate(self.nodes, q.m, self.force, self._a, a_out)
 
     def columns(self, t: float) -> dict[str, float]:
