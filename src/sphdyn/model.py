@@ -331,7 +331,10 @@ def build_model(deck) -> Model:
     for k, pr in enumerate(deck.probe):
         if pr.set in mesh_sets:
             mesh, idx = mesh_sets[pr.set]
-            names = tuple(pr.quantities) if "quantities" in pr.model_fields_set else tuple(
+            # the default list (compared by value: a resolved deck writes it
+            # out) keeps what mesh nodes have; a list the user gave is checked
+            default = type(pr).model_fields["quantities"].default
+            names = tuple(pr.quantities) if pr.quantities != default else tuple(
                 q for q in pr.quantities if node_probe_field(q) is not None)
             probe = Probe(pr.set, idx, names, pr.reduce, mesh=mesh)
             for q in probe.quantities:
