@@ -205,6 +205,46 @@ def test_exterior_faces_are_the_boundary_oriented_outward(dim):
     assert area == pytest.approx(32.0 if dim == 3 else 10.0, rel=1e-12)
 
 
+@pytest.mark.parametrize("dim", [2, 3])
+def test_exterior_faces_of_kept_elements_from_the_twins(dim):
+    """The exterior faces of a subset of the elements (erosion's master
+    surface) from the face twins made once: the same faces in the same order
+    as the exterior faces of the subset's own connectivity, their elements
+    numbered in the whole mesh; against an independent count of each face's
+    sorted nodes (a face is exterior when one kept element holds it). The
+    twins pair up (twin of twin is the slot), and a face of three elements
+    (not a valid mesh) is never exterior, as the whole mesh's count has it."""
+    from collections import Counter
+
+    from sphdyn.interactions.penalty_geometry import HEX8_FACES, QUAD4_EDGES, face_twins
+
+    x, cells = block([0, 0, 0], [4.0, 3.0, 2.0], (4, 3, 2), dim)
+    local = HEX8_FACES if dim == 3 else QUAD4_EDGES
+    twins = face_twins(cells)
+    paired = np.flatnonzero(twins >= 0)
+    assert np.array_equal(twins[twins[paired]], paired)
+    rng = np.random.default_rng(7)
+    for frac in (1.0, 0.8, 0.4, 0.0):
+        active = (rng.random(len(cells)) < frac).astype(np.int8)
+        faces, elements = exterior_faces(cells, with_elements=True, active=active, twins=twins)
+        kept = np.flatnonzero(active)
+        assert np.array_equal(faces, exterior_faces(cells[kept]).reshape(-1, local.shape[1]))
+        count = Counter(tuple(sorted(cells[e][f])) for e in kept for f in local)
+        expect = [(e, tuple(cells[e][f])) for e in kept for f in local
+                  if count[tuple(sorted(cells[e][f]))] == 1]
+        assert [(e, tuple(f)) for e, f in zip(elements, faces)] == expect
+    # element 0 twice: its faces on the boundary are held by two elements now,
+    # those it shares with a neighbour by three (-2, never exterior)
+    tripled = np.vstack([cells, cells[:1]])
+    t3 = face_twins(tripled)
+    count = Counter(tuple(sorted(c[f])) for c in tripled for f in local)
+    held = np.array([count[tuple(sorted(c[f]))] for c in tripled for f in local])
+    assert np.array_equal(t3 == -2, held >= 3) and np.array_equal(t3 == -1, held == 1)
+    assert (held >= 3).any()
+    expect = [tuple(c[f]) for c in tripled for f in local if count[tuple(sorted(c[f]))] == 1]
+    assert [tuple(f) for f in exterior_faces(tripled)] == expect
+
+
 def test_closest_point_on_a_warped_face():
     # A non-planar quadrilateral (one corner lifted by 30 % of its size):
     # Newton's closest point matches a brute-force search over a 801^2 grid

@@ -37,33 +37,81 @@ QUAD4_EDGES = np.array([[0, 1], [1, 2], [2, 3], [3, 0]], dtype=np.int64)
 NEWTON_ITERATIONS = 8
 
 
-def exterior_faces(cells: np.ndarray, with_elements: bool = False):
+def _local_faces(cells: np.ndarray) -> np.ndarray:
+    """The local faces (hex8) or edges (quad4) of ``cells``' elements."""
+    local = {8: HEX8_FACES, 4: QUAD4_EDGES}.get(cells.shape[1])
+    if local is None:
+        raise ValueError(f"exterior faces of hex8 or quad4 meshes, got {cells.shape[1]}-node "
+                         "elements")
+    return local
+
+
+def face_twins(cells: np.ndarray) -> np.ndarray:
+    """For each face slot ``s = e * n_local + f`` (element e, local face f) of a
+    hex8 or quad4 mesh, the slot of the other element's face on the same
+    nodes, -1 for a face of one element only, or -2 for a face held by more
+    than two elements (not a valid mesh; never exterior, as the face count
+    of the whole mesh has it): (E * n_local,) int64.
+
+    Made once per mesh (a sort of the slots by their sorted node keys); the
+    exterior faces of any subset of the elements then follow without a sort
+    (:func:`exterior_faces`' ``active``), which erosion asks for after every
+    event."""
+    cells = np.asarray(cells, dtype=np.int64)
+    local = _local_faces(cells)
+    key = np.sort(cells[:, local].reshape(-1, local.shape[1]), axis=1)
+    n = key.shape[0]
+    twins = np.full(n, -1, dtype=np.int64)
+    if n == 0:
+        return twins
+    order = np.lexsort(key.T[::-1])  # slots sorted by their keys
+    k = key[order]
+    start = np.flatnonzero(np.concatenate(([True], np.any(k[1:] != k[:-1], axis=1))))
+    size = np.diff(np.append(start, n))
+    pair = start[size == 2]
+    twins[order[pair]] = order[pair + 1]
+    twins[order[pair + 1]] = order[pair]
+    for s0, m in zip(start[size > 2], size[size > 2]):
+        twins[order[s0:s0 + m]] = -2
+    return twins
+
+
+def exterior_faces(cells: np.ndarray, with_elements: bool = False, active=None,
+                   twins=None):
     """Boundary faces of a mesh, oriented outward.
 
     Parameters
     ----------
     cells : (E, 8) hex8 or (E, 4) quad4 connectivity (VTK order).
     with_elements : also return the element of each face.
+    active : optional (E,) flags: the exterior faces of the elements with a
+        nonzero flag only (a face between a kept and a dropped element is
+        exterior); the same faces, in the same order, as ``cells[active != 0]``
+        gives, with elements numbered in ``cells``.
+    twins : :func:`face_twins` of ``cells``, when made already.
 
     Returns
     -------
     faces : (F, 4) quadrilaterals (hex8) or (F, 2) segments (quad4), int64
         node indices in the order of the module docstring: the faces that
-        belong to exactly one element, in element order then local-face order.
+        belong to exactly one (kept) element, in element order then
+        local-face order.
     elements : (F,) the element each face belongs to (``with_elements``).
     """
     cells = np.asarray(cells, dtype=np.int64)
-    local = {8: HEX8_FACES, 4: QUAD4_EDGES}.get(cells.shape[1])
-    if local is None:
-        raise ValueError(f"exterior faces of hex8 or quad4 meshes, got {cells.shape[1]}-node "
-                         "elements")
-    faces = cells[:, local].reshape(-1, local.shape[1])  # (E * n_local, nf)
-    key = np.sort(faces, axis=1)
-    _, inverse, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
-    once = counts[inverse.reshape(-1)] == 1
-    out = np.ascontiguousarray(faces[once])
+    local = _local_faces(cells)
+    n_local = local.shape[0]
+    twins = face_twins(cells) if twins is None else twins
+    slot_element = np.arange(twins.size, dtype=np.int64) // n_local
+    kept = (np.ones(cells.shape[0], dtype=bool) if active is None
+            else np.asarray(active) != 0)
+    once = kept[slot_element] & ((twins == -1)
+                                 | ((twins >= 0) & ~kept[np.maximum(twins, 0) // n_local]))
+    slots = np.flatnonzero(once)
+    out = np.ascontiguousarray(cells[slots // n_local][np.arange(slots.size)[:, None],
+                                                        local[slots % n_local]])
     if with_elements:
-        return out, np.flatnonzero(once) // local.shape[0]
+        return out, slots // n_local
     return out
 
 
