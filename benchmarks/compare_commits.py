@@ -16,7 +16,11 @@ included in both), ``hex3d --elements 100000`` (element-steps per second), and t
 drop-weight beam in its impact (``benchmarks/profile_step.py`` on
 ``examples/dropweight_coarse.toml``, 300 steps after 2,000 untimed ones: the
 ram meets the beam at about step 1,900; item-steps per second, the same deck
-file for both trees); ``--cases`` picks some by name (comma-separated).
+file for both trees), and the Forrestal penetration case at 10 mm elements
+(``sphdyn run validation/cases/forrestal1994_ogive.toml`` with the coarse
+target, 1,500 steps to 440 us: the projectile's tip 63 mm in, 224
+elements eroded into particles; item-steps per second from its summary, the same deck file
+for both trees); ``--cases`` picks some by name (comma-separated).
 """
 
 from __future__ import annotations
@@ -35,7 +39,12 @@ CASES = [("rings2d", ["bench", "rings2d", "--steps", "500"]),
          ("CSCM disc", ["run", "examples/disc_impact.toml", "-q", "--max-steps", "150"]),
          ("hex3d 100k", ["bench", "hex3d", "--elements", "100000", "--steps", "100"]),
          ("HVI coarse impact", ["profile", "--deck", "examples/dropweight_coarse.toml",
-                                "--start-steps", "2000", "--steps", "300"])]
+                                "--start-steps", "2000", "--steps", "300"]),
+         ("Forrestal 10 mm", ["run", "validation/cases/forrestal1994_ogive.toml", "-q",
+                              "--set", "mesh.target.block.divisions=[30,30,36]",
+                              "--set", "body.projectile.dx=0.00538",
+                              "--set", "material.concrete.erosion.min_time_step=2.5e-7",
+                              "--max-steps", "1500"])]
 
 PROFILE = Path(__file__).resolve().parent / "profile_step.py"
 

@@ -4,6 +4,7 @@ command's errors. The quick cases' numbers are held by
 tests/test_validation_quick.py.
 """
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -335,6 +336,48 @@ def test_ndrc_depth_in_its_own_units_and_both_branches():
     assert ndrc_depth(v1, lb, inch, 1e4 * psi, 0.72) == pytest.approx(2.0 * inch, rel=1e-9)
     assert ndrc_depth(v1 * 4 ** (1 / 1.8), lb, inch, 1e4 * psi, 0.72) == \
         pytest.approx(5.0 * inch, rel=1e-9)
+
+
+def test_forrestal_penetration_against_li_and_chens_closed_forms():
+    """The two-stage force law (estimates.forrestal_penetration) against Li &
+    Chen's (2003) dimensionless closed forms, written independently:
+    I = M V^2 / (S d^3 f'c), N = M / (N* rho d^3),
+    deep:    X/d = (2/pi) N ln((1 + I/N) / (1 + k pi / (4N))) + k,
+    shallow: X/d = sqrt((4 k I / pi) (1 + k pi / (4N)) / (1 + I/N)).
+    Forrestal's shot 14 (0.906 kg, 26.9 mm, 277 m/s, 35.2 MPa, 2370 kg/m^3,
+    crh 2, S = 12, k = 2) gives X/d = 6.21 in Li & Chen's Table 2 (as quoted
+    in the data file's read-in (3)); 1e-12 is round-off. The velocity is
+    continuous at kd, zero at X, and the tunnel's speed obeys the force law
+    (finite differences, 1e-6 from the step's truncation)."""
+    from sphdyn.validation.estimates import (forrestal_penetration,
+                                             forrestal_resistance_constant,
+                                             ogive_nose_factor)
+
+    M, d, fc, rho, k = 0.906, 0.0269, 35.2e6, 2370.0, 2.0
+    nose = ogive_nose_factor(2.0)
+    assert nose == pytest.approx(15 / 96, rel=1e-15)
+    assert forrestal_resistance_constant(fc) == pytest.approx(82.6 * 35.2 ** -0.544, rel=1e-15)
+    N = M / (nose * rho * d**3)
+    for v, S in ((277.0, 12.0), (60.0, 12.0), (277.0, 60.0)):
+        I = M * v * v / (S * d**3 * fc)
+        if I > math.pi * k / 4:
+            ratio = 2 / math.pi * N * math.log((1 + I / N) / (1 + k * math.pi / (4 * N))) + k
+        else:
+            ratio = math.sqrt(4 * k * I / math.pi * (1 + k * math.pi / (4 * N)) / (1 + I / N))
+        V, X = forrestal_penetration([0.0, k * d, 10.0], v, M, d, fc, rho, nose, S, k)
+        assert X / d == pytest.approx(ratio, rel=1e-12)
+        assert V[0] == v and V[2] == 0.0
+    V, X = forrestal_penetration([0.0], 277.0, M, d, fc, rho, nose, 12.0, k)
+    assert X / d == pytest.approx(6.21, abs=0.01)
+    # continuity at kd and the tunnel's equation of motion
+    e, x = 1e-9, 0.1
+    near = forrestal_penetration([k * d - e, k * d + e], 277.0, M, d, fc, rho, nose, 12.0)[0]
+    assert near[0] == pytest.approx(near[1], rel=1e-6)
+    h = 1e-5
+    (vm, v0, vp), _ = forrestal_penetration([x - h, x, x + h], 277.0, M, d, fc, rho, nose, 12.0)
+    force = -M * v0 * (vp - vm) / (2 * h)
+    assert force == pytest.approx(math.pi * d * d / 4 * (12.0 * fc + nose * rho * v0 * v0),
+                                  rel=1e-6)
 
 
 def test_concrete_and_steel_curves_of_the_section_estimate():

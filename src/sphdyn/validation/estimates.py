@@ -30,6 +30,70 @@ def ndrc_depth(velocity: float, mass: float, diameter: float, fc: float,
     return ratio * diameter
 
 
+def ogive_nose_factor(crh: float) -> float:
+    """Nose factor N* of an ogive nose of calibre radius head ``crh`` = s/d
+    (Forrestal et al. 1994; Li & Chen 2003, Eq. 3a)::
+
+        N* = 1 / (3 psi) - 1 / (24 psi^2)
+
+    (15/96 = 0.156 for crh 2)."""
+    return 1.0 / (3.0 * crh) - 1.0 / (24.0 * crh * crh)
+
+
+def forrestal_resistance_constant(fc: float) -> float:
+    """Forrestal et al. (1994), Eq. (12): the target resistance S [-] of the
+    cavity-expansion force law from the cylinder strength ``fc`` [Pa]::
+
+        S = 82.6 (f'c / MPa)^-0.544
+
+    (11.9 for 35.2 MPa; the paper's Table 2 gives 12 for that concrete)."""
+    return 82.6 * (fc / 1e6) ** -0.544
+
+
+def forrestal_penetration(depth, velocity: float, mass: float, diameter: float,
+                          fc: float, density: float, nose: float, S: float,
+                          k: float = 2.0):
+    r"""Velocity [m/s] of a rigid projectile at each ``depth`` [m] (array) in a
+    concrete half-space, and its final depth [m], by Forrestal et al.'s
+    (1994) two-stage force law (Li & Chen 2003, Eqs. 12-15)::
+
+        F = c x                                   x <= k d   (crater)
+        F = (pi d^2 / 4) (S f'c + N* rho V^2)     x >  k d   (tunnel)
+
+    with ``c`` from the force's continuity at x = k d; the tunnel's motion
+    ``m V dV/dx = -F`` integrates to
+
+    .. math:: V^2(x) = \left(V_1^2 + rac{S f'_c}{N^*ho}ight)
+              e^{-2 A N^*ho (x - kd) / m} - rac{S f'_c}{N^*ho},
+              \qquad X = kd + rac{m}{2 A N^* ho}
+              \ln\left(1 + rac{N^*ho V_1^2}{S f'_c}ight)
+
+    (:math:`A = \pi d^2/4`, :math:`V_1` the velocity at kd). ``velocity``
+    the striking velocity, ``mass`` [kg], ``diameter`` d [m], ``fc`` [Pa],
+    ``density`` the target's [kg/m^3], ``nose`` N* (:func:`ogive_nose_factor`),
+    ``S`` (:func:`forrestal_resistance_constant`), ``k`` the crater depth in
+    calibres (2: Forrestal et al. 1994). Zero velocity beyond the final depth.
+    Returns (V at each depth, X).
+    """
+    x = np.asarray(depth, dtype=float)
+    A = 0.25 * math.pi * diameter * diameter
+    kd = k * diameter
+    static, inertia = S * fc, nose * density
+    c = A * (static + inertia * velocity ** 2) / (kd * (1.0 + A * inertia * kd / mass))
+    v1_sq = velocity ** 2 - c * kd * kd / mass
+    if v1_sq <= 0.0:  # stops in the crater: m V0^2 / 2 = c X^2 / 2
+        X = velocity * math.sqrt(mass / c)
+        v_sq = velocity ** 2 - c * np.minimum(x, X) ** 2 / mass
+    else:
+        X = kd + mass / (2.0 * A * inertia) * math.log1p(inertia * v1_sq / static)
+        crater = velocity ** 2 - c * np.minimum(x, kd) ** 2 / mass
+        tunnel = ((v1_sq + static / inertia) * np.exp(-2.0 * A * inertia
+                                                      * (np.minimum(x, X) - kd) / mass)
+                  - static / inertia)
+        v_sq = np.where(x <= kd, crater, tunnel)
+    return np.sqrt(np.clip(v_sq, 0.0, None)), X
+
+
 def parabola_rectangle(strain, fc: float, eps_c2: float = 2.0e-3, n: float = 2.0):
     """Concrete compressive stress [Pa] of the parabola-rectangle diagram
     (EN 1992-1-1, 3.1.7, Eq. 3.17), compression positive::

@@ -1,0 +1,181 @@
+"""Study: the Forrestal target's resistance against the cavity-expansion force law (issue 53).
+
+sphdyn's projectile stops at a third to a half of the measured 173 mm
+(docs/validation.md, "Forrestal 1994"). Where does the extra resistance come
+from: the static part (the concrete's confined strength, Forrestal's S f'c)
+or a part that grows with the velocity? This reads runs of the case
+(validation/cases/forrestal1994_ogive.toml, any resolution) and compares the
+projectile's velocity against its depth with Forrestal et al.'s (1994)
+two-stage force law for the same shot (:func:`sphdyn.validation.estimates.
+forrestal_penetration`: F = c x in the crater, x <= 2 d; F = (pi d^2/4)
+(S f'c + N* rho V^2) in the tunnel; S from their Eq. 12, N* of the crh-2
+ogive):
+
+* the mean resisting stress in velocity bands, sigma = (loss of kinetic
+  energy) / (A x distance travelled) while the velocity falls through the
+  band (no derivative of a noisy signal), sphdyn's and the law's;
+* the effective S: the S for which the law stops the projectile where
+  sphdyn does (its depth as `sphdyn validate` measures it);
+* a figure, velocity against depth and the banded resistance against the
+  velocity (``--figure``).
+
+The projectile's velocity is its mean particle velocity (a ``[[probe]]`` of
+velocity_z, mean, which the case has since 2026-11-30) or else the
+derivative of its tip's depth (a Savitzky-Golay fit over 41 us). The
+projectile's depth is its tip's (the deepest particle below the face at z =
+0). Its mass, calibre and striking velocity, the concrete's strength and
+density are the experiment's (validation/data/forrestal1994_ogive_penetration.csv).
+
+    python studies/forrestal_resistance.py RUN[=LABEL] [...] [--figure PNG]
+
+(RUN: a run folder, e.g. ``sphdyn validate forrestal1994_ogive --out OUT``
+makes OUT/forrestal1994_ogive; validation/runs/ keeps the full and graded
+runs' histories.)
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+import tomllib
+from pathlib import Path
+
+import numpy as np
+from scipy.optimize import brentq
+from scipy.signal import savgol_filter
+
+from sphdyn.validation.estimates import (forrestal_penetration, forrestal_resistance_constant,
+                                         ogive_nose_factor)
+from sphdyn.validation.measures import depth_of_penetration
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = ROOT / "validation" / "data" / "forrestal1994_ogive_penetration.csv"
+#: velocity bands [m/s] of the mean resistance, from the striking velocity down
+BANDS = ((277.0, 200.0), (200.0, 100.0), (100.0, 25.0))
+
+
+def shot(velocity: float = 277.0) -> dict:
+    """The experiment's numbers for the shot at ``velocity`` (the data file)."""
+    rows = [r for r in csv.reader(line for line in DATA.open() if not line.startswith("#"))]
+    head, body = rows[0], rows[1:]
+    row = next(dict(zip(head, r)) for r in body if float(r[0]) == velocity)
+    return {"v": velocity, "m": float(row["m_p_kg"]), "fc": float(row["fc_MPa"]) * 1e6,
+            "d": 0.0269, "rho": 2370.0, "crh": 2.0, "dop": float(row["dop_m"])}
+
+
+def measured_depth(run: Path) -> float:
+    """The depth [m] as `sphdyn validate` measures it (the deepest the
+    projectile's particles reached, plus half their spacing)."""
+    with (run / "deck.resolved.toml").open("rb") as f:
+        deck = tomllib.load(f)
+    dx = next(b["dx"] for b in deck["body"] if b["name"] == "projectile")
+    return depth_of_penetration(run, "projectile", face=0.0, dx=dx)
+
+
+def trajectory(run: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
+    """Time [s], tip depth [m] below the face and velocity [m/s] (downwards
+    positive) of the projectile in a run, and how the velocity was had."""
+    with (run / "history.csv").open() as f:
+        rows = list(csv.DictReader(f))
+    t = np.array([float(r["time"]) for r in rows])
+    t, keep = np.unique(t, return_index=True)  # a restart repeats its first record
+    depth = -np.array([float(rows[i]["probe_projectile_position_z"]) for i in keep])
+    if "probe_projectile_velocity_z" in rows[0]:
+        v = -np.array([float(rows[i]["probe_projectile_velocity_z"]) for i in keep])
+        return t, depth, v, "mean particle velocity"
+    grid = np.arange(t[0], t[-1], 1e-6)
+    tip = np.interp(grid, t, depth)
+    v = savgol_filter(tip, 41, 2, deriv=1, delta=1e-6)
+    return grid, tip, v, "tip depth's derivative (Savitzky-Golay, 41 us)"
+
+
+def banded_resistance(depth: np.ndarray, v: np.ndarray, mass: float, area: float,
+                      bands=BANDS) -> list[float]:
+    """Mean resisting stress [Pa] while the velocity falls from each band's
+    upper to its lower value: (1/2) m (V_hi^2 - V_lo^2) / (A dx), dx the
+    depth travelled meanwhile (NaN where the run never reaches the band)."""
+    out = []
+    below = np.minimum.accumulate(v)  # the first time the velocity falls to a value
+    for hi, lo in bands:
+        if below[-1] > lo:
+            out.append(math.nan)
+            continue
+        start = np.argmax(below <= hi) if below[0] > hi else 0
+        v_hi = min(hi, v[start])
+        end = np.argmax(below <= lo)
+        travelled = depth[end] - depth[start]
+        out.append(0.5 * mass * (v_hi ** 2 - lo ** 2) / (area * travelled)
+                   if travelled > 0 else math.nan)
+    return out
+
+
+def effective_s(depth: float, s: dict, nose: float) -> float:
+    """The S for which the force law stops the shot at ``depth`` [m]."""
+    def miss(S):
+        return forrestal_penetration([0.0], s["v"], s["m"], s["d"], s["fc"], s["rho"], nose,
+                                     S)[1] - depth
+    return brentq(miss, 0.01, 1e4, xtol=1e-6)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("runs", nargs="+", metavar="RUN[=LABEL]",
+                    help="a run folder, optionally with its label in the figure")
+    ap.add_argument("--figure", type=Path, help="write the figure here (PNG)")
+    args = ap.parse_args(argv)
+    s = shot()
+    nose = ogive_nose_factor(s["crh"])
+    S = forrestal_resistance_constant(s["fc"])
+    area = 0.25 * math.pi * s["d"] ** 2
+    x = np.linspace(0.0, 0.2, 2001)
+    v_law, X_law = forrestal_penetration(x, s["v"], s["m"], s["d"], s["fc"], s["rho"], nose, S)
+    law = banded_resistance(x, v_law, s["m"], area)
+    print(f"Forrestal et al. (1994) force law: S = {S:.2f} (Eq. 12, f'c {s['fc'] / 1e6:g} MPa), "
+          f"N* = {nose:.4f}, stops at {X_law * 1e3:.1f} mm (measured {s['dop'] * 1e3:.0f} mm)")
+    head = " | ".join(f"sigma {hi:g}-{lo:g} m/s [MPa]" for hi, lo in BANDS)
+    print(f"| run | velocity from | depth [mm] | effective S | {head} |")
+    print("|---|---|---|---|" + "---|" * len(BANDS))
+    print(f"| force law | - | {X_law * 1e3:.1f} | {S:.1f} | "
+          + " | ".join(f"{b / 1e6:.0f}" for b in law) + " |")
+    curves = []
+    for given in args.runs:
+        path, _, label = given.partition("=")
+        run = Path(path)
+        label = label or (run.name if run.name != "forrestal1994_ogive" else run.parent.name)
+        t, depth, v, how = trajectory(run)
+        deepest = measured_depth(run)
+        sig = banded_resistance(depth, v, s["m"], area)
+        print(f"| {label} | {how} | {deepest * 1e3:.1f} | {effective_s(deepest, s, nose):.1f} | "
+              + " | ".join(f"{b / 1e6:.0f}" for b in sig) + " |")
+        curves.append((label, depth, v, sig))
+    if args.figure:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2))
+        a1.plot(x * 1e3, v_law, "k--", label=f"force law, S = {S:.1f} (Eq. 12)")
+        a1.axvline(s["dop"] * 1e3, color="0.5", lw=0.8)
+        a1.text(s["dop"] * 1e3, 5, " measured depth", color="0.4", fontsize=8)
+        mids = [0.5 * (hi + lo) for hi, lo in BANDS]
+        a2.plot(mids, [b / 1e6 for b in law], "k--o", label="force law")
+        for label, depth, v, sig in curves:
+            a1.plot(depth * 1e3, v, label=label)
+            a2.plot(mids, [b / 1e6 for b in sig], "o-", label=label)
+        a1.set(xlabel="tip depth below the face [mm]", ylabel="projectile velocity [m/s]",
+               xlim=(0, 200), ylim=(0, 300))
+        a2.set(xlabel="velocity band's middle [m/s]",
+               ylabel="mean resisting stress F / (pi d^2/4) [MPa]")
+        for a in (a1, a2):
+            a.grid(alpha=0.3)
+            a.legend(fontsize=8)
+        fig.suptitle("Forrestal et al. (1994), 277 m/s: sphdyn's resistance against the "
+                     "cavity-expansion force law", fontsize=10)
+        fig.tight_layout()
+        fig.savefig(args.figure, dpi=120)
+        print(f"wrote {args.figure}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
