@@ -216,7 +216,8 @@ def test_exterior_faces_of_kept_elements_from_the_twins(dim):
     (not a valid mesh) is never exterior, as the whole mesh's count has it."""
     from collections import Counter
 
-    from sphdyn.interactions.penalty_geometry import HEX8_FACES, QUAD4_EDGES, face_twins
+    from sphdyn.interactions.penalty_geometry import (HEX8_FACES, QUAD4_EDGES, face_nodes,
+                                                      face_twins)
 
     x, cells = block([0, 0, 0], [4.0, 3.0, 2.0], (4, 3, 2), dim)
     local = HEX8_FACES if dim == 3 else QUAD4_EDGES
@@ -233,6 +234,8 @@ def test_exterior_faces_of_kept_elements_from_the_twins(dim):
         expect = [(e, tuple(cells[e][f])) for e in kept for f in local
                   if count[tuple(sorted(cells[e][f]))] == 1]
         assert [(e, tuple(f)) for e, f in zip(elements, faces)] == expect
+        # the master surface's nodes, by a mask: numpy.unique's
+        assert np.array_equal(face_nodes(faces, len(x)), np.unique(faces))
     # element 0 twice: its faces on the boundary are held by two elements now,
     # those it shares with a neighbour by three (-2, never exterior)
     tripled = np.vstack([cells, cells[:1]])

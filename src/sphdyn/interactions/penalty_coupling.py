@@ -154,8 +154,8 @@ import numpy as np
 from numba import njit, prange
 
 from .base import InteractionBase
-from .penalty_geometry import (candidate_pairs, closest_point, exterior_faces, face_twins,
-                               face_anchors, face_point, face_shapes)
+from .penalty_geometry import (candidate_pairs, closest_point, exterior_faces, face_anchors,
+                               face_nodes, face_point, face_shapes, face_twins)
 from .wall import STIFFNESS
 from .wall_contact import (STIFFNESS_BULK, STIFFNESS_MASS, contact_thickness,
                            keep_spring_energy, spring_acceleration)
@@ -601,7 +601,7 @@ class PenaltyCoupling(InteractionBase):
         if self.faces.ndim != 2 or self.faces.shape[1] != (4 if dim == 3 else 2):
             raise ValueError(f"{name}: faces must have shape (F, {4 if dim == 3 else 2}) "
                              f"in {dim}D, got {self.faces.shape}")
-        self.master_nodes = np.unique(self.faces)
+        self.master_nodes = face_nodes(self.faces, solid_part.nodes.n)
         # penetration allowed without force: particles born (or exposed to new
         # faces) inside the contact thickness (the kernel's pen0); the face each
         # particle faced at the last evaluation and its signed penetration there
@@ -721,7 +721,7 @@ class PenaltyCoupling(InteractionBase):
             self.tie_shares = np.zeros((self.tied.size, 4, 3))
             self.tie_force = np.zeros((self.tied.size, 3))
         self.faces = faces
-        self.master_nodes = np.unique(self.faces)
+        self.master_nodes = face_nodes(self.faces, self.solid.nodes.n)
         self._allocate()
 
     def withdraw_forces(self) -> None:

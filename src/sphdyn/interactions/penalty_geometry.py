@@ -115,6 +115,15 @@ def exterior_faces(cells: np.ndarray, with_elements: bool = False, active=None,
     return out
 
 
+def face_nodes(faces: np.ndarray, n_nodes: int) -> np.ndarray:
+    """The nodes (sorted, int64) of the faces (F, nf) of a mesh of ``n_nodes``
+    nodes: ``numpy.unique(faces)`` by a mask, without a sort (after every
+    erosion event)."""
+    used = np.zeros(n_nodes, dtype=bool)
+    used[faces.ravel()] = True
+    return np.flatnonzero(used).astype(np.int64)
+
+
 def on_nodes(faces: np.ndarray, nodes) -> np.ndarray:
     """Mask (F,) of the faces (F, nf) whose nodes all belong to the node set ``nodes``."""
     inside = np.zeros(int(faces.max()) + 1 if faces.size else 0, dtype=bool)
