@@ -324,17 +324,11 @@ divisions = [2, 2, 2]
 [[set]]
 name = "back"
 mesh = "plate"
-[set.region]
-shape = "box"
-lo = [-1, -1, -1]
-hi = [1, 1, "0.1 mm"]
+region = { shape = "box", lo = [-1, -1, -1], hi = [1, 1, "0.1 mm"] }
 [[set]]
 name = "all"
 mesh = "plate"
-[set.region]
-shape = "box"
-lo = [-1, -1, -1]
-hi = [1, 1, 1]
+region = { shape = "halfspace", point = [0, 0, -1], normal = [0, 0, 1] }
 [[boundary]]
 set = "back"
 type = "non_reflecting"
