@@ -51,8 +51,15 @@ from sphdyn.validation.measures import depth_of_penetration
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "validation" / "data" / "forrestal1994_ogive_penetration.csv"
-#: velocity bands [m/s] of the mean resistance, from the striking velocity down
-BANDS = ((277.0, 200.0), (200.0, 100.0), (100.0, 25.0))
+#: the velocities [m/s] that bound the bands of the mean resistance, below the
+#: striking velocity (the first band starts there)
+BAND_EDGES = (400.0, 277.0, 200.0, 100.0, 25.0)
+
+
+def bands(velocity: float) -> tuple[tuple[float, float], ...]:
+    """The velocity bands (upper, lower) [m/s] from the striking velocity down."""
+    edges = [velocity] + [b for b in BAND_EDGES if b < velocity]
+    return tuple(zip(edges[:-1], edges[1:]))
 
 
 def shot(velocity: float = 277.0) -> dict:
@@ -91,7 +98,7 @@ def trajectory(run: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
 
 
 def banded_resistance(depth: np.ndarray, v: np.ndarray, mass: float, area: float,
-                      bands=BANDS) -> list[float]:
+                      bands) -> list[float]:
     """Mean resisting stress [Pa] while the velocity falls from each band's
     upper to its lower value: (1/2) m (V_hi^2 - V_lo^2) / (A dx), dx the
     depth travelled meanwhile (NaN where the run never reaches the band)."""
@@ -123,19 +130,23 @@ def main(argv=None) -> int:
     ap.add_argument("runs", nargs="+", metavar="RUN[=LABEL]",
                     help="a run folder, optionally with its label in the figure")
     ap.add_argument("--figure", type=Path, help="write the figure here (PNG)")
+    ap.add_argument("--velocity", type=float, default=277.0,
+                    help="the shot's striking velocity [m/s], a row of the data file (the "
+                         "runs must be of that shot: --set body.projectile.velocity=...)")
     args = ap.parse_args(argv)
-    s = shot()
+    s = shot(args.velocity)
+    edges = bands(s["v"])
     nose = ogive_nose_factor(s["crh"])
     S = forrestal_resistance_constant(s["fc"])
     area = 0.25 * math.pi * s["d"] ** 2
     x = np.linspace(0.0, 0.2, 2001)
     v_law, X_law = forrestal_penetration(x, s["v"], s["m"], s["d"], s["fc"], s["rho"], nose, S)
-    law = banded_resistance(x, v_law, s["m"], area)
+    law = banded_resistance(x, v_law, s["m"], area, edges)
     print(f"Forrestal et al. (1994) force law: S = {S:.2f} (Eq. 12, f'c {s['fc'] / 1e6:g} MPa), "
           f"N* = {nose:.4f}, stops at {X_law * 1e3:.1f} mm (measured {s['dop'] * 1e3:.0f} mm)")
-    head = " | ".join(f"sigma {hi:g}-{lo:g} m/s [MPa]" for hi, lo in BANDS)
+    head = " | ".join(f"sigma {hi:g}-{lo:g} m/s [MPa]" for hi, lo in edges)
     print(f"| run | velocity from | depth [mm] | effective S | {head} |")
-    print("|---|---|---|---|" + "---|" * len(BANDS))
+    print("|---|---|---|---|" + "---|" * len(edges))
     print(f"| force law | - | {X_law * 1e3:.1f} | {S:.1f} | "
           + " | ".join(f"{b / 1e6:.0f}" for b in law) + " |")
     curves = []
@@ -145,7 +156,7 @@ def main(argv=None) -> int:
         label = label or (run.name if run.name != "forrestal1994_ogive" else run.parent.name)
         t, depth, v, how = trajectory(run)
         deepest = measured_depth(run)
-        sig = banded_resistance(depth, v, s["m"], area)
+        sig = banded_resistance(depth, v, s["m"], area, edges)
         print(f"| {label} | {how} | {deepest * 1e3:.1f} | {effective_s(deepest, s, nose):.1f} | "
               + " | ".join(f"{b / 1e6:.0f}" for b in sig) + " |")
         curves.append((label, depth, v, sig))
@@ -157,19 +168,19 @@ def main(argv=None) -> int:
         a1.plot(x * 1e3, v_law, "k--", label=f"force law, S = {S:.1f} (Eq. 12)")
         a1.axvline(s["dop"] * 1e3, color="0.5", lw=0.8)
         a1.text(s["dop"] * 1e3, 5, " measured depth", color="0.4", fontsize=8)
-        mids = [0.5 * (hi + lo) for hi, lo in BANDS]
+        mids = [0.5 * (hi + lo) for hi, lo in edges]
         a2.plot(mids, [b / 1e6 for b in law], "k--o", label="force law")
         for label, depth, v, sig in curves:
             a1.plot(depth * 1e3, v, label=label)
             a2.plot(mids, [b / 1e6 for b in sig], "o-", label=label)
         a1.set(xlabel="tip depth below the face [mm]", ylabel="projectile velocity [m/s]",
-               xlim=(0, 200), ylim=(0, 300))
+               xlim=(0, max(200.0, 1.2e3 * s["dop"])), ylim=(0, 1.1 * s["v"]))
         a2.set(xlabel="velocity band's middle [m/s]",
                ylabel="mean resisting stress F / (pi d^2/4) [MPa]")
         for a in (a1, a2):
             a.grid(alpha=0.3)
             a.legend(fontsize=8)
-        fig.suptitle("Forrestal et al. (1994), 277 m/s: sphdyn's resistance against the "
+        fig.suptitle(f"Forrestal et al. (1994), {s['v']:g} m/s: sphdyn's resistance against the "
                      "cavity-expansion force law", fontsize=10)
         fig.tight_layout()
         fig.savefig(args.figure, dpi=120)

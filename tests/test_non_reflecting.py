@@ -97,6 +97,13 @@ def test_the_centred_solve_matches_numpy():
         w = np.linalg.solve(np.eye(3) + dt / (2 * m[k]) * C[k], v[k] + 0.5 * dt * a_int[k])
         assert np.allclose(a_own[k], -C[k] @ w / m[k], rtol=1e-12, atol=1e-12)
     assert np.array_equal(a_out, 1.0 + a_own)
+    # a node whose elements all eroded has no mass and no faces (C = 0): no
+    # dashpot, and no NaN (0/0 stopped a Forrestal run at 499 m/s, 2026-11-30)
+    m[4], C[4] = 0.0, 0.0
+    a_own, a_out = np.zeros((n, 3)), np.ones((n, 3))
+    dashpot_accelerations(np.arange(n), m, C, v, a_int, dt, a_own, a_out)
+    assert np.all(np.isfinite(a_out)) and np.array_equal(a_own[4], np.zeros(3))
+    assert np.array_equal(a_out[4], np.ones(3))
 
 
 # ------------------------------------------------------------- the centring

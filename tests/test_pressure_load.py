@@ -483,3 +483,17 @@ def test_a_pressure_on_a_set_without_faces_is_refused(extra, set_name, match, tm
     assert main(["check", str(path)]) == 2
     err = capsys.readouterr().err
     assert "load[0].set" in err and "Fix:" in err and "Traceback" not in err
+
+
+def test_a_node_without_mass_gets_no_acceleration():
+    """A loaded node whose elements all eroded has no mass (and no force, its
+    faces gone): its acceleration is 0, not 0/0; the others force / m."""
+    from sphdyn.interactions.pressure import accelerate
+
+    nodes = np.array([0, 1, 2])
+    m = np.array([2.0, 0.0, 4.0])
+    force = np.array([[2.0, 4.0, 6.0], [0.0, 0.0, 0.0], [4.0, 8.0, 12.0]])
+    a_own, a_out = np.zeros((3, 3)), np.ones((3, 3))
+    accelerate(nodes, m, force, a_own, a_out)
+    assert np.array_equal(a_own, [[1.0, 2.0, 3.0], [0.0, 0.0, 0.0], [1.0, 2.0, 3.0]])
+    assert np.array_equal(a_out, 1.0 + a_own)

@@ -106,9 +106,14 @@ def dashpot_accelerations(nodes, m, C, v, a_int, dt, a_own, a_out):
     [kg/s] (:func:`boundary_dashpots`), ``v`` (N, 3) :math:`\mathbf v^{n+1/2}`,
     ``a_int`` (N, 3) the internal accelerations at :math:`t^{n+1}`, ``dt`` [s].
     The matrix is symmetric positive definite (C is positive semi-definite):
-    solved by its adjugate."""
+    solved by its adjugate. A node without mass (every element about it
+    eroded, so its faces are gone too) gets none: ``a_own[k] = 0``."""
     for k in range(nodes.shape[0]):
         i = nodes[k]
+        if not m[i] > 0.0:
+            for j in range(3):
+                a_own[k, j] = 0.0
+            continue
         s = 0.5 * dt / m[i]
         a00 = 1.0 + s * C[k, 0, 0]
         a11 = 1.0 + s * C[k, 1, 1]

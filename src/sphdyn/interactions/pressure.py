@@ -132,11 +132,13 @@ def face_pressure_forces(x, faces, local, elements, active, p, S, force):
 @njit(cache=True, error_model="numpy")
 def accelerate(nodes, m, force, a_own, a_out):
     """``a_own[k] = force[k] / m[nodes[k]]`` (k, 3) [m/s^2], added to
-    ``a_out[nodes[k]]`` (N, 3)."""
+    ``a_out[nodes[k]]`` (N, 3); 0 on a node without mass (every element about
+    it eroded: its faces, and so its force, are gone)."""
     for k in range(nodes.shape[0]):
         i = nodes[k]
+        massless = not m[i] > 0.0
         for j in range(3):
-            a_own[k, j] = force[k, j] / m[i]
+            a_own[k, j] = 0.0 if massless else force[k, j] / m[i]
             a_out[i, j] += a_own[k, j]
 
 
