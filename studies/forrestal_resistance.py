@@ -17,7 +17,11 @@ ogive):
 * the effective S: the S for which the law stops the projectile where
   sphdyn does (its depth as `sphdyn validate` measures it);
 * a figure, velocity against depth and the banded resistance against the
-  velocity (``--figure``).
+  velocity (``--figure``);
+* with ``--carried`` (the runs' frames), the target mass moving ahead of the
+  nose: below the tip (plus 5 mm) and downwards at more than half the
+  projectile's speed, per frame while it moves (a plug of crushed concrete
+  pushed ahead would show here).
 
 The projectile's velocity is its mean particle velocity (a ``[[probe]]`` of
 velocity_z, mean, which the case has since 2026-11-30) or else the
@@ -125,11 +129,45 @@ def effective_s(depth: float, s: dict, nose: float) -> float:
     return brentq(miss, 0.01, 1e4, xtol=1e-6)
 
 
+def carried_mass(run: Path, mesh: str = "target", ahead: float = 5e-3) -> list[tuple]:
+    """Per frame of a run while the projectile moves down: (time [s], its
+    velocity [m/s], the target's mass [kg] below its tip (plus ``ahead`` [m])
+    moving down at more than half its speed: the mesh nodes' and the eroded
+    elements' particles'). The projectile's particles are those of the most
+    common particle mass (its lattice's; the debris particles carry their
+    elements' masses)."""
+    import h5py
+
+    from sphdyn.io.frames import list_frames
+
+    out = []
+    for path in list_frames(run):
+        with h5py.File(path, "r") as f:
+            t = float(f.attrs["time"])
+            m, x, v = f["mass"][:], f["position"][:], f["velocity"][:]
+            values, counts = np.unique(m, return_counts=True)
+            proj = m == values[np.argmax(counts)]
+            V = float((m[proj] * v[proj, 2]).sum() / m[proj].sum())
+            if not V < 0.0:
+                continue
+            tip = float(x[proj, 2].min())
+            g = f["meshes"][mesh]
+            xn = g["points"][:] + g["point_data/displacement"][:]
+            vn, mn = g["point_data/velocity"][:], g["point_data/mass"][:]
+        nodes = (vn[:, 2] < 0.5 * V) & (xn[:, 2] < tip + ahead)
+        debris = ~proj & (v[:, 2] < 0.5 * V) & (x[:, 2] < tip + ahead)
+        out.append((t, V, float(mn[nodes].sum()), float(m[debris].sum())))
+    return out
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("runs", nargs="+", metavar="RUN[=LABEL]",
                     help="a run folder, optionally with its label in the figure")
     ap.add_argument("--figure", type=Path, help="write the figure here (PNG)")
+    ap.add_argument("--carried", action="store_true",
+                    help="also print, per frame, the target mass carried ahead of the nose "
+                         "(needs the runs' frames)")
     ap.add_argument("--velocity", type=float, default=277.0,
                     help="the shot's striking velocity [m/s], a row of the data file (the "
                          "runs must be of that shot: --set body.projectile.velocity=...)")
@@ -161,6 +199,15 @@ def main(argv=None) -> int:
         print(f"| {label} | {how} | {deepest * 1e3:.1f} | {effective_s(deepest, s, nose):.1f} | "
               + " | ".join(f"{b / 1e6:.0f}" for b in sig) + " |")
         curves.append((label, depth, v, sig))
+    if args.carried:
+        print("| run | time [us] | projectile velocity [m/s] | carried: nodes [g] | "
+              "debris particles [g] |")
+        print("|---|---|---|---|---|")
+        for given in args.runs:
+            path, _, label = given.partition("=")
+            for t, V, nodes, debris in carried_mass(Path(path)):
+                print(f"| {label or path} | {t * 1e6:.0f} | {V:.1f} | {nodes * 1e3:.1f} | "
+                      f"{debris * 1e3:.1f} |")
     if args.figure:
         import matplotlib
         matplotlib.use("Agg")
