@@ -270,6 +270,13 @@ MUTANTS: tuple[Mutant, ...] = (
            ("tests/test_non_reflecting.py::test_a_plane_pulse_leaves_through_the_absorbing_"
             "ends[S-quad4]",),
            "non-reflecting boundary: rho c_s = sqrt(rho G) -> sqrt(G)"),
+    Mutant("exterior_twin_kept", "issue 53", "sphdyn/interactions/penalty_geometry.py",
+           "| ((twins >= 0) & ~kept[np.maximum(twins, 0) // n_local]))",
+           "| ((twins >= 0) & kept[np.maximum(twins, 0) // n_local]))",
+           ("tests/test_penalty_coupling.py::test_exterior_faces_of_kept_elements_from_the_"
+            "twins[3]",),
+           "erosion's master surface: a face exterior when its twin's element is kept "
+           "instead of dropped"),
     Mutant("hex_lanes_node_share", "issue 53", "sphdyn/parts/fem/hex_lanes.py",
            "S[MSH_ * LANES + l] = m_el[e] / 8", "S[MSH_ * LANES + l] = m_el[e] / 4",
            ("tests/test_fem_solid.py::test_an_element_distorted_into_its_hourglass_shape_"
