@@ -21,7 +21,12 @@ ogive):
 * with ``--carried`` (the runs' frames), the target mass moving ahead of the
   nose: below the tip (plus 5 mm) and downwards at more than half the
   projectile's speed, per frame while it moves (a plug of crushed concrete
-  pushed ahead would show here).
+  pushed ahead would show here);
+* with ``--wall`` (frames), the live elements ahead of the nose: how deep
+  the eroded debris lies between the tip and the first element on the axis,
+  and the pressure, von Mises stress and damage of the most compressed
+  elements there, beside MAT_159's TXC shear surface at that pressure with
+  the default fits (q = sqrt(3) Ff(3p), no rate effects, undamaged).
 
 The projectile's velocity is its mean particle velocity (a ``[[probe]]`` of
 velocity_z, mean, which the case has since 2026-11-30) or else the
@@ -160,6 +165,47 @@ def carried_mass(run: Path, mesh: str = "target", ahead: float = 5e-3) -> list[t
     return out
 
 
+def wall_states(run: Path, mesh: str = "target", below: float = 15e-3,
+                reach: float = 25e-3, count: int = 3) -> list[tuple]:
+    """Per frame while the projectile moves down: (time [s], the depth [m] of
+    the first live element's centre below the tip nearest the axis,
+    and for the ``count`` live elements of highest pressure within ``below``
+    [m] under the tip (and 10 mm above it) and ``reach`` [m] of the axis:
+    pressure p = -tr(sigma)/3 [Pa], von Mises q [Pa], damage). The stress is
+    the element's (damaged) stress of the frame."""
+    import h5py
+
+    from sphdyn.io.frames import list_frames
+
+    out = []
+    for path in list_frames(run):
+        with h5py.File(path, "r") as f:
+            t = float(f.attrs["time"])
+            m, x, v = f["mass"][:], f["position"][:], f["velocity"][:]
+            values, counts = np.unique(m, return_counts=True)
+            proj = m == values[np.argmax(counts)]
+            tip = float(x[proj, 2].min())
+            if not ((m[proj] * v[proj, 2]).sum() < 0.0 and tip < 0.0):
+                continue  # in the target and moving down
+            g = f["meshes"][mesh]
+            xn = g["points"][:] + g["point_data/displacement"][:]
+            cells, sig = g["cells"][:], g["cell_data/stress"][:]
+            live, damage = g["cell_data/eroded"][:] == 0, g["cell_data/damage"][:]
+        centre = xn[cells].mean(axis=1)
+        r = np.hypot(centre[:, 0], centre[:, 1])
+        below_tip = live & (centre[:, 2] < tip)
+        # the elements nearest the axis (within 5 mm, or the innermost ring's)
+        axis = below_tip & (r <= max(5e-3, 1.01 * float(r[below_tip].min(initial=np.inf))))
+        gap = tip - float(centre[axis, 2].max()) if axis.any() else math.nan
+        p = -np.trace(sig, axis1=1, axis2=2) / 3.0
+        dev = sig + p[:, None, None] * np.eye(3)
+        q = np.sqrt(1.5 * np.einsum("kij,kij->k", dev, dev))
+        near = live & (r < reach) & (centre[:, 2] < tip + 10e-3) & (centre[:, 2] > tip - below)
+        top = np.flatnonzero(near)[np.argsort(-p[near])[:count]]
+        out.append((t, gap, [(float(p[k]), float(q[k]), float(damage[k])) for k in top]))
+    return out
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("runs", nargs="+", metavar="RUN[=LABEL]",
@@ -168,6 +214,9 @@ def main(argv=None) -> int:
     ap.add_argument("--carried", action="store_true",
                     help="also print, per frame, the target mass carried ahead of the nose "
                          "(needs the runs' frames)")
+    ap.add_argument("--wall", action="store_true",
+                    help="also print, per frame, the stress states of the live elements "
+                         "ahead of the nose against MAT_159's shear surface (needs frames)")
     ap.add_argument("--velocity", type=float, default=277.0,
                     help="the shot's striking velocity [m/s], a row of the data file (the "
                          "runs must be of that shot: --set body.projectile.velocity=...)")
@@ -208,6 +257,26 @@ def main(argv=None) -> int:
             for t, V, nodes, debris in carried_mass(Path(path)):
                 print(f"| {label or path} | {t * 1e6:.0f} | {V:.1f} | {nodes * 1e3:.1f} | "
                       f"{debris * 1e3:.1f} |")
+    if args.wall:
+        from sphdyn.materials.cscm.defaults import default_parameters
+
+        c = default_parameters(s["fc"], 0.016)  # the case's 16 mm aggregate
+        slope = math.sqrt(3.0) * 3.0 * c["theta"]
+        print(f"MAT_159's TXC surface, default fits: q = sqrt(3) Ff(3p), its slope q/p at high "
+              f"pressure sqrt(3) 3 theta = {slope:.2f}. The elements' stresses are damaged, "
+              "(1 - d) times the undamaged ones, so their q/p is the one to compare.")
+        print("| run | time [us] | debris ahead [mm] | p [MPa] | von Mises q [MPa] | q/p | "
+              "damage | MAT_159's TXC q at that p [MPa] |")
+        print("|---|---|---|---|---|---|---|---|")
+        for given in args.runs:
+            path, _, label = given.partition("=")
+            for t, gap, states in wall_states(Path(path)):
+                for p, q, d in states:
+                    J1 = 3.0 * p  # Ff(J1) = alpha - lamda exp(-beta J1) + theta J1, vs sqrt(J2')
+                    ff = c["alpha"] - c["lamda"] * math.exp(-c["beta"] * J1) + c["theta"] * J1
+                    print(f"| {label or path} | {t * 1e6:.0f} | {gap * 1e3:.1f} | {p / 1e6:.0f} | "
+                          f"{q / 1e6:.0f} | {q / p:.2f} | {d:.2f} | "
+                          f"{math.sqrt(3.0) * ff / 1e6:.0f} |")
     if args.figure:
         import matplotlib
         matplotlib.use("Agg")
