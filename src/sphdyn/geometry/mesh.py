@@ -311,9 +311,9 @@ def graded_nodes(lo: float, hi: float, n: int, ratio: float = 1.0,
     :math:`k_i` element i's distance in elements from the smallest one(s)
     (:math:`k_i = |i - (n-1)/2| - \min_j |j - (n-1)/2|` for "centre": the
     middle element, or the middle two, smallest; two elements stay equal)
-    and :math:`s_0` set by :math:`\sum s_i = hi - lo` (a bias, as LS-DYNA's and Gmsh's progressions). ``ratio = 1``: equal
-    elements, the same bits as ``numpy.linspace``; the ends are ``lo`` and
-    ``hi`` exactly."""
+    and :math:`s_0` set by :math:`\sum s_i = hi - lo` (a bias, as LS-DYNA's
+    and Gmsh's progressions). ``ratio = 1``: equal elements, the same bits
+    as ``numpy.linspace``; the ends are ``lo`` and ``hi`` exactly."""
     if ratio == 1.0 or n == 1:
         return np.linspace(lo, hi, n + 1)
     i = np.arange(n, dtype=float)

@@ -63,10 +63,10 @@ def forrestal_penetration(depth, velocity: float, mass: float, diameter: float,
     with ``c`` from the force's continuity at x = k d; the tunnel's motion
     ``m V dV/dx = -F`` integrates to
 
-    .. math:: V^2(x) = \left(V_1^2 + rac{S f'_c}{N^*ho}ight)
-              e^{-2 A N^*ho (x - kd) / m} - rac{S f'_c}{N^*ho},
-              \qquad X = kd + rac{m}{2 A N^* ho}
-              \ln\left(1 + rac{N^*ho V_1^2}{S f'_c}ight)
+    .. math:: V^2(x) = \left(V_1^2 + \frac{S f'_c}{N^*\rho}\right)
+              e^{-2 A N^*\rho (x - kd) / m} - \frac{S f'_c}{N^*\rho},
+              \qquad X = kd + \frac{m}{2 A N^* \rho}
+              \ln\left(1 + \frac{N^*\rho V_1^2}{S f'_c}\right)
 
     (:math:`A = \pi d^2/4`, :math:`V_1` the velocity at kd). ``velocity``
     the striking velocity, ``mass`` [kg], ``diameter`` d [m], ``fc`` [Pa],
