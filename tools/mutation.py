@@ -271,8 +271,8 @@ MUTANTS: tuple[Mutant, ...] = (
             "ends[S-quad4]",),
            "non-reflecting boundary: rho c_s = sqrt(rho G) -> sqrt(G)"),
     Mutant("exterior_twin_kept", "issue 53", "sphdyn/interactions/penalty_geometry.py",
-           "| ((twins >= 0) & ~kept[np.maximum(twins, 0) // n_local]))",
-           "| ((twins >= 0) & kept[np.maximum(twins, 0) // n_local]))",
+           "| ((twins >= 0) & ~kept[np.maximum(twins, 0)]))",
+           "| ((twins >= 0) & kept[np.maximum(twins, 0)]))",
            ("tests/test_penalty_coupling.py::test_exterior_faces_of_kept_elements_from_the_"
             "twins[3]",),
            "erosion's master surface: a face exterior when its twin's element is kept "

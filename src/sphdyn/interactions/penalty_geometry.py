@@ -71,8 +71,7 @@ def face_twins(cells: np.ndarray) -> np.ndarray:
     pair = start[size == 2]
     twins[order[pair]] = order[pair + 1]
     twins[order[pair + 1]] = order[pair]
-    for s0, m in zip(start[size > 2], size[size > 2]):
-        twins[order[s0:s0 + m]] = -2
+    twins[order[np.repeat(size > 2, size)]] = -2
     return twins
 
 
@@ -102,11 +101,9 @@ def exterior_faces(cells: np.ndarray, with_elements: bool = False, active=None,
     local = _local_faces(cells)
     n_local = local.shape[0]
     twins = face_twins(cells) if twins is None else twins
-    slot_element = np.arange(twins.size, dtype=np.int64) // n_local
-    kept = (np.ones(cells.shape[0], dtype=bool) if active is None
-            else np.asarray(active) != 0)
-    once = kept[slot_element] & ((twins == -1)
-                                 | ((twins >= 0) & ~kept[np.maximum(twins, 0) // n_local]))
+    kept = np.repeat(np.ones(cells.shape[0], dtype=bool) if active is None
+                     else np.asarray(active) != 0, n_local)  # per face slot
+    once = kept & ((twins == -1) | ((twins >= 0) & ~kept[np.maximum(twins, 0)]))
     slots = np.flatnonzero(once)
     out = np.ascontiguousarray(cells[slots // n_local][np.arange(slots.size)[:, None],
                                                         local[slots % n_local]])
