@@ -26,7 +26,8 @@ ogive):
   the eroded debris lies between the tip and the first element on the axis,
   and the pressure, von Mises stress and damage of the most compressed
   elements there, beside MAT_159's TXC shear surface at that pressure with
-  the default fits (q = sqrt(3) Ff(3p), no rate effects, undamaged).
+  the run's concrete parameters (q = sqrt(3) Ff(3p), no rate effects,
+  undamaged) and its slope at high pressure.
 
 The projectile's velocity is its mean particle velocity (a ``[[probe]]`` of
 velocity_z, mean, which the case has since 2026-11-30) or else the
@@ -45,7 +46,6 @@ runs' histories.)
 from __future__ import annotations
 
 import argparse
-import csv
 import math
 import tomllib
 from pathlib import Path
@@ -54,9 +54,13 @@ import numpy as np
 from scipy.optimize import brentq
 from scipy.signal import savgol_filter
 
+from sphdyn.io.history import History
+from sphdyn.materials import cscm
+from sphdyn.materials.cscm.layout import P_THETA
+from sphdyn.validation import data
+from sphdyn.validation.cases import CASES
 from sphdyn.validation.estimates import (forrestal_penetration, forrestal_resistance_constant,
                                          ogive_nose_factor)
-from sphdyn.validation.measures import depth_of_penetration
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "validation" / "data" / "forrestal1994_ogive_penetration.csv"
@@ -72,34 +76,35 @@ def bands(velocity: float) -> tuple[tuple[float, float], ...]:
 
 
 def shot(velocity: float = 277.0) -> dict:
-    """The experiment's numbers for the shot at ``velocity`` (the data file)."""
-    rows = [r for r in csv.reader(line for line in DATA.open() if not line.startswith("#"))]
-    head, body = rows[0], rows[1:]
-    row = next(dict(zip(head, r)) for r in body if float(r[0]) == velocity)
-    return {"v": velocity, "m": float(row["m_p_kg"]), "fc": float(row["fc_MPa"]) * 1e6,
-            "d": 0.0269, "rho": 2370.0, "crh": 2.0, "dop": float(row["dop_m"])}
+    """The experiment's numbers for the shot at ``velocity`` (the data file's
+    row; the calibre, the concrete's density and the ogive's crh from its
+    set-up lines)."""
+    row = data.read(DATA).row(v_s_m_per_s=f"{velocity:g}")
+    return {"v": velocity, "m": data.number(row, "m_p_kg"),
+            "fc": data.number(row, "fc_MPa") * 1e6, "d": 0.0269, "rho": 2370.0, "crh": 2.0,
+            "dop": data.number(row, "dop_m")}
+
+
+def resolved_deck(run: Path) -> dict:
+    """The run's resolved deck."""
+    with (run / "deck.resolved.toml").open("rb") as f:
+        return tomllib.load(f)
 
 
 def measured_depth(run: Path) -> float:
-    """The depth [m] as `sphdyn validate` measures it (the deepest the
-    projectile's particles reached, plus half their spacing)."""
-    with (run / "deck.resolved.toml").open("rb") as f:
-        deck = tomllib.load(f)
-    dx = next(b["dx"] for b in deck["body"] if b["name"] == "projectile")
-    return depth_of_penetration(run, "projectile", face=0.0, dx=dx)
+    """The depth [m] as `sphdyn validate` measures it (the case's own measure:
+    the deepest the projectile's particles reached, plus half their spacing)."""
+    return CASES["forrestal1994_ogive"].measure(run, resolved_deck(run))["dop"]
 
 
 def trajectory(run: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
     """Time [s], tip depth [m] below the face and velocity [m/s] (downwards
     positive) of the projectile in a run, and how the velocity was had."""
-    with (run / "history.csv").open() as f:
-        rows = list(csv.DictReader(f))
-    t = np.array([float(r["time"]) for r in rows])
-    t, keep = np.unique(t, return_index=True)  # a restart repeats its first record
-    depth = -np.array([float(rows[i]["probe_projectile_position_z"]) for i in keep])
-    if "probe_projectile_velocity_z" in rows[0]:
-        v = -np.array([float(rows[i]["probe_projectile_velocity_z"]) for i in keep])
-        return t, depth, v, "mean particle velocity"
+    h = History.from_csv(run / "history.csv").as_arrays()
+    t, keep = np.unique(h["time"], return_index=True)  # a restart repeats a record
+    depth = -h["probe_projectile_position_z"][keep]
+    if "probe_projectile_velocity_z" in h:
+        return t, depth, -h["probe_projectile_velocity_z"][keep], "mean particle velocity"
     grid = np.arange(t[0], t[-1], 1e-6)
     tip = np.interp(grid, t, depth)
     v = savgol_filter(tip, 41, 2, deriv=1, delta=1e-6)
@@ -134,63 +139,56 @@ def effective_s(depth: float, s: dict, nose: float) -> float:
     return brentq(miss, 0.01, 1e4, xtol=1e-6)
 
 
-def carried_mass(run: Path, mesh: str = "target", ahead: float = 5e-3) -> list[tuple]:
-    """Per frame of a run while the projectile moves down: (time [s], its
-    velocity [m/s], the target's mass [kg] below its tip (plus ``ahead`` [m])
-    moving down at more than half its speed: the mesh nodes' and the eroded
-    elements' particles'). The projectile's particles are those of the most
-    common particle mass (its lattice's; the debris particles carry their
-    elements' masses)."""
+def projectile_frames(run: Path, mesh: str = "target"):
+    """Each frame of a run with the projectile in the target (its tip below the
+    face) and moving down: (time [s], the particles' mass, position and
+    velocity, the projectile's mask, its velocity [m/s] and tip [m], and the
+    mesh group of the frame, read while the file is open). The projectile's
+    particles are those of the most common particle mass (its lattice's; the
+    debris particles carry their elements' masses)."""
     import h5py
 
     from sphdyn.io.frames import list_frames
 
-    out = []
     for path in list_frames(run):
         with h5py.File(path, "r") as f:
-            t = float(f.attrs["time"])
             m, x, v = f["mass"][:], f["position"][:], f["velocity"][:]
             values, counts = np.unique(m, return_counts=True)
             proj = m == values[np.argmax(counts)]
             V = float((m[proj] * v[proj, 2]).sum() / m[proj].sum())
-            if not V < 0.0:
-                continue
             tip = float(x[proj, 2].min())
-            g = f["meshes"][mesh]
-            xn = g["points"][:] + g["point_data/displacement"][:]
-            vn, mn = g["point_data/velocity"][:], g["point_data/mass"][:]
+            if V < 0.0 and tip < 0.0:
+                yield float(f.attrs["time"]), m, x, v, proj, V, tip, f["meshes"][mesh]
+
+
+def carried_mass(run: Path, ahead: float = 5e-3) -> list[tuple]:
+    """Per frame (:func:`projectile_frames`): (time [s], the projectile's
+    velocity [m/s], the target's mass [kg] below its tip (plus ``ahead`` [m])
+    moving down at more than half its speed: the mesh nodes' and the eroded
+    elements' particles')."""
+    out = []
+    for t, m, x, v, proj, V, tip, g in projectile_frames(run):
+        xn = g["points"][:] + g["point_data/displacement"][:]
+        vn, mn = g["point_data/velocity"][:], g["point_data/mass"][:]
         nodes = (vn[:, 2] < 0.5 * V) & (xn[:, 2] < tip + ahead)
         debris = ~proj & (v[:, 2] < 0.5 * V) & (x[:, 2] < tip + ahead)
         out.append((t, V, float(mn[nodes].sum()), float(m[debris].sum())))
     return out
 
 
-def wall_states(run: Path, mesh: str = "target", below: float = 15e-3,
-                reach: float = 25e-3, count: int = 3) -> list[tuple]:
-    """Per frame while the projectile moves down: (time [s], the depth [m] of
-    the first live element's centre below the tip nearest the axis,
-    and for the ``count`` live elements of highest pressure within ``below``
-    [m] under the tip (and 10 mm above it) and ``reach`` [m] of the axis:
-    pressure p = -tr(sigma)/3 [Pa], von Mises q [Pa], damage). The stress is
-    the element's (damaged) stress of the frame."""
-    import h5py
-
-    from sphdyn.io.frames import list_frames
-
+def wall_states(run: Path, below: float = 15e-3, reach: float = 25e-3,
+                count: int = 3) -> list[tuple]:
+    """Per frame (:func:`projectile_frames`): (time [s], the depth [m] of the
+    first live element's centre below the tip nearest the axis, and for the
+    ``count`` live elements of highest pressure within ``below`` [m] under
+    the tip (and 10 mm above it) and ``reach`` [m] of the axis: pressure p =
+    -tr(sigma)/3 [Pa], von Mises q [Pa], damage). The stress is the
+    element's (damaged) stress of the frame."""
     out = []
-    for path in list_frames(run):
-        with h5py.File(path, "r") as f:
-            t = float(f.attrs["time"])
-            m, x, v = f["mass"][:], f["position"][:], f["velocity"][:]
-            values, counts = np.unique(m, return_counts=True)
-            proj = m == values[np.argmax(counts)]
-            tip = float(x[proj, 2].min())
-            if not ((m[proj] * v[proj, 2]).sum() < 0.0 and tip < 0.0):
-                continue  # in the target and moving down
-            g = f["meshes"][mesh]
-            xn = g["points"][:] + g["point_data/displacement"][:]
-            cells, sig = g["cells"][:], g["cell_data/stress"][:]
-            live, damage = g["cell_data/eroded"][:] == 0, g["cell_data/damage"][:]
+    for t, m, x, v, proj, V, tip, g in projectile_frames(run):
+        xn = g["points"][:] + g["point_data/displacement"][:]
+        cells, sig = g["cells"][:], g["cell_data/stress"][:]
+        live, damage = g["cell_data/eroded"][:] == 0, g["cell_data/damage"][:]
         centre = xn[cells].mean(axis=1)
         r = np.hypot(centre[:, 0], centre[:, 1])
         below_tip = live & (centre[:, 2] < tip)
@@ -204,6 +202,14 @@ def wall_states(run: Path, mesh: str = "target", below: float = 15e-3,
         top = np.flatnonzero(near)[np.argsort(-p[near])[:count]]
         out.append((t, gap, [(float(p[k]), float(q[k]), float(damage[k])) for k in top]))
     return out
+
+
+def concrete_parameters(run: Path) -> np.ndarray:
+    """The packed CSCM parameters of the run's concrete (its resolved deck's
+    material, overrides such as ``theta`` included)."""
+    material = next(mat for mat in resolved_deck(run)["material"] if mat["name"] == "concrete")
+    return cscm.pack_cscm({k: v for k, v in material.items()
+                           if k not in ("name", "model", "erosion")})
 
 
 def main(argv=None) -> int:
@@ -237,11 +243,14 @@ def main(argv=None) -> int:
     print("|---|---|---|---|" + "---|" * len(edges))
     print(f"| force law | - | {X_law * 1e3:.1f} | {S:.1f} | "
           + " | ".join(f"{b / 1e6:.0f}" for b in law) + " |")
-    curves = []
+    runs = []
     for given in args.runs:
         path, _, label = given.partition("=")
         run = Path(path)
-        label = label or (run.name if run.name != "forrestal1994_ogive" else run.parent.name)
+        runs.append((run, label or (run.name if run.name != "forrestal1994_ogive"
+                                    else run.parent.name)))
+    curves = []
+    for run, label in runs:
         t, depth, v, how = trajectory(run)
         deepest = measured_depth(run)
         sig = banded_resistance(depth, v, s["m"], area, edges)
@@ -252,31 +261,26 @@ def main(argv=None) -> int:
         print("| run | time [us] | projectile velocity [m/s] | carried: nodes [g] | "
               "debris particles [g] |")
         print("|---|---|---|---|---|")
-        for given in args.runs:
-            path, _, label = given.partition("=")
-            for t, V, nodes, debris in carried_mass(Path(path)):
-                print(f"| {label or path} | {t * 1e6:.0f} | {V:.1f} | {nodes * 1e3:.1f} | "
+        for run, label in runs:
+            for t, V, nodes, debris in carried_mass(run):
+                print(f"| {label} | {t * 1e6:.0f} | {V:.1f} | {nodes * 1e3:.1f} | "
                       f"{debris * 1e3:.1f} |")
     if args.wall:
-        from sphdyn.materials.cscm.defaults import default_parameters
-
-        c = default_parameters(s["fc"], 0.016)  # the case's 16 mm aggregate
-        slope = math.sqrt(3.0) * 3.0 * c["theta"]
-        print(f"MAT_159's TXC surface, default fits: q = sqrt(3) Ff(3p), its slope q/p at high "
-              f"pressure sqrt(3) 3 theta = {slope:.2f}. The elements' stresses are damaged, "
-              "(1 - d) times the undamaged ones, so their q/p is the one to compare.")
+        print("MAT_159's TXC surface of each run's concrete: q = sqrt(3) Ff(3p), its slope q/p at "
+              "high pressure sqrt(3) 3 theta. The elements' stresses are damaged, (1 - d) times "
+              "the undamaged ones, so their q/p is the one to compare.")
         print("| run | time [us] | debris ahead [mm] | p [MPa] | von Mises q [MPa] | q/p | "
-              "damage | MAT_159's TXC q at that p [MPa] |")
-        print("|---|---|---|---|---|---|---|---|")
-        for given in args.runs:
-            path, _, label = given.partition("=")
-            for t, gap, states in wall_states(Path(path)):
+              "damage | TXC q at that p [MPa] | TXC slope |")
+        print("|---|---|---|---|---|---|---|---|---|")
+        for run, label in runs:
+            c = concrete_parameters(run)
+            slope = math.sqrt(3.0) * 3.0 * c[P_THETA]
+            for t, gap, states in wall_states(run):
                 for p, q, d in states:
-                    J1 = 3.0 * p  # Ff(J1) = alpha - lamda exp(-beta J1) + theta J1, vs sqrt(J2')
-                    ff = c["alpha"] - c["lamda"] * math.exp(-c["beta"] * J1) + c["theta"] * J1
-                    print(f"| {label or path} | {t * 1e6:.0f} | {gap * 1e3:.1f} | {p / 1e6:.0f} | "
-                          f"{q / 1e6:.0f} | {q / p:.2f} | {d:.2f} | "
-                          f"{math.sqrt(3.0) * ff / 1e6:.0f} |")
+                    txc = math.sqrt(3.0) * cscm.shear_surface(3.0 * p, c)
+                    print(f"| {label} | {t * 1e6:.0f} | {gap * 1e3:.1f} | {p / 1e6:.0f} | "
+                          f"{q / 1e6:.0f} | {q / p:.2f} | {d:.2f} | {txc / 1e6:.0f} | "
+                          f"{slope:.2f} |")
     if args.figure:
         import matplotlib
         matplotlib.use("Agg")
