@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numba
 
-from sphdyn.assembly import build_stepper
+from sphdyn.build import build_stepper
 from sphdyn.deck import load_deck
 
 ROOT = Path(__file__).resolve().parents[1]

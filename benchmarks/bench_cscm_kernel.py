@@ -20,7 +20,7 @@ import time
 
 import numba
 
-from sphdyn.assembly import build_stepper
+from sphdyn.build import build_stepper
 from sphdyn.deck import load_deck
 
 

@@ -23,7 +23,7 @@ import time
 import numba
 import numpy as np
 
-from sphdyn.assembly import build_stepper
+from sphdyn.build import build_stepper
 from sphdyn.bench import case_deck
 from sphdyn.deck import load_deck
 from sphdyn.parts.sph.passes import GRADIENT_CHUNKS, GRADIENT_ROWS, velocity_gradient

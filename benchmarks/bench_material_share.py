@@ -33,7 +33,7 @@ import time
 import numba
 
 from sphdyn.deck import load_deck
-from sphdyn.assembly import build_stepper
+from sphdyn.build import build_stepper
 from sphdyn.model import build_model
 
 

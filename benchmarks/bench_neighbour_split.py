@@ -67,7 +67,7 @@ def _deck_state(deck, start, cache):
     if cache and os.path.exists(cache):
         d = np.load(cache)
         return d["x"], d["h"], float(d["rf"]), float(d["skin"]), d["act"]
-    from sphdyn.assembly import build_stepper
+    from sphdyn.build import build_stepper
     from sphdyn.deck import load_deck
     st = build_stepper(load_deck(deck, ["output.vtk=false"]))
     for _ in range(start):

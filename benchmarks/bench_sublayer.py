@@ -21,7 +21,7 @@ from pathlib import Path
 import numba
 from interleaved import best_step_times
 
-from sphdyn.assembly import build_stepper
+from sphdyn.build import build_stepper
 from sphdyn.deck import loads_deck
 
 DECK = Path(__file__).resolve().parents[1] / "examples" / "pullout_sublayer.toml"

@@ -31,7 +31,7 @@ from collections import defaultdict
 import numba
 from numba.core.registry import CPUDispatcher
 
-from sphdyn.assembly import build_stepper
+from sphdyn.build import build_stepper
 from sphdyn.bench import hex3d_stepper
 from sphdyn.deck import load_deck
 

@@ -124,7 +124,7 @@ RAM = 3  # the ram's material index in the decks (ram_steel)
 def masses(out: Path) -> tuple[float, float]:
     """The mass of a run's whole model (particles and mesh nodes) and of its
     ram [kg], from its resolved deck."""
-    from sphdyn.assembly import build_stepper
+    from sphdyn.build import build_stepper
     from sphdyn.deck import load_deck
 
     stepper = build_stepper(load_deck(out / "deck.resolved.toml"))

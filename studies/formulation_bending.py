@@ -46,7 +46,7 @@ from string import Template
 
 import numpy as np
 
-from sphdyn.assembly import build_stepper
+from sphdyn.build import build_stepper
 from sphdyn.deck import loads_deck
 from sphdyn.model import build_model
 

@@ -31,7 +31,7 @@ COMPONENTS = ("xx", "yy", "zz", "xy", "yz", "xz")
 
 
 def main(argv: list[str]) -> None:
-    from sphdyn.assembly import build_stepper
+    from sphdyn.build import build_stepper
     from sphdyn.deck import load_deck
 
     t_end = float(argv[0]) if argv and not argv[0].startswith("--") else 0.004

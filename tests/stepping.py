@@ -1,6 +1,6 @@
 """Test helpers around the stepper: build one from a deck, step with the record."""
 
-from sphdyn.assembly import build_stepper  # noqa: F401  (re-exported for the tests)
+from sphdyn.build import build_stepper  # noqa: F401  (re-exported for the tests)
 
 
 class _Grab:

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sphdyn.assembly import build_stepper
+from sphdyn.build import build_stepper
 from sphdyn.deck import load_deck
 
 ROOT = Path(__file__).resolve().parents[1]

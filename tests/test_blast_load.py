@@ -28,7 +28,7 @@ import math
 import numpy as np
 import pytest
 
-from sphdyn.assembly import build_stepper
+from sphdyn.build import build_stepper
 from sphdyn.deck import DeckError, loads_deck
 from sphdyn.interactions.blast import BlastLoad, face_geometry
 from sphdyn.kingery_bulmash import (SURFACE, blast_parameters, decay_coefficient,

@@ -17,7 +17,7 @@ import pytest
 
 from fem_models import block
 from sphdyn.deck import DeckError, loads_deck
-from sphdyn.assembly import build_stepper
+from sphdyn.build import build_stepper
 from sphdyn.geometry.shapes import shape_functions
 from sphdyn.interactions.embedded import locate
 from sphdyn.io import read_history_csv

@@ -400,7 +400,7 @@ def test_deck_run_lights_the_charge_and_books_the_chemical_energy():
     # point, particles burning from the left, the history's E_chemical and
     # a closed energy balance (within 2 % of E_chemical so early: the
     # first-order front error of test_chemical_energy_released...)
-    from sphdyn.assembly import build_stepper
+    from sphdyn.build import build_stepper
     from sphdyn.model import build_model
     deck = load_deck_dict(_deck())
     model = build_model(deck)
@@ -422,7 +422,7 @@ def test_deck_run_lights_the_charge_and_books_the_chemical_energy():
 
 
 def test_material_viscosity_and_time_step_factor_reach_the_particles():
-    from sphdyn.assembly import build_stepper
+    from sphdyn.build import build_stepper
     d = _deck(extra={"sph": {"viscosity": {"alpha": 0.5, "beta": 1.0}}})
     d["material"][0]["viscosity"] = {"beta": 3.0}
     d["material"][0]["time_step_factor"] = 0.5
@@ -534,7 +534,7 @@ def test_particles_leaving_the_domain_are_removed_and_booked():
     # initial energy (the benz 1D gas alone drifts ~1e-4)
     import copy
 
-    from sphdyn.assembly import build_stepper
+    from sphdyn.build import build_stepper
     deck = load_deck_dict(_expanding_gas_deck())
     st = build_stepper(deck)
     e0 = st.record()["E_total"]
@@ -573,7 +573,7 @@ def test_particles_leaving_the_domain_are_removed_and_booked():
 
 
 def test_particles_leaving_the_domain_stop_the_run_by_default():
-    from sphdyn.assembly import build_stepper
+    from sphdyn.build import build_stepper
     from sphdyn.watchers.guards import SimulationFailed, check_particles
     st = build_stepper(load_deck_dict(_expanding_gas_deck("stop")))
     p = st.parts[0].p

@@ -25,7 +25,7 @@ part is not).
 
 from __future__ import annotations
 
-from sphdyn.assembly import build_stepper
+from sphdyn.build import build_stepper
 from sphdyn.deck import loads_deck
 
 GFT = 79.17047464637365  # J/m^2, the CSCM fit for f'c 40 MPa, 16 mm aggregate

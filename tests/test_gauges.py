@@ -8,7 +8,7 @@ gauge at its own rate; bad gauges are refused before anything runs.
 import numpy as np
 import pytest
 
-from sphdyn.assembly import build_stepper
+from sphdyn.build import build_stepper
 from sphdyn.deck import DeckError, loads_deck
 from sphdyn.watchers.gauges import build_gauges
 from sphdyn.io.history import read_history_csv

@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from sphdyn.assembly import build_stepper
+from sphdyn.build import build_stepper
 from sphdyn.deck import DeckError, loads_deck
 from sphdyn.interactions import Gravity
 from sphdyn.interactions.gravity import add_gravity, gravity_work

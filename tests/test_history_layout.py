@@ -10,7 +10,7 @@ beside J2 bars.
 import numpy as np
 import pytest
 
-from sphdyn.assembly import build_stepper
+from sphdyn.build import build_stepper
 from sphdyn.deck import loads_deck
 from sphdyn.fields import history_column
 from sphdyn.materials import MaterialModel, get_model, history_layout

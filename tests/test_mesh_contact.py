@@ -9,7 +9,7 @@ keeping its momentum to round-off and the block taking the impulse.
 import numpy as np
 import pytest
 
-from sphdyn.assembly import build_stepper
+from sphdyn.build import build_stepper
 from sphdyn.deck import DeckError, loads_deck
 from sphdyn.interactions.penalty_coupling import PenaltyCoupling
 

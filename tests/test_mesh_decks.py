@@ -35,7 +35,7 @@ import numpy as np
 import pytest
 
 from decks import ROLLERS
-from sphdyn.assembly import build_stepper
+from sphdyn.build import build_stepper
 from sphdyn.cli import main
 from sphdyn.deck import DeckError, loads_deck
 from sphdyn.geometry.mesh import block_mesh

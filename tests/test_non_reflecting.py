@@ -15,7 +15,7 @@ with the absorbed energy booked as external work.
 import numpy as np
 import pytest
 
-from sphdyn.assembly import build_stepper
+from sphdyn.build import build_stepper
 from sphdyn.deck import DeckError, loads_deck
 from sphdyn.interactions.non_reflecting import (boundary_dashpots,
                                                 dashpot_accelerations)

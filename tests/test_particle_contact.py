@@ -88,7 +88,7 @@ def test_overlap_allowance_pushes_only_beyond_it_and_shrinks():
 
 
 def test_particles_born_inside_the_contact_distance_get_no_kick():
-    from sphdyn.assembly import build_stepper
+    from sphdyn.build import build_stepper
     from sphdyn.deck import loads_deck
     from sphdyn.events.inject import InjectParticles
     from sphdyn.interactions.contact import ParticleContact

@@ -27,7 +27,7 @@ import numpy as np
 import pytest
 
 from fem_models import block, material, part
-from sphdyn.assembly import build_stepper
+from sphdyn.build import build_stepper
 from sphdyn.deck import loads_deck
 from sphdyn.geometry.convert import elements_to_particles
 from sphdyn.geometry.mesh import block_mesh

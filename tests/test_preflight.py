@@ -78,7 +78,7 @@ def test_history_width_is_the_built_parts_layout(deck):
     # CSCM concrete beside J2 sublayer particles (igirder_sph) lay their
     # columns side by side: the estimate counts the joined layout, as built
     d = load_deck(EXAMPLES / f"{deck}.toml")
-    from sphdyn.assembly import build_stepper
+    from sphdyn.build import build_stepper
 
     part = build_stepper(d).part("sph")
     assert history_width(d) == part.p.hist.shape[1]

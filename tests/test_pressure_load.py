@@ -12,7 +12,7 @@ did not), and the work of the load closes the energy balance.
 import numpy as np
 import pytest
 
-from sphdyn.assembly import build_stepper
+from sphdyn.build import build_stepper
 from sphdyn.cli import main
 from sphdyn.deck import DeckError, loads_deck
 from sphdyn.geometry.mesh import block_mesh

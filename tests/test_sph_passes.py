@@ -554,7 +554,7 @@ def test_pair_stress_and_viscosity_match_their_formulas(alpha, beta, approach):
 def test_history_counts_particles_held_at_a_density_limit():
     # the part takes each material's (min, max) factors from the deck and the
     # history column density_limited counts the particles at either limit
-    from sphdyn.assembly import build_stepper
+    from sphdyn.build import build_stepper
     from sphdyn.deck import loads_deck
 
     from decks import concrete_disc_2d

@@ -244,7 +244,7 @@ def test_forrestal_non_reflecting_faces_are_the_four_sides_and_the_back():
     """The case (and --faces non_reflecting): the four lateral faces (20 x 24
     element faces each) and the back face (20 x 20) of the quick block on
     dashpots, the impact face free; --faces free takes them all off."""
-    from sphdyn.assembly import build_stepper
+    from sphdyn.build import build_stepper
     from sphdyn.interactions.non_reflecting import NonReflectingBoundary
 
     st = build_stepper(_forrestal_quick_block("non_reflecting"))

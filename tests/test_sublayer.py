@@ -28,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sphdyn.assembly import build_stepper
+from sphdyn.build import build_stepper
 from sphdyn.cli import main
 from sphdyn.deck import DeckError, loads_deck
 from sphdyn.interactions.sublayer import sublayer_masses

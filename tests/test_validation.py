@@ -278,7 +278,7 @@ def test_the_meshed_beams_deck_keeps_the_contact_thickness_at_every_size(quick):
     supports at 2.5 mm (thickness_factor x the element size: 0.5 x 5 mm,
     0.25 x 10 mm), where the supports' top faces stand below the beam (so
     nothing touches at the start) and the rod's tip 2 mm farther up."""
-    from sphdyn.assembly import build_stepper
+    from sphdyn.build import build_stepper
     from sphdyn.deck import load_deck
     from sphdyn.interactions.penalty_coupling import PenaltyCoupling
     from sphdyn.validation.cases import CASES

@@ -166,7 +166,7 @@ def run_bench(case: str, steps: int = 1000, threads: int | None = None,
               particles: int | None = None, warmup: int = 3,
               elements: int | None = None, coarse: bool = False) -> dict:
     """Run ``steps`` time steps of a case and time them (compilation excluded)."""
-    from .assembly import build_stepper
+    from .build import build_stepper
 
     if threads:
         numba.set_num_threads(threads)

@@ -209,7 +209,7 @@ def cmd_check(args) -> int:
     limit, source = memory_limit(deck)
     stepper = None
     if deck.gauge or deck.time.mass_scaling is not None:
-        from .assembly import build_stepper
+        from .build import build_stepper
 
         # gauges are placed on the stepper's parts, as a run places them; the
         # mass scaling is worked out on its started parts (and may be refused)

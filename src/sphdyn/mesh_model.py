@@ -1,6 +1,6 @@
 """Deck -> meshes: the [[mesh]] tables as node coordinates, connectivity and sets.
 
-With :mod:`sphdyn.model` (particles) and :mod:`sphdyn.assembly` (parts and
+With :mod:`sphdyn.model` (particles) and :mod:`sphdyn.build` (parts and
 interactions) the only place that reads the deck's meshes. Every problem is
 found here, before a part is made or a file written, and reported as a
 :class:`~sphdyn.deck.DeckError` line ``mesh[k]...: <what>. Fix: <what>``
@@ -22,6 +22,7 @@ from .geometry.convert import element_centroids, elements_to_particles, hybrid_p
 from .geometry.mesh import (MeshData, block_mesh, check_elements, polyline_mesh, prism_mesh,
                             read_mesh)
 from .interactions.penalty_geometry import exterior_faces, on_nodes
+from .parts.fem import BeamSection
 
 #: Element kind of a solid mesh by dimension.
 SOLID_KIND = {3: "hex8", 2: "quad4"}
@@ -180,6 +181,12 @@ def converted_count(spec, k: int, dim: int) -> int:
     _, _, conv = _convert(spec, mesh, np.zeros(mesh.n_elements, np.int32), where, dim)
     return conv.x.shape[0] + (conv.hybrid.x.shape[0] if conv.hybrid is not None else 0)
 
+
+def section_of(spec) -> BeamSection:
+    """The cross-section of a [mesh.line]'s [mesh.section]."""
+    sec = spec.section
+    return (BeamSection.rectangle(sec.width, sec.height) if sec.shape == "rectangle"
+            else BeamSection.circle(sec.diameter))
 
 def build_meshes(deck) -> list[MeshModel]:
     """Every [[mesh]] of a validated deck, read, checked and converted.

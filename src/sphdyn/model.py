@@ -1,6 +1,6 @@
 """Deck -> model: particles of every body, material groups, sets, walls, guard box.
 
-With :mod:`sphdyn.assembly` (parts, interactions, stepper) this is the only
+With :mod:`sphdyn.build` (parts, interactions, stepper) this is the only
 place that reads the deck and turns deck objects into arrays; the parts and
 interactions below it see settings, arrays and scalars only.
 """
@@ -27,7 +27,7 @@ from .preflight import (check_meshes_in_domain, checked_lattices, history_models
                         support_radius)
 from .materials import MaterialGroup, available_models, get_model, history_layout
 from .materials.uniaxial import UNIAXIAL, uniaxial_params
-from .mesh_model import MeshModel, build_meshes, mesh_node_set, pressure_faces
+from .mesh_model import MeshModel, build_meshes, mesh_node_set, pressure_faces, section_of
 from .watchers.probes import NODE_FIELDS, Probe, node_probe_field, quantity
 from .state import Particles
 
@@ -423,7 +423,6 @@ def _sublayer_particles(deck, mm: MeshModel, b: int, n_hist: int) -> Particles:
     density and volume are the concrete's, set by :func:`_seat_sublayers`),
     h = sph.h_factor times the mean element length (or [mesh.sublayer]
     smoothing_length), body ``b``."""
-    from .mesh_assembly import section_of
     from .interactions.sublayer import sublayer_masses
 
     mat = deck.material[int(mm.mat[0])]
@@ -496,7 +495,7 @@ def _sublayer_groups(deck, meshes, particles: Particles, body_names: list[str],
       density over the steel's): a particle of SPH volume :math:`m_s/\rho_c =
       r A L_n \rho_s/\rho_c` then acts through the kernel as the steel volume
       :math:`r A L_n`, the bar's share ``mass_ratio`` = r, and the elements
-      carry the rest (:func:`sphdyn.mesh_assembly.mesh_part`). The particles'
+      carry the rest (:func:`sphdyn.build.meshes.mesh_part`). The particles'
       wave speed is the steel's, :math:`\sqrt{(\rho_c/\rho_s) M/\rho_c}`.
     * ``"axial"``: as ``"split"``, with the uniaxial bar model
       (:mod:`sphdyn.materials.uniaxial`) on those scaled parameters: the

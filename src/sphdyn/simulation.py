@@ -32,7 +32,7 @@ from .analysis import window_mean_force
 from .io.frames import STOP_FRAME, list_frames
 from .io.plots import (energy_columns, per_depth, plot_gauges, relative_drift, scaled_unit,
                        time_unit)
-from .assembly import build_stepper
+from .build import build_stepper
 from .watchers.gauges import GaugeRecorder, build_gauges
 from .model import Model, build_model
 from .watchers.interrupt import StopRequests
@@ -295,10 +295,9 @@ class Simulation:
             summary.update(neighbours_mean=mean_neighbours(sph.nl),
                            neighbours_max=max_neighbours(sph.nl),
                            neighbour_builds=sph.nl.n_builds)
-        for part in s.parts:
-            if part.kind != "sph":
-                summary.setdefault("meshes", {})[part.name] = {
-                    "nodes": part.kin.n, "elements": _element_count(part)}
+        for part in s.parts:  # the parts that report themselves (the meshes)
+            if hasattr(part, "summary"):
+                summary.setdefault("meshes", {})[part.name] = part.summary()
         if s.mass_scaling is not None:
             summary["mass_scaling"] = s.mass_scaling.summary()
         if self.energy_guard is not None and self.energy_guard.warning is not None:
@@ -387,35 +386,11 @@ def summary_text(summary: dict, outdir) -> str:
     return "\n".join(lines)
 
 
-def _elements(part):
-    """The element table of a mesh part (solid: ``el``, line: ``elements``)."""
-    return getattr(part, "el", None) or part.elements
-
-
-def _element_count(part) -> int:
-    return int(_elements(part).n)
-
-
 def mesh_frames(parts) -> dict[str, MeshFrame]:
-    """One :class:`~sphdyn.io.MeshFrame` per mesh part: nodes at their current
-    positions with ``displacement``, ``velocity`` and ``mass`` [m, m/s, kg;
-    the lumped nodal mass, kg/m in 2D], and every cell
-    field of the part (``stress``, ``von_mises``, ``damage``, plastic strain
-    and the other history columns, ``hourglass_energy``; beams: forces);
-    eroded elements are left out."""
-    out = {}
-    for part in parts:
-        if part.kind == "sph":
-            continue
-        q, el = part.kin, _elements(part)
-        kind = getattr(part, "element_kind", "line2")
-        live = el.active == 1  # eroded elements leave the picture
-        out[part.name] = MeshFrame(
-            points=q.x.copy(), cells=el.conn[live], kind=kind,
-            point_data={"displacement": q.x - q.x0, "velocity": q.v.copy(),
-                        "mass": q.m.copy()},
-            cell_data={name: np.asarray(fn())[live] for name, fn in part.fields().items()})
-    return out
+    """Each part's own picture in a frame, by part name: the parts that draw one
+    (``frame()``, :func:`sphdyn.parts.fem.output.mesh_frame`); the particles
+    are written as the frame's points instead."""
+    return {part.name: part.frame() for part in parts if hasattr(part, "frame")}
 
 
 def _output_failure(exc: OSError, s) -> str:

@@ -165,25 +165,38 @@ class DeckSections(Section):
 
 
 def deck_model() -> type[DeckSections]:
-    """The Deck model for the material models registered now.
+    """The Deck model for the material models and builders registered now.
 
-    Asking loads the models of other packages (entry points) the first
-    time; the model is built once per set of material tables.
+    Asking loads the models and builders of other packages (entry points)
+    the first time; the model is built once per set of material tables and
+    builders' own tables (:func:`sphdyn.build.registry.extension_tables`).
     """
+    from ..build.registry import extension_tables
     from ..materials.registry import material_schemas
 
-    return _deck_for(material_schemas())
+    return _deck_for(material_schemas(), extension_tables())
 
 
 @functools.cache
-def _deck_for(materials: tuple[type[MaterialSection], ...]) -> type[DeckSections]:
-    """The Deck model whose ``material`` entries are one of ``materials``."""
+def _deck_for(materials: tuple[type[MaterialSection], ...],
+              extensions: tuple = ()) -> type[DeckSections]:
+    """The Deck model whose ``material`` entries are one of ``materials``, with
+    a table per ``(name, schema, many)`` of ``extensions``: ``[[name]]`` (a
+    tuple, default empty) if ``many``, else ``[name]`` (default None).
+    ``ValueError`` if an extension's name is one of the deck's own tables."""
     choice = Annotated[Union[materials], Field(discriminator="model")]
     entries = Annotated[tuple[choice, ...], BeforeValidator(NonEmpty("material"))]
     info = DeckSections.model_fields["material"]
+    tables = {}
+    for name, schema, many in extensions:
+        if name in DeckSections.model_fields:
+            raise ValueError(f"a builder's table [{name}] would replace the deck's own")
+        doc = (schema.__doc__ or name).strip().split("\n")[0]
+        tables[name] = ((tuple[schema, ...], Field((), description=doc)) if many
+                        else (schema | None, Field(None, description=doc)))
     return create_model("Deck", __base__=DeckSections, __module__=__name__,
                         __doc__=DeckSections.__doc__.split("\n")[0],
-                        material=(entries, Field(description=info.description)))
+                        material=(entries, Field(description=info.description)), **tables)
 
 
 def __getattr__(name: str):

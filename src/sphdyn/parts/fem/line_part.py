@@ -78,6 +78,7 @@ from .beam import (N_RES, RES_L, RES_MY_A, RES_MY_B, RES_MZ_A, RES_MZ_B, RES_N, 
                    truss_element_steps, truss_forces, truss_gradient, truss_kinematics,
                    truss_stable_dt)
 from .gather import gather_loads, node_element_list
+from .output import mesh_frame, mesh_summary
 
 
 @dataclass(frozen=True)
@@ -368,6 +369,14 @@ class LinePart:
         else:
             out[f"{p}_lateral_unconverged"] = float(self.lateral_unconverged)
         return out
+
+    def frame(self):
+        """The part's picture in an output frame (:func:`.output.mesh_frame`)."""
+        return mesh_frame(self, self.elements, "line2")
+
+    def summary(self) -> dict:
+        """The part's entry in the run's summary (:func:`.output.mesh_summary`)."""
+        return mesh_summary(self, self.elements)
 
     def fields(self) -> dict:
         """Cell fields: ``axial_force`` (E,) [N], ``axial_stress`` (E,) [Pa]

@@ -29,6 +29,7 @@ from ...fields import von_mises
 from ...state import BC_FIXED, STATE, Elements, MaterialPoints, Nodes
 from ..base import register_part
 from .gather import gather_loads, node_element_list
+from .output import mesh_frame, mesh_summary
 from .hex_lanes import hex_forces, hex_strain_rate, lane_scratch
 from .solid import (DT_BLOCKS, HG_STIFFNESS, HG_VISCOUS, block_scratch, char_length,
                     element_step, element_volumes, hourglass_bound, hourglass_overlap,
@@ -452,6 +453,14 @@ class SolidPart:
         for k, name in enumerate(self.pts.hist_names):
             out[name] = (lambda k=k: self.element_mean(self.pts.hist[:, k]))
         return out
+
+    def frame(self):
+        """The part's picture in an output frame (:func:`.output.mesh_frame`)."""
+        return mesh_frame(self, self.el, self.element_kind)
+
+    def summary(self) -> dict:
+        """The part's entry in the run's summary (:func:`.output.mesh_summary`)."""
+        return mesh_summary(self, self.el)
 
     # --------------------------------------------------------- checkpoint
     def state(self) -> tuple[dict, dict[str, np.ndarray]]:

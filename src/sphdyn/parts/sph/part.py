@@ -56,7 +56,7 @@ VISCOUS_SIGNAL_WEIGHT = 1.2
 
 @dataclass(frozen=True)
 class SPHSettings:
-    """The SPH scheme's settings, resolved from the deck by :mod:`sphdyn.assembly`
+    """The SPH scheme's settings, resolved from the deck by :mod:`sphdyn.build`
     (the defaults are the deck's, written there once).
 
     Per-body tuples are indexed by ``particles.body``.
