@@ -34,7 +34,7 @@ import numba
 
 from sphdyn.deck import load_deck
 from sphdyn.build import build_stepper
-from sphdyn.model import build_model
+from sphdyn.build.model import build_model
 
 
 class TimedModel:

@@ -77,7 +77,7 @@ def _frame(path: Path) -> dict:
 def face_damage(out: Path) -> tuple[np.ndarray, np.ndarray, float]:
     """The damage of the concrete's top and bottom particle layers at the last
     frame as (ny, nx) images, and the lattice spacing [m]."""
-    from sphdyn.analysis import projected_max
+    from sphdyn.analysis.fragments import projected_max
 
     fr = _frame(sorted((out / "frames").glob("frame_*.h5"))[-1])
     concrete = fr["material"] == CONCRETE

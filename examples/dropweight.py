@@ -87,7 +87,7 @@ def side_damage(out: Path, face: bool) -> tuple[np.ndarray, float]:
     """(nz, nx) damage of the concrete seen from the side at the last frame:
     of the side face's layer of particles (``face``), or the largest across
     the width; and the lattice spacing [m]."""
-    from sphdyn.analysis import side_view_max
+    from sphdyn.analysis.fragments import side_view_max
 
     x0, d, layer, dx = concrete_damage(out)
     if face:

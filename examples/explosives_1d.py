@@ -6,7 +6,7 @@ Runs examples/sod_shock_tube.toml and examples/gurney_1d.toml (or reuses
 out/sod_shock_tube and out/gurney_1d with --reuse) and writes
 
 * docs/figures/sod_shock_tube.png: density, velocity and pressure at
-  t = 0.2 against the exact solution (:mod:`sphdyn.riemann`);
+  t = 0.2 against the exact solution (:mod:`sphdyn.analysis.riemann`);
 * docs/figures/gurney_1d.png: the plate's mean velocity over time against
   Gurney's terminal velocity;
 * a table (stdout, markdown): the Sod L1 density error and shock position,
@@ -49,7 +49,7 @@ def sod_result(out: Path) -> dict:
     """The last frame against the exact solution: positions, fields, L1 error of
     the density over [-0.5, 0.5] and the shock position (half way up its jump)."""
     from sphdyn.io import list_frames, read_frame
-    from sphdyn.riemann import sample, shock_speed
+    from sphdyn.analysis.riemann import sample, shock_speed
 
     t, _, f, _ = read_frame(list_frames(out)[-1])
     o = np.argsort(f["position"][:, 0])
@@ -85,7 +85,7 @@ def main() -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from sphdyn.riemann import sample
+    from sphdyn.analysis.riemann import sample
 
     sod = sod_result(run("sod_shock_tube", a.reuse))
     fig, axes = plt.subplots(1, 3, figsize=(13, 3.8), layout="constrained")

@@ -174,7 +174,7 @@ def side_damage(out: Path, model: str) -> np.ndarray:
     """(nz, nx) largest damage across the width at each point of the side, last frame."""
     import h5py
 
-    from sphdyn.analysis import side_view_max
+    from sphdyn.analysis.fragments import side_view_max
     from sphdyn.io import read_frame_meshes
 
     last = sorted((out / "frames").glob("frame_*.h5"))[-1]

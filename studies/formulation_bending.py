@@ -48,7 +48,7 @@ import numpy as np
 
 from sphdyn.build import build_stepper
 from sphdyn.deck import loads_deck
-from sphdyn.model import build_model
+from sphdyn.build.model import build_model
 
 HERE = Path(__file__).resolve().parent
 FIGURES = HERE.parent / "docs" / "figures"

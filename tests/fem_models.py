@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-from sphdyn.geometry.mesh import block_mesh
+from sphdyn.geometry.mesh_blocks import block_mesh
 from sphdyn.materials import get_model
 from sphdyn.parts.fem import SolidSettings, solid_part
 
 
 def block(lo, hi, div, dim=3):
-    """Structured block (:func:`sphdyn.geometry.mesh.block_mesh`): points (N, 3), cells."""
+    """Structured block (:func:`sphdyn.geometry.mesh_blocks.block_mesh`): points (N, 3), cells."""
     mesh = block_mesh(lo, hi, div[:dim], dim)
     return mesh.points.copy(), mesh.cells.copy()
 

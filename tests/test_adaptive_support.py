@@ -7,7 +7,7 @@ from sphdyn import kernels
 from sphdyn.deck import loads_deck
 from sphdyn.geometry import box_lattice
 from sphdyn.geometry.spacing import adapted_smoothing_lengths, local_spacing
-from sphdyn.model import build_model
+from sphdyn.build.model import build_model
 from sphdyn.neighbours import build_neighbours
 from decks import STEEL
 

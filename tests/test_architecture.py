@@ -7,13 +7,13 @@ import pytest
 
 from sphdyn.deck import loads_deck
 from sphdyn.events import InjectParticles
-from sphdyn.interactions import InteractionBase
 from sphdyn.io import read_checkpoint, read_frame, read_history_csv
 from sphdyn.simulation import Simulation
 from sphdyn.state import STATE, WORK, ArrayStore, Kinematics
 from sphdyn.stepper import Stepper
 from decks import SMALL_DISC
 from stepping import build_stepper
+from toys import PointMasses, UniformField
 
 
 T_INJECT = 1.0e-3
@@ -143,66 +143,6 @@ def test_restart_across_the_injection_is_bitwise(tmp_path, stop_after):
 
 
 # ------------------------------------------- a part and an interaction from outside
-class PointMasses:
-    """A toy part: free point masses, no internal forces (docs/architecture.md)."""
-
-    name = "balls"
-    kind = "points"
-
-    def __init__(self, x, v, m):
-        self.kin = Kinematics(len(x), 3)
-        self.kin.x, self.kin.v, self.kin.m = x, v, m
-
-    def stable_dt(self):
-        return np.inf, 0
-
-    def start(self, dt):
-        self.kin.a[:] = 0.0
-
-    def drift(self, dt):
-        self.kin.x += dt * self.kin.v
-
-    def update_geometry(self, t, dt):
-        pass
-
-    def internal_forces(self, t, dt):
-        self.kin.a[:] = 0.0
-
-    def energies(self):
-        return 0.0, 0.0
-
-    def columns(self):
-        return {}
-
-    def fields(self):
-        return {}
-
-    def state(self):
-        return {}, {}
-
-    def restore(self, scalars, arrays):
-        pass
-
-
-class UniformField(InteractionBase):
-    """A toy interaction: a uniform acceleration ``g`` on every item of a part."""
-
-    name = "field"
-
-    def __init__(self, part, g):
-        self.part, self.g = part, np.asarray(g, float)
-        self.kicks = 0
-
-    def forces(self, t, dt, a_out):
-        a_out += self.g
-
-    def after_kick(self, dt_kick):
-        self.kicks += 1
-
-    def columns(self, t):
-        return {"kicks": float(self.kicks)}
-
-
 def test_a_part_and_an_interaction_from_outside_the_package():
     # Point masses under a uniform acceleration g: leapfrog is exact for a
     # constant acceleration at a constant step, x(t) = x0 + v0 t + g t^2 / 2

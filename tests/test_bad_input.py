@@ -19,7 +19,7 @@ import pytest
 from decks import SMALL_DISC
 from sphdyn.cli import _threads, build_parser, main
 from sphdyn.deck import DeckError, loads_deck
-from sphdyn.model import build_model
+from sphdyn.build.model import build_model
 
 EXAMPLES = Path(__file__).parent.parent / "examples"
 

@@ -1,6 +1,6 @@
 """Empirical air-blast loads: the Kingery-Bulmash fits and their load on faces.
 
-The fits (sphdyn.kingery_bulmash, ARL-TR-1310's imperial coefficients
+The fits (sphdyn.interactions.kingery_bulmash, ARL-TR-1310's imperial coefficients
 converted to SI) are checked against three independent things:
 
 * Swisdak's simplified fits of the same surface-burst data (Swisdak 1994,
@@ -31,7 +31,7 @@ import pytest
 from sphdyn.build import build_stepper
 from sphdyn.deck import DeckError, loads_deck
 from sphdyn.interactions.blast import BlastLoad, face_geometry
-from sphdyn.kingery_bulmash import (SURFACE, blast_parameters, decay_coefficient,
+from sphdyn.interactions.kingery_bulmash import (SURFACE, blast_parameters, decay_coefficient,
                                     face_pressure, friedlander)
 
 from decks import STEEL

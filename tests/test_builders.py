@@ -9,17 +9,16 @@ masses, ``[[balls]]``) and an interaction (a uniform acceleration on a part,
 ``[field]``), each with its own deck table, and a deck uses both at once.
 """
 
-import sys
-import textwrap
-
 import numpy as np
 import pytest
 
 from sphdyn.build import Builder, Built, builders, register, registry
 from sphdyn.deck import DeckError, deck_model, loads_deck
+from sphdyn.parts import base
 from sphdyn.simulation import Simulation
 from decks import SMALL_DISC
 from stepping import build_stepper
+from toys import install_toy
 
 
 def test_built_in_builders_run_in_the_order_the_forces_need():
@@ -51,9 +50,8 @@ from pydantic import Field
 
 from sphdyn.build import Builder, Built
 from sphdyn.deck.values import Section
-from sphdyn.interactions import InteractionBase
 from sphdyn.parts import register_part
-from sphdyn.state import Kinematics
+from toys import PointMasses, UniformField
 
 
 class BallsTable(Section):
@@ -73,63 +71,16 @@ class FieldTable(Section):
 
 
 @register_part("points")
-class PointMasses:
-    def __init__(self, name, x, v, m):
-        self.name = name
-        self.kin = Kinematics(len(x), 3)
-        self.kin.x, self.kin.v, self.kin.m = x, v, m
-
-    def stable_dt(self):
-        return np.inf, 0
-
-    def start(self, dt):
-        self.kin.a[:] = 0.0
-
-    def drift(self, dt):
-        self.kin.x += dt * self.kin.v
-
-    def update_geometry(self, t, dt):
-        pass
-
-    def internal_forces(self, t, dt):
-        self.kin.a[:] = 0.0
-
-    def energies(self):
-        return 0.0, 0.0
-
-    def columns(self):
-        return {}
-
-    def fields(self):
-        return {}
-
-    def state(self):
-        return {}, {"x": self.kin.x, "v": self.kin.v}
-
-    def restore(self, scalars, arrays):
-        self.kin.x[:] = arrays["x"]
-        self.kin.v[:] = arrays["v"]
-
-
-class UniformField(InteractionBase):
-    name = "field"
-
-    def __init__(self, part, g):
-        self.part, self.g = part, np.asarray(g, float)
-
-    def forces(self, t, dt, a_out):
-        a_out += self.g
-
-    def columns(self, t):
-        return {}
+class Balls(PointMasses):
+    """The tests' point masses as a registered part kind."""
 
 
 def build_balls(ctx):
     parts = []
     for b in ctx.deck.balls:
         x = np.array(b.positions, dtype=float)
-        parts.append(PointMasses(b.name, x, np.tile(np.array(b.velocity, float), (len(x), 1)),
-                                 np.full(len(x), b.mass)))
+        parts.append(Balls(x, np.tile(np.array(b.velocity, float), (len(x), 1)),
+                           np.full(len(x), b.mass), name=b.name))
     return Built(parts=parts)
 
 
@@ -161,23 +112,14 @@ g = [0.0, -9.81, 0.0]
 
 @pytest.fixture
 def toy_installed(tmp_path, monkeypatch):
-    """The toy package on sys.path and a registry that loads entry points again."""
-    site = tmp_path / "site"
-    info = site / "toy_builders-1.0.dist-info"
-    info.mkdir(parents=True)
-    (site / "toy_builders.py").write_text(textwrap.dedent(TOY))
-    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: toy-builders\n"
-                                   "Version: 1.0\n")
-    (info / "entry_points.txt").write_text("[sphdyn.builders]\n"
-                                           "balls = toy_builders:BALLS\n"
-                                           "field = toy_builders:FIELD\n")
-    monkeypatch.syspath_prepend(str(site))
+    """The toy package on sys.path and registries that load entry points again."""
+    forget = install_toy(tmp_path, monkeypatch, "toy_builders", TOY, "sphdyn.builders",
+                         {"balls": "toy_builders:BALLS", "field": "toy_builders:FIELD"})
     monkeypatch.setattr(registry, "REGISTRY", dict(registry.REGISTRY))
     monkeypatch.setattr(registry, "entry_points_loaded", False)
-    from sphdyn.parts import base
     monkeypatch.setattr(base, "PART_KINDS", dict(base.PART_KINDS))
     yield
-    sys.modules.pop("toy_builders", None)
+    forget()
 
 
 def _deck(extra=""):

@@ -1,4 +1,4 @@
-"""Compression between platens (sphdyn.compression) and the mesostructure UCS study."""
+"""Compression between platens (sphdyn.analysis.compression) and the mesostructure UCS study."""
 
 import json
 import shutil
@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 from sphdyn.cli import main
-from sphdyn.compression import compression_curve, ensemble_report
+from sphdyn.analysis.compression import compression_curve, ensemble_report
 from sphdyn.deck import loads_deck
 from sphdyn.io import read_history_csv
-from sphdyn.model import build_model
+from sphdyn.build.model import build_model
 from sphdyn.simulation import Simulation
 
 EXAMPLES = Path(__file__).parent.parent / "examples"

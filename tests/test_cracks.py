@@ -6,7 +6,7 @@ import pytest
 from sphdyn.deck import loads_deck
 from sphdyn.geometry import lattice_from_shape
 from sphdyn.heterogeneity.cracks import crack_mask, crack_particles, distance_to_polyline
-from sphdyn.model import build_model
+from sphdyn.build.model import build_model
 from sphdyn.simulation import Simulation
 
 from decks import concrete_disc_2d

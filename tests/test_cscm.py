@@ -785,7 +785,7 @@ def test_deck_keys_reach_the_parameters():
 
     from sphdyn.deck import DeckError, loads_deck
     from sphdyn.materials import cscm as mod
-    from sphdyn.model import build_model
+    from sphdyn.build.model import build_model
 
     base = (Path(__file__).parent.parent / "examples/disc_impact.toml").read_text()
     # (the deck sets rate_thresholds = true, marked calibrated; the default is false)

@@ -21,7 +21,7 @@ import numpy as np
 
 from sphdyn.deck import loads_deck
 from sphdyn.materials import cscm
-from sphdyn.model import build_model
+from sphdyn.build.model import build_model
 from stepping import build_stepper
 
 ERODE_STRAIN = 0.01

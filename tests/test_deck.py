@@ -341,7 +341,7 @@ def test_resolved_deck_with_mesh_defaults_builds(tmp_path):
     """The defaults whose meaning depends on the set's kind (a mesh probe's
     quantities, the non-reflecting boundary's directions) mean the same once
     written out: the resolved deck builds the same model."""
-    from sphdyn.model import build_model
+    from sphdyn.build.model import build_model
 
     deck = loads_deck(RESOLVED_EXTRAS)
     dump_resolved(deck, tmp_path / "r.toml")

@@ -24,7 +24,7 @@ def _deck(geometry=None, **extra):
 
 
 def test_one_component_vectors_and_a_segment_of_particles():
-    from sphdyn.model import build_model
+    from sphdyn.build.model import build_model
     deck = _load(_deck(geometry={"shape": "box", "lo": ["0 mm"], "hi": ["1 m"]}))
     assert deck.body[0].geometry.lo == (0.0, 0.0, 0.0)
     p = build_model(deck).particles

@@ -582,26 +582,6 @@ def _warped_column(others=()):
     return solid, sph, cp, top
 
 
-def test_an_old_checkpoints_born_particles_keep_their_allowance():
-    """A checkpoint written before 2026-11-27 kept a ``fresh`` flag per particle
-    (born inside the contact thickness: its penetration allowed) and no
-    switch-of-face state; restored, a fresh particle is one that faced nothing
-    known (last_face -2, d_last -inf: all its penetration allowed); one not
-    fresh is as a particle present from the start (last_face -1: no
-    allowance, as the old code had it)."""
-    solid, sph, cp = _cube_and_particle([0.005, 0.005, 0.008], 2.4e-3, 1e-6, 2e-3)
-    scalars, arrays = cp.state()
-    old = {k: v.copy() for k, v in arrays.items() if k not in ("last_face", "d_last")}
-    old["fresh"] = np.ones(sph.p.n, bool)
-    cp2 = PenaltyCoupling("c", sph, solid, alpha=0.1)
-    cp2.restore(scalars, old)
-    assert np.all(cp2.last_face == -2) and np.all(np.isneginf(cp2.d_last))
-    old["fresh"][:] = False
-    cp3 = PenaltyCoupling("c", sph, solid, alpha=0.1)
-    cp3.restore(scalars, old)
-    assert np.all(cp3.last_face == -1)
-
-
 def test_a_restore_leaves_the_springs_state_as_the_checkpoint_has_it():
     """A particle born inside a face's contact thickness (last face unknown,
     -2; its depth -inf: all of its penetration is to be allowed at its first

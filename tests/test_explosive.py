@@ -11,13 +11,13 @@ import math
 import numpy as np
 import pytest
 
-from sphdyn.riemann import sample, shock_speed
+from sphdyn.analysis.riemann import sample, shock_speed
 from pathlib import Path
 
 import tomli_w
 
 from sphdyn.deck import DeckError, loads_deck
-from sphdyn.detonation import lighting_times
+from sphdyn.build.detonation import lighting_times
 from sphdyn.kernels import KernelContext
 from sphdyn.materials import MaterialGroup, get_model
 from sphdyn.materials.eos import (cj_state, jwl_hugoniot_pressure, jwl_pressure,
@@ -389,7 +389,7 @@ def test_gas_eos_keys_are_checked():
 
 
 def test_detonation_point_outside_the_charge_is_refused_naming_the_field():
-    from sphdyn.model import build_model
+    from sphdyn.build.model import build_model
     deck = load_deck_dict(_deck(detonation=[{"point": [0.05, 0.005]}]))
     with pytest.raises(DeckError, match=r"detonation\[0\]\.point"):
         build_model(deck)
@@ -401,7 +401,7 @@ def test_deck_run_lights_the_charge_and_books_the_chemical_energy():
     # a closed energy balance (within 2 % of E_chemical so early: the
     # first-order front error of test_chemical_energy_released...)
     from sphdyn.build import build_stepper
-    from sphdyn.model import build_model
+    from sphdyn.build.model import build_model
     deck = load_deck_dict(_deck())
     model = build_model(deck)
     p = model.particles
@@ -619,7 +619,7 @@ def test_blast_slab_coarse_first_100_us(tmp_path):
 def test_a_detonation_point_turns_with_its_tilted_charge():
     # the charge tilted 90 degrees about y: the point given at the upright
     # charge's top centre lights the (now sideways) end first
-    from sphdyn.model import build_model
+    from sphdyn.build.model import build_model
     d = _deck(dim=3, material=None, detonation=[{"point": [0.005, 0.005, 0.0115],
                                                  "rotate_with": "charge"}])
     d["body"][0]["geometry"] = {"shape": "cylinder", "centre": [0.005, 0.005, 0.0],

@@ -413,7 +413,7 @@ def test_gmsh_file_gives_the_same_part_as_the_generated_block(tmp_path):
     places as the generated block's, and 50 steps from the same initial
     velocity field end at the same positions (1e-12 of the size: only the
     summation order differs)."""
-    from sphdyn.geometry.mesh import read_mesh
+    from sphdyn.geometry.mesh_files import read_mesh
     from test_mesh_geometry import HI, LO, gmsh_model, write_msh41
 
     ref, _, nodes, quads, hexes = gmsh_model()

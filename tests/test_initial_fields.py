@@ -5,7 +5,7 @@ import pytest
 
 from sphdyn.deck import DeckError, loads_deck
 from sphdyn.deck.expressions import ExpressionError, evaluate
-from sphdyn.model import build_model
+from sphdyn.build.model import build_model
 from sphdyn.simulation import Simulation
 
 PLATE = """

@@ -203,12 +203,12 @@ def test_history_flush_keeps_the_file_within_its_interval():
 
 def test_ctrl_c_outside_the_step_loop_is_one_line_and_130(tmp_path, monkeypatch, capsys):
     # e.g. while a big model is being built: no traceback, exit 130
-    import sphdyn.model
+    import sphdyn.build.model
 
     def slow_build(deck):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(sphdyn.model, "build_model", slow_build)
+    monkeypatch.setattr(sphdyn.build.model, "build_model", slow_build)
     deck = tmp_path / "d.toml"
     deck.write_text(SMALL_DISC.format(t_end="3 ms", ck=0))
     assert main(["check", str(deck)]) == 130

@@ -10,7 +10,7 @@ from sphdyn.heterogeneity.mass import (body_rng, distribution, draw_factors,
 from sphdyn.heterogeneity.plots import plot_mass_histogram
 from sphdyn.io import read_frame
 from sphdyn.io.frames import list_frames
-from sphdyn.model import build_model
+from sphdyn.build.model import build_model
 from sphdyn.simulation import Simulation
 
 from decks import concrete_disc_2d

@@ -6,8 +6,6 @@ entry point ``toy`` in the group ``sphdyn.materials``. Its model owns its
 deck table (key ``stiffness``), so a deck can use it at once.
 """
 
-import sys
-import textwrap
 
 import numpy as np
 import pytest
@@ -15,6 +13,7 @@ import pytest
 from sphdyn.deck import DeckError, deck_model, loads_deck
 from sphdyn.materials import ELASTIC, MaterialModel, registry
 from sphdyn.simulation import Simulation
+from toys import install_toy
 
 TOY = '''
 """A toy material: linear elasticity from one stiffness, nu = 1/4."""
@@ -71,19 +70,12 @@ fields = ["velocity", "stress"]
 @pytest.fixture
 def toy_installed(tmp_path, monkeypatch):
     """The toy package on sys.path and a registry that loads entry points again."""
-    site = tmp_path / "site"
-    info = site / "toy_material-1.0.dist-info"
-    info.mkdir(parents=True)
-    (site / "toy_material.py").write_text(textwrap.dedent(TOY))
-    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: toy-material\n"
-                                   "Version: 1.0\n")
-    (info / "entry_points.txt").write_text("[sphdyn.materials]\n"
-                                           "toy = toy_material:MODEL\n")
-    monkeypatch.syspath_prepend(str(site))
+    forget = install_toy(tmp_path, monkeypatch, "toy_material", TOY, "sphdyn.materials",
+                         {"toy": "toy_material:MODEL"})
     monkeypatch.setattr(registry, "REGISTRY", dict(registry.REGISTRY))
     monkeypatch.setattr(registry, "entry_points_loaded", False)
     yield
-    sys.modules.pop("toy_material", None)
+    forget()
 
 
 def test_entry_point_registers_the_model_lazily(toy_installed):

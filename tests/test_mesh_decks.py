@@ -38,10 +38,10 @@ from decks import ROLLERS
 from sphdyn.build import build_stepper
 from sphdyn.cli import main
 from sphdyn.deck import DeckError, loads_deck
-from sphdyn.geometry.mesh import block_mesh
+from sphdyn.geometry.mesh_blocks import block_mesh
 from sphdyn.watchers.guards import SimulationFailed
 from sphdyn.io import read_checkpoint, read_frame_meshes, read_history_csv
-from sphdyn.model import build_model
+from sphdyn.build.model import build_model
 from sphdyn.simulation import Simulation
 
 E, RHO = 210e9, 7850.0
@@ -415,7 +415,7 @@ def test_a_graded_block_from_a_deck_puts_its_small_elements_where_asked():
     """[mesh.block] grading: the bar's nodes along x are graded_nodes' (bits),
     and its step is set by its smallest element, the last along x (the
     element the step names), shorter than the equal bar's."""
-    from sphdyn.geometry.mesh import graded_nodes
+    from sphdyn.geometry.mesh_blocks import graded_nodes
 
     graded = BLOCK.replace("divisions = [10, 1, 1]}",
                            'divisions = [10, 1, 1], grading = [{ ratio = 4, smallest = '

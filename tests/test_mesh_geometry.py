@@ -123,7 +123,7 @@ def test_graded_axis_grows_geometrically_from_its_smallest_element(n, smallest):
     length (1e-12), the largest `ratio` times the smallest (1e-12) and each
     neighbour's size ratio the same constant q = ratio^(1/k_max) away from
     the smallest element(s); ratio 1 gives numpy.linspace's bits."""
-    from sphdyn.geometry.mesh import graded_nodes
+    from sphdyn.geometry.mesh_blocks import graded_nodes
 
     x = graded_nodes(-0.36, 0.12, n, 4.0, smallest)
     assert x[0] == -0.36 and x[-1] == 0.12 and x.size == n + 1

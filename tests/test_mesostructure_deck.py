@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from sphdyn.deck import DeckError, loads_deck
-from sphdyn.model import build_model
+from sphdyn.build.model import build_model
 
 DECK = """
 [run]

@@ -30,12 +30,12 @@ from fem_models import block, material, part
 from sphdyn.build import build_stepper
 from sphdyn.deck import loads_deck
 from sphdyn.geometry.convert import elements_to_particles
-from sphdyn.geometry.mesh import block_mesh
+from sphdyn.geometry.mesh_blocks import block_mesh
 from sphdyn.interactions.base import InteractionBase
 from sphdyn.interactions.nodal import PrescribedMotion
 from sphdyn.interactions.penalty_coupling import PenaltyCoupling
 from sphdyn.interactions.penalty_geometry import closest_point, exterior_faces
-from sphdyn.model import build_model
+from sphdyn.build.model import build_model
 from sphdyn.stepper import Stepper
 from stepping import step
 
@@ -441,7 +441,7 @@ def test_a_spring_slid_to_a_heavier_point_of_its_face_keeps_its_energy():
     allowance delta (1 - sqrt(k_c / k_m)) (the spring's energy kept, 1e-12);
     the cycle's net work is 1e-3 of the stored energy (applied as it is, the
     spring returned k_m / k_c times what it took)."""
-    from sphdyn.interactions.penalty_coupling import face_inverse_mass, spring_mass
+    from sphdyn.interactions.penalty_kernels import face_inverse_mass, spring_mass
     from sphdyn.interactions.penalty_geometry import closest_point, face_shapes
     dt = 1e-7
     sph, solid, cp, alpha, force = _pressed_particle("current", node_scale=1e-2)

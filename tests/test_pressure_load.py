@@ -15,7 +15,7 @@ import pytest
 from sphdyn.build import build_stepper
 from sphdyn.cli import main
 from sphdyn.deck import DeckError, loads_deck
-from sphdyn.geometry.mesh import block_mesh
+from sphdyn.geometry.mesh_blocks import block_mesh
 from sphdyn.interactions.nodal import TimeFactor, curve_value
 from sphdyn.interactions.penalty_geometry import exterior_faces, on_nodes
 from sphdyn.interactions.pressure import nodal_forces

@@ -100,7 +100,8 @@ def test_prism_mesh_fills_the_i_and_its_centres_are_the_prism_particles():
     FEM reference): the same points to 1e-12 m, the volume exact (1e-9; the
     vertices sit on the grid), every element right-handed, no unused node,
     the end-face node sets on the extrusion's ends."""
-    from sphdyn.geometry.mesh import check_elements, element_jacobians, prism_mesh
+    from sphdyn.geometry.mesh import check_elements, element_jacobians
+    from sphdyn.geometry.mesh_blocks import prism_mesh
     m = prism_mesh(I_POLY, 0.02, 3, axis="x", base=0.1, length=0.4)
     check_elements(m)
     det = element_jacobians(m.points, m.cells, m.kind)
@@ -124,7 +125,7 @@ def test_prism_mesh_fills_the_i_and_its_centres_are_the_prism_particles():
 def test_prism_mesh_deck_and_its_errors():
     """A [mesh.prism] deck builds the I; a 2D prism with a length and a mesh
     with two sources are refused naming the field."""
-    from sphdyn.model import build_model
+    from sphdyn.build.model import build_model
     pts = ('[[0, 0], ["120 mm", 0], ["120 mm", "40 mm"], ["80 mm", "40 mm"], '
            '["80 mm", "160 mm"], ["120 mm", "160 mm"], ["120 mm", "200 mm"], [0, "200 mm"], '
            '[0, "160 mm"], ["40 mm", "160 mm"], ["40 mm", "40 mm"], [0, "40 mm"]]')

@@ -1,4 +1,4 @@
-"""The exact Riemann solution (sphdyn.riemann) against Toro's published
+"""The exact Riemann solution (sphdyn.analysis.riemann) against Toro's published
 values (Riemann Solvers and Numerical Methods for Fluid Dynamics, 3rd ed.,
 Table 4.3: star pressure, velocity and densities as printed, to half a unit
 of their last digit)."""
@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sphdyn.riemann import sample, shock_speed, star_state
+from sphdyn.analysis.riemann import sample, shock_speed, star_state
 
 # (left, right, p*, u*, rho*_L, rho*_R) as printed, gamma = 1.4
 TORO = [

@@ -1,7 +1,7 @@
 """Colliding rubber rings (Gray, Monaghan & Swift 2001; thesis sec. 3.2) at reduced
 resolution: the tensile instability breaks the rings of plain updated-Lagrangian
 SPH, the artificial stress (Monaghan 2000) keeps them intact and they bounce.
-Also the fragment counting of :mod:`sphdyn.analysis` used as the measure.
+Also the fragment counting of :mod:`sphdyn.analysis.fragments` used as the measure.
 
 Resolution: dx = 1.5 mm (7 particles across the 10 mm wall, 976 per ring)
 and h = 1.2 dx as in the thesis. With h = 1.5 dx (Gray et al.) at this dx
@@ -20,7 +20,7 @@ would otherwise count as fragments.
 import numpy as np
 import pytest
 
-from sphdyn.analysis import count_fragments, fragment_labels, fragment_sizes
+from sphdyn.analysis.fragments import count_fragments, fragment_labels, fragment_sizes
 from sphdyn.deck import loads_deck
 from sphdyn.geometry import box_lattice
 from stepping import build_stepper

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from sphdyn.deck import loads_deck
-from sphdyn.model import build_model
+from sphdyn.build.model import build_model
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "studies"))
 import formulation_bending as fb  # noqa: E402
@@ -145,7 +145,7 @@ def test_punching_study_reads_a_meshed_beam_at_its_elements(tmp_path):
     damages and its nodes' mean displacement and velocity, so the section
     and the damaged block read elements as they read particles (exact)."""
     import dropweight_punching as dp
-    from sphdyn.geometry.mesh import block_mesh
+    from sphdyn.geometry.mesh_blocks import block_mesh
     from sphdyn.io import MeshFrame
     from sphdyn.io.hdf5 import write_frame
 

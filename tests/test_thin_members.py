@@ -1,4 +1,4 @@
-"""Members too thin for their SPH formulation (sphdyn.thin_members): the
+"""Members too thin for their SPH formulation (sphdyn.checks.thin_members): the
 stiffness-error law from the measured table and the warning of check / run."""
 
 import csv
@@ -9,8 +9,8 @@ import pytest
 
 from sphdyn.cli import main
 from sphdyn.deck import loads_deck
-from sphdyn.model import build_model
-from sphdyn.thin_members import (F_TIMOSHENKO, FREQUENCY, PLATEAU_ERROR_PCT, across_for,
+from sphdyn.build.model import build_model
+from sphdyn.checks.thin_members import (F_TIMOSHENKO, FREQUENCY, PLATEAU_ERROR_PCT, across_for,
                                  measured_errors, member_extents, stiffness_error,
                                  thin_member_warnings)
 

@@ -32,7 +32,7 @@ import pytest
 from sphdyn.build import build_stepper
 from sphdyn.deck import DeckError, loads_deck
 from sphdyn.geometry.convert import hybrid_points
-from sphdyn.geometry.mesh import block_mesh
+from sphdyn.geometry.mesh_blocks import block_mesh
 from sphdyn.interactions.penalty_geometry import face_shapes
 from sphdyn.interactions.tied_coupling import tie_map
 from sphdyn.state import BC_SLAVE

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from sphdyn.cli import main
-from sphdyn.geometry.mesh import block_mesh
+from sphdyn.geometry.mesh_blocks import block_mesh
 from sphdyn.io import MeshFrame
 from sphdyn.io.hdf5 import write_frame
 from sphdyn.validation import cases, data, measures, report
@@ -172,7 +172,7 @@ def test_crater_diameter_on_a_graded_face_adds_the_local_half_element(tmp_path):
     lost node, not the smallest size passed as h: 2 (r_max + s/2), s the
     spacing to the next node outwards along the axis nearer its radius
     (1e-12)."""
-    from sphdyn.geometry.mesh import graded_nodes
+    from sphdyn.geometry.mesh_blocks import graded_nodes
 
     g = [(1.5, "centre"), (1.5, "centre"), (1.0, "lo")]
     _frame_with_crater(tmp_path, 0.0085, grading=g)

@@ -11,7 +11,7 @@ from scipy import stats
 from sphdyn.deck import DeckError, loads_deck
 from sphdyn.heterogeneity.variation import (FACTOR_FLOOR, factor_of, quantise,
                                             standard_normal_field)
-from sphdyn.model import build_model
+from sphdyn.build.model import build_model
 
 DECK = """
 [run]

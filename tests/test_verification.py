@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from sphdyn.deck import loads_deck
-from sphdyn.model import build_model
+from sphdyn.build.model import build_model
 from stepping import build_stepper, step, wall
 
 ELASTIC = """
@@ -258,7 +258,7 @@ def test_window_mean_force_of_a_spring_oscillation_is_its_mean():
     # that divides T, so the interpolation of I is exact: 1e-12 relative);
     # before a full window has passed, the impulse before t = 0 counts as 0,
     # so the mean is I(t) / T.
-    from sphdyn.analysis import window_mean_force
+    from sphdyn.analysis.fragments import window_mean_force
     F0, T = 3.0e4, 4.0e-6
     t = np.arange(0, 201) * (T / 40)
     imp = F0 * t + F0 * T * (1 - np.cos(2 * np.pi * t / T)) / (2 * np.pi)
@@ -478,7 +478,7 @@ geometry = {{ shape = "box", lo = [0, 0, 0], hi = [0.1, 0.1, 0.01] }}
 def test_side_view_takes_the_largest_value_across_the_width():
     # cells of 10 mm: two particles in cell (x 0, z 1) at different y keep the
     # larger value, an empty cell is NaN, and the image is (nz, nx)
-    from sphdyn.analysis import side_view_max
+    from sphdyn.analysis.fragments import side_view_max
 
     x0 = np.array([[0.005, 0.005, 0.015], [0.005, 0.025, 0.015], [0.015, 0.0, 0.005]])
     img = side_view_max(x0, np.array([0.2, 0.7, 1.0]), 0.01)
@@ -490,7 +490,7 @@ def test_side_view_takes_the_largest_value_across_the_width():
 def test_plan_view_takes_the_largest_value_through_the_thickness():
     # the same particles seen along z (axes x, y): cells (x 0, y 0), (x 0,
     # y 2) and (x 1, y 0)
-    from sphdyn.analysis import projected_max
+    from sphdyn.analysis.fragments import projected_max
 
     x0 = np.array([[0.005, 0.005, 0.015], [0.005, 0.025, 0.015], [0.015, 0.0, 0.005],
                    [0.006, 0.004, 0.005]])

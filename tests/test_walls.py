@@ -365,7 +365,7 @@ def _bounce(halve: bool):
     halved while in contact when ``halve``; run until it has left the wall
     and 200 steps more. Returns (initial kinetic energy, final record, the
     mean of E_total over the 200 steps)."""
-    from sphdyn.geometry.mesh import block_mesh
+    from sphdyn.geometry.mesh_blocks import block_mesh
     from sphdyn.materials import get_model
     from sphdyn.parts.fem import solid_part
     from sphdyn.stepper import Stepper

@@ -143,7 +143,7 @@ def hex3d_stepper(elements: int | None = None):
     """The ``hex3d`` case: the block3d cube as hex8 elements on a rigid wall."""
     import numpy as np
 
-    from .geometry.mesh import block_mesh
+    from .geometry.mesh_blocks import block_mesh
     from .interactions import Wall, WallSpec
     from .interactions.wall_contact import STIFFNESS_MASS
     from .materials import get_model

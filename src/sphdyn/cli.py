@@ -118,8 +118,8 @@ def cmd_run(args) -> int:
 
 def _warn_thin_members(deck, model) -> None:
     """``warning: ...`` on stderr for each member too thin for its formulation
-    (:func:`sphdyn.thin_members.thin_member_warnings`); not an error."""
-    from .thin_members import thin_member_warnings
+    (:func:`sphdyn.checks.thin_members.thin_member_warnings`); not an error."""
+    from .checks.thin_members import thin_member_warnings
 
     for text in thin_member_warnings(deck, model):
         print(f"warning: {text}", file=sys.stderr, flush=True)
@@ -199,8 +199,8 @@ def cmd_ensemble(args) -> int:
 
 def cmd_check(args) -> int:
     from .deck import load_deck
-    from .model import build_model
-    from .preflight import estimate_size, memory_limit, show_bytes
+    from .build.model import build_model
+    from .checks.preflight import estimate_size, memory_limit, show_bytes
 
     deck = load_deck(args.deck, args.set)
     model = build_model(deck)  # refuses a model over the memory limit before building
@@ -271,7 +271,7 @@ def cmd_plot(args) -> int:
 def cmd_mesostructure(args) -> int:
     from .deck import load_deck
     from .heterogeneity.mesostructure import phase_statistics, save_phase_slices
-    from .model import build_model
+    from .build.model import build_model
 
     deck = load_deck(args.deck, args.set or [])
     model = build_model(deck)
@@ -298,7 +298,7 @@ def cmd_mesostructure(args) -> int:
 
 
 def cmd_ucs(args) -> int:
-    from .compression import ensemble_report
+    from .analysis.compression import ensemble_report
 
     stats = ensemble_report(args.dirs, args.wall, args.out, homogeneous=args.homogeneous)
     ps, es = stats["peak_stress"], stats["strain_at_peak"]
@@ -502,7 +502,7 @@ def cmd_material_test(args) -> int:
 
 def cmd_airblast(args) -> int:
     from .io.plots import markdown_table
-    from .kingery_bulmash import Z_RANGE, BURSTS, blast_parameters
+    from .interactions.kingery_bulmash import Z_RANGE, BURSTS, blast_parameters
 
     w, ranges = args.charge, args.distance
     lo, hi = Z_RANGE[BURSTS[args.burst]]

@@ -28,13 +28,12 @@ from .deck import dump_resolved, load_deck
 from .watchers.guards import SimulationFailed
 from .io import (FrameWriter, History, MeshFrame, atomic_write_text, particle_fields,
                  plot_history, read_checkpoint, write_checkpoint)
-from .analysis import window_mean_force
 from .io.frames import STOP_FRAME, list_frames
 from .io.plots import (energy_columns, per_depth, plot_gauges, relative_drift, scaled_unit,
                        time_unit)
 from .build import build_stepper
 from .watchers.gauges import GaugeRecorder, build_gauges
-from .model import Model, build_model
+from .build.model import Model, build_model
 from .watchers.interrupt import StopRequests
 from .watchers.monitors import (Checkpoints, EnergyGuard, FrameOutput, Guards,
                                 HistoryFlush, HistoryRecorder, Progress)
@@ -308,22 +307,10 @@ class Simulation:
             drift = relative_drift(h["E_total"], [h[c] for c in energy_columns(list(h))])
             summary["energy_error_max_rel"] = float(np.max(np.abs(drift)))
         window = deck.output.force_window
-        for w in self.model.walls:
-            col = f"F_wall_{w.name}"
-            if col in h and h[col].size:
-                summary[f"peak_{col}"] = float(np.max(h[col]))
-                impulse = h.get(f"I_wall_{w.name}")  # absent before 2026-11-23
-                if impulse is not None:
-                    summary[f"peak_{col}_mean"] = float(np.max(window_mean_force(
-                        h["time"], impulse, window)))
+        for i in s.interactions:  # a wall's peak forces, a boundary's peak reaction
+            summary.update(i.summary(h, window) if h else {})
         if self.model.walls:
             summary["force_window"] = window
-        for col in h:  # prescribed node sets: the largest magnitude of the reaction
-            if col.endswith("_reaction_x") and h[col].size:
-                name = col[:-len("_reaction_x")]
-                r = np.stack([h.get(f"{name}_reaction_{c}", np.zeros_like(h[col]))
-                              for c in "xyz"])
-                summary[f"peak_{name}_reaction"] = float(np.max(np.linalg.norm(r, axis=0)))
         return summary
 
 

@@ -330,8 +330,7 @@ class Stepper:
         for part in self.parts:
             if f"kin.{part.name}" not in groups:
                 raise ValueError(f"the checkpoint has no part {part.name!r}: it was written "
-                                 "by another deck or an sphdyn before parts existed "
-                                 "(2026-11-23); run the deck again")
+                                 "by another deck; run the deck again")
             arrays = groups[f"kin.{part.name}"]
             q = part.kin
             n_old, n_new = q.n, arrays["x"].shape[0]

@@ -1,6 +1,6 @@
 """Deck -> stepper: one builder per deck table, run in stage order.
 
-:func:`build_stepper` builds the model (:func:`sphdyn.model.build_model`:
+:func:`build_stepper` builds the model (:func:`sphdyn.build.model.build_model`:
 particles, meshes, sets), then asks each registered
 :class:`~sphdyn.build.registry.Builder` for its parts, interactions and
 events (the stages: :mod:`sphdyn.build.registry`). With the model this is
@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..mass_scaling import MassScaling
-from ..model import Model, build_model
+from .model import Model, build_model
 from ..stepper import Stepper
 from . import conditions, couplings, erosion, meshes, particles  # noqa: F401 (register)
 from .context import BuildContext

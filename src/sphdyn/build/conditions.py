@@ -17,7 +17,7 @@ from ..interactions.blast import BlastLoad
 from ..interactions.nodal import NodalLoad, PrescribedMotion
 from ..interactions.non_reflecting import NonReflectingBoundary
 from ..interactions.pressure import PressureLoad
-from ..mesh_model import pressure_faces, set_faces
+from .mesh_model import pressure_faces, set_faces
 from ..state import BC_FIXED
 from .registry import Builder, Built, register
 

@@ -14,7 +14,7 @@ from ..interactions import Wall
 from ..interactions.embedded import EmbeddedNodes
 from ..interactions.nodal import MassDamping
 from ..materials import get_model
-from ..mesh_model import section_of
+from .mesh_model import section_of
 from ..parts import SolidSettings
 from ..parts.fem import LinePart, solid_part
 from .registry import MESH_STAGE, Builder, Built, builders, register

@@ -9,7 +9,7 @@ from ..events import DomainExit
 from ..interactions import ParticleContact, Wall
 from ..interactions.nodal import MassDamping
 from ..kernels import KernelContext
-from ..model import debris_meshes, sublayer_meshes
+from .model import debris_meshes, sublayer_meshes
 from ..parts import SPHPart, SPHSettings
 from .registry import Builder, Built, register
 

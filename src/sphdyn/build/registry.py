@@ -34,17 +34,16 @@ entries as ``deck.<table>``. It registers through an entry point in the group
 
 naming a :class:`Builder` (or a callable returning one, or registering it
 and returning None). Entry points are loaded once, when the builders or the
-extension tables are first asked for; a failing one is skipped with a
-``RuntimeWarning``.
+extension tables are first asked for (:func:`sphdyn.plugins.load_group`).
 """
 
 from __future__ import annotations
 
 import re
-import warnings
 from dataclasses import dataclass, field
-from importlib.metadata import entry_points
 from typing import Any, Callable
+
+from ..plugins import load_group
 
 ENTRY_POINT_GROUP = "sphdyn.builders"
 
@@ -74,7 +73,7 @@ class Builder:
     ``table``: the table it reads (``"boundary"``, ``"mesh.contact"``);
     ``build``: ``build(ctx) -> Built``, or ``build(ctx, mesh) -> Built`` for a
     mesh sub-table (``mesh=True``; ``mesh`` a
-    :class:`~sphdyn.mesh_model.MeshModel`); ``stage``: its place in the order
+    :class:`~sphdyn.build.mesh_model.MeshModel`); ``stage``: its place in the order
     (module docstring); ``schema``: the deck table it brings (extensions only;
     the built-in tables are the deck's own); ``many``: ``[[table]]`` (a list)
     rather than ``[table]``.
@@ -129,15 +128,8 @@ def load_entry_points() -> None:
     if entry_points_loaded:
         return
     entry_points_loaded = True
-    for ep in entry_points(group=ENTRY_POINT_GROUP):
-        try:
-            found = ep.load()
-            builder = found if isinstance(found, Builder) else found()
-            if isinstance(builder, Builder) and REGISTRY.get(builder.key) is not builder:
-                register(builder)
-        except Exception as exc:  # a broken plugin must not stop every deck
-            warnings.warn(f"builder entry point {ep.name!r} ({ep.value}) was skipped: "
-                          f"{exc}", RuntimeWarning, stacklevel=2)
+    load_group(ENTRY_POINT_GROUP, Builder,
+               lambda b: None if REGISTRY.get(b.key) is b else register(b))
 
 
 def builders(mesh: bool = False) -> list[Builder]:

@@ -36,14 +36,14 @@ from .sections.run import Domain, Run, Time
 from .sections.meshes import BeamSection, BlockMesh, Convert, LineMesh, Mesh, MeshGroup
 from .sections.sets import Boundary, Load, ParticleSet
 from .sections.shapes import Geometry, Region
-from .sections.sph import Contact, Sph
+from .sections.sph import BodyContact, Sph
 from .sections.walls import Wall
 from .values import ExistingFile, NonEmpty, Section
 
 __all__ = [
     "BeamSection", "Blast", "BlockMesh", "Body", "Boundary", "Convert", "Detonation",
     "LineMesh", "Load", "Mesh",
-    "MeshGroup", "Contact", "Crack", "Deck", "DeckSections", "Domain",
+    "MeshGroup", "BodyContact", "Crack", "Deck", "DeckSections", "Domain",
     "ExistingFile", "Gauge", "Geometry", "MassField", "MaterialSection", "Mesostructure",
     "Output", "ParticleSet", "Probe", "Region", "Run", "Section", "Sph", "Time",
     "Variation", "Wall", "deck_model", "field_annotation", "metadata",
@@ -80,7 +80,7 @@ class DeckSections(Section):
         (), validate_default=True,
         description="Bodies of particles (at least one body or mesh).")
     mesh: tuple[Mesh, ...] = Field((), description="Finite-element parts.")
-    contact: Contact = Field(default_factory=Contact,
+    contact: BodyContact = Field(default_factory=BodyContact,
                              description="Contact between bodies.")
     wall: tuple[Wall, ...] = Field((), description="Rigid walls.")
     set: tuple[ParticleSet, ...] = Field((), description="Particle sets.")

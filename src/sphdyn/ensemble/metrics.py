@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..analysis import window_mean_force
+from ..analysis.fragments import window_mean_force
 
 #: Damage at and above which a particle counts as failed (fully damaged).
 FAILED_DAMAGE = 0.9
@@ -32,7 +32,7 @@ def count_main_cracks(x0, damage, mass, dx: float, normal=(0.0, 1.0, 0.0),
     x0 : (N, 3) initial positions [m]; damage, mass : (N,).
     dx : particle spacing [m]; normal : (3,) impact direction.
     """
-    from ..analysis import fragment_labels, fragment_sizes
+    from ..analysis.fragments import fragment_labels, fragment_sizes
 
     x0 = np.asarray(x0, float)
     solid = np.asarray(mass) > 0
@@ -54,7 +54,7 @@ def sample_metrics(sim) -> dict:
     * ``peak_contact_force``: maximum over the history of the summed normal
       wall forces [N] (N/m in 2D); NaN without walls;
     * ``peak_contact_force_mean``: maximum of the same force averaged over
-      ``[output] force_window`` (:func:`sphdyn.analysis.window_mean_force`),
+      ``[output] force_window`` (:func:`sphdyn.analysis.fragments.window_mean_force`),
       free of the spikes of first contact;
     * ``dissipated_energy``: internal energy at the end [J]: plastic and
       damage work, artificial-viscosity heat (also given alone as

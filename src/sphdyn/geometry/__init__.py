@@ -15,17 +15,9 @@ from .lattice import (
     ring_lattice,
     sphere_lattice,
 )
-from .mesh import (
-    MESH_KINDS,
-    MeshData,
-    block_mesh,
-    check_elements,
-    element_jacobians,
-    line_mesh,
-    polyline_mesh,
-    prism_mesh,
-    read_mesh,
-)
+from .mesh import MESH_KINDS, MeshData, check_elements, element_jacobians
+from .mesh_blocks import block_mesh, line_mesh, polyline_mesh, prism_mesh
+from .mesh_files import read_mesh
 from .regions import REGION_SHAPES, bounding_box, select
 
 __all__ = [

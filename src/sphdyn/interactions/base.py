@@ -19,7 +19,11 @@ couplings, prescribed motion, loads and damping. The
 * ``constrain(t, dt)``: after the kick of the step [t, t + dt], the
   tied and hybrid couplings set their slaves' positions and velocities
   from their masters';
-* ``columns(t)``: its history columns; ``state()`` / ``restore()``.
+* ``columns(t)``: its history columns; ``state()`` / ``restore()``;
+* ``summary(history, window)``: what it adds to the run's summary from the
+  whole history (``{column: (K,) array}``; ``window`` the deck's
+  ``[output] force_window`` [s]): a wall's peak forces, a boundary's peak
+  reaction.
 """
 
 from __future__ import annotations
@@ -40,6 +44,7 @@ class Interaction(Protocol):
     def external_work(self) -> float: ...
     def constrain(self, t: float, dt: float) -> None: ...
     def columns(self, t: float) -> dict[str, float]: ...
+    def summary(self, history: dict, window: float) -> dict: ...
     def state(self) -> tuple[dict, dict[str, np.ndarray]]: ...
     def restore(self, scalars: dict, arrays: dict[str, np.ndarray]) -> None: ...
 
@@ -69,6 +74,9 @@ class InteractionBase:
 
     def constrain(self, t: float, dt: float) -> None:
         return None
+
+    def summary(self, history: dict, window: float) -> dict:
+        return {}
 
     def state(self) -> tuple[dict, dict[str, np.ndarray]]:
         return {}, {}

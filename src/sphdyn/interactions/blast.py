@@ -2,7 +2,7 @@ r"""Empirical air-blast load on exposed faces (LS-DYNA's LOAD_BLAST_ENHANCED).
 
 A TNT charge of mass :math:`W` at :math:`\mathbf x_c`, detonated at
 :math:`t_d`, loads every face of a set with the Kingery-Bulmash pressure
-(:mod:`sphdyn.kingery_bulmash`): at the face's centre :math:`\mathbf c` with
+(:mod:`sphdyn.interactions.kingery_bulmash`): at the face's centre :math:`\mathbf c` with
 outward unit normal :math:`\mathbf n` and area :math:`A`, the range
 :math:`R = |\mathbf c - \mathbf x_c|`, the scaled distance
 :math:`Z = R/W^{1/3}`, the cosine of the angle of incidence
@@ -47,7 +47,7 @@ import numpy as np
 from numba import njit
 from scipy.spatial import cKDTree
 
-from .. import kingery_bulmash as kb
+from . import kingery_bulmash as kb
 from .base import InteractionBase
 
 

@@ -223,6 +223,14 @@ class PrescribedMotion(_SetInteraction):
         return {f"{self.name}_reaction_x": float(r[0]), f"{self.name}_reaction_y": float(r[1]),
                 f"{self.name}_reaction_z": float(r[2])}
 
+    def summary(self, history: dict, window: float) -> dict:
+        """``peak_<name>_reaction``: the largest magnitude of the reaction [N]
+        (N/m in 2D) over the history."""
+        cols = [history.get(f"{self.name}_reaction_{c}", np.zeros(0)) for c in "xyz"]
+        if not cols[0].size:
+            return {}
+        return {f"peak_{self.name}_reaction": float(np.max(np.linalg.norm(cols, axis=0)))}
+
 
 class NodalLoad(_SetInteraction):
     """A total force ``force`` (3,) [N] shared evenly by the items, times a ramp
@@ -270,13 +278,10 @@ class NodalLoad(_SetInteraction):
         return {"now": self._now, "work": self.work, "kick": self._kick}, {"a": self._a}
 
     def restore(self, scalars: dict, arrays: dict) -> None:
-        # checkpoints before 2026-11-27 kept nothing of a load (its first kick
-        # after the restart then books no work for it)
-        self._now = float(scalars.get("now", 0.0))
-        self.work = float(scalars.get("work", 0.0))
-        self._kick = float(scalars.get("kick", 0.0))
-        if "a" in arrays:
-            self._a[...] = arrays["a"]
+        self._now = float(scalars["now"])
+        self.work = float(scalars["work"])
+        self._kick = float(scalars["kick"])
+        self._a[...] = arrays["a"]
 
 
 class MassDamping(_SetInteraction):

@@ -29,7 +29,7 @@ are zeroed (the shared pair functions of :mod:`.slaves`), so
 a bar particle's strain rate comes from the concrete around it only.
 
 The particles take the density of the concrete around them (and a nominal
-volume :math:`m_s/\rho_c`; :func:`sphdyn.model.build_model`). A bar
+volume :math:`m_s/\rho_c`; :func:`sphdyn.build.model.build_model`). A bar
 particle's strain rate is sampled from its concrete neighbours with the
 weights :math:`m_j/\rho_i` of the energy-consistent velocity gradient
 (:mod:`sphdyn.parts.sph.passes`); at the steel's 7850 kg/m^3 those weights

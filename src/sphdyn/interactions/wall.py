@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..analysis.fragments import window_mean_force
 from .base import InteractionBase
 from .wall_contact import (BORN, STIFFNESS_BULK, STIFFNESS_MASS, bulk_contact_time_step,
                            column_sums, wall_contact)
@@ -129,6 +130,19 @@ class Wall(InteractionBase):
             out[f"d_wall_{w.name}"] = float(w.velocity @ w.normal) * w.travel(t)
         return out
 
+    def summary(self, history: dict, window: float) -> dict:
+        """``peak_F_wall_<name>``: the largest normal force [N] (N/m in 2D) of the
+        history, and ``peak_F_wall_<name>_mean``: the largest mean over
+        ``window`` seconds (:func:`sphdyn.analysis.fragments.window_mean_force`,
+        from the impulse column, exact however sparse the records)."""
+        col = f"F_wall_{self.spec.name}"
+        if not history.get(col, np.zeros(0)).size:
+            return {}
+        mean = window_mean_force(history["time"], history[f"I_wall_{self.spec.name}"],
+                                 window)
+        return {f"peak_{col}": float(np.max(history[col])),
+                f"peak_{col}_mean": float(np.max(mean))}
+
     def state(self) -> tuple[dict, dict[str, np.ndarray]]:
         p = self.part.p
         return {}, {"impulse": self.impulse, "allowance": getattr(p, self._pen0),
@@ -136,7 +150,6 @@ class Wall(InteractionBase):
 
     def restore(self, scalars: dict, arrays: dict) -> None:
         self.impulse[...] = arrays["impulse"]
-        if "allowance" in arrays:  # absent in checkpoints before 2026-11-27
-            p = self.part.p
-            setattr(p, self._pen0, arrays["allowance"])
-            setattr(p, self._k_last, arrays["stiffness"])
+        p = self.part.p
+        setattr(p, self._pen0, arrays["allowance"])
+        setattr(p, self._k_last, arrays["stiffness"])

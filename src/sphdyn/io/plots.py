@@ -250,7 +250,7 @@ def history_figures(data: dict[str, np.ndarray], title: str = "",
       relative drift of ``E_total`` in a second panel;
     * ``forces``: every ``F_*`` column against time, and for each wall with
       an impulse column ``I_wall_<name>`` its force averaged over
-      ``force_window`` (:func:`sphdyn.analysis.window_mean_force`, dashed);
+      ``force_window`` (:func:`sphdyn.analysis.fragments.window_mean_force`, dashed);
     * ``reactions``: the reaction force components ``<set>_reaction_x|y|z``
       of prescribed motions (components that stay zero left out);
     * ``dt``: ``dt`` against ``step`` (or time if there is no step), from 0.
@@ -298,7 +298,7 @@ def history_figures(data: dict[str, np.ndarray], title: str = "",
             force_window = Output.model_fields["force_window"].default
         for c in columns:
             if c.startswith("I_wall_") and f"F_wall_{c[7:]}" in data:
-                from ..analysis import window_mean_force
+                from ..analysis.fragments import window_mean_force
 
                 ax.plot(shown, ff * window_mean_force(time, data[c], force_window), "--",
                         label=f"F_wall_{c[7:]}, {force_window * 1e6:g} µs mean")

@@ -11,7 +11,7 @@ fraction :math:`F \in [0, 1]` that never decreases,
 
 with :math:`t_l` the particle's lighting time (the straight-line distance
 from the nearest detonation point over ``D``, plus that point's time,
-:mod:`sphdyn.detonation`), ``s`` the particle size (its initial spacing),
+:mod:`sphdyn.build.detonation`), ``s`` the particle size (its initial spacing),
 :math:`w_b` the burn width in particle sizes (1.5: LS-DYNA's
 :math:`F_1 = 2(t - t_l) D A_{max} / (3 v)` for a cube of side ``s``), and
 :math:`V_{CJ} = 1 - p_{CJ} / (\rho_0 D^2)` (the Rayleigh line). ``burn``

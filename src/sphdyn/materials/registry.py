@@ -24,12 +24,12 @@ skipped with a ``RuntimeWarning``.
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
-from importlib.metadata import entry_points
 from typing import Any, Callable, get_args
 
 import numpy as np
+
+from ..plugins import load_group
 
 # Common leading block of every parameter vector.
 P_DENSITY = 0
@@ -145,10 +145,10 @@ class MaterialModel:
         (moduli, strengths), so scaling those scales the stress: a bar of it
         can share its stiffness between its elements and its sublayer
         particles (``[mesh.sublayer] stiffness = "split"``,
-        :func:`sphdyn.model.build_model`).
+        :func:`sphdyn.build.model.build_model`).
     explosive : bool
         A high explosive: the material a ``[[detonation]]`` lights
-        (:mod:`sphdyn.detonation`).
+        (:mod:`sphdyn.build.detonation`).
     test_density : float or None
         The density [kg/m^3] ``sphdyn material-test`` gives a point of the
         model when the user gives none: a point driven by strain has a
@@ -261,15 +261,8 @@ def load_entry_points() -> None:
     if entry_points_loaded:
         return
     entry_points_loaded = True
-    for ep in entry_points(group=ENTRY_POINT_GROUP):
-        try:
-            found = ep.load()
-            model = found if isinstance(found, MaterialModel) else found()
-            if isinstance(model, MaterialModel) and REGISTRY.get(model.name) is not model:
-                register(model)
-        except Exception as exc:  # a broken plugin must not stop every deck
-            warnings.warn(f"material entry point {ep.name!r} ({ep.value}) was "
-                          f"skipped: {exc}", RuntimeWarning, stacklevel=2)
+    load_group(ENTRY_POINT_GROUP, MaterialModel,
+               lambda m: None if REGISTRY.get(m.name) is m else register(m))
 
 
 def available_models() -> tuple[str, ...]:

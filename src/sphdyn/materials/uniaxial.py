@@ -39,7 +39,7 @@ speed: the bar's, :math:`c = \sqrt{E/\rho}`, :math:`E = 9KG/(3K + G)`.
 
 Parameter vector ``[density, K, G, yield_stress, hardening_modulus]`` (the J2
 layout, :func:`uniaxial_params`). Not a deck model: the sublayer builds its
-groups (:func:`sphdyn.model.build_model`).
+groups (:func:`sphdyn.build.model.build_model`).
 """
 
 from __future__ import annotations

@@ -20,7 +20,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..geometry.mesh import graded_nodes
+from ..geometry.mesh_blocks import graded_nodes
 from . import data
 from .figures import deflection_figure, load_figure, section_figure
 from .measures import (depth_of_penetration, largest_deflection, lost_face_diameter,
@@ -78,7 +78,7 @@ def _named(items: list[dict], name: str) -> dict:
 
 def block_spacing(deck: dict, mesh: str) -> tuple[float, float, float]:
     """Element sizes (hx, hy, hz) [m] of a ``[[mesh]]`` block: the smallest on
-    each axis of a graded one (:func:`~sphdyn.geometry.mesh.graded_nodes`)."""
+    each axis of a graded one (:func:`~sphdyn.geometry.mesh_blocks.graded_nodes`)."""
     b = _named(deck["mesh"], mesh)["block"]
     grading = b.get("grading") or [{"ratio": 1.0, "smallest": "lo"}] * len(b["divisions"])
     return tuple(float(np.diff(graded_nodes(lo, hi, n, g["ratio"], g.get("smallest", "lo")))

@@ -99,7 +99,7 @@ def _candidates(deck, parts, spec):
                 out.append((pk, np.arange(q.n)))
         elif spec.body is not None:
             if part.kind == "sph":
-                from ..model import particle_body_names
+                from ..build.model import particle_body_names
 
                 k = particle_body_names(deck).index(spec.body)
                 out.append((pk, np.flatnonzero(q.body == k)))

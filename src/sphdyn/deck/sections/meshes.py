@@ -243,7 +243,7 @@ class PenaltyKeys(Section):
                                "has what each did in the 800 m/s penetration run.")
 
 
-class Contact(PenaltyKeys):
+class MeshContact(PenaltyKeys):
     """[mesh.contact]: the particles of every body meet the mesh's exterior faces
     by penalty (an SPH projectile or impactor on a finite-element target).
 
@@ -444,7 +444,7 @@ class Mesh(Section):
         None, description="A region of elements replaced by SPH particles.")
     erosion: Optional[MeshErosion] = Field(
         None, description="Elements erode during the run ([mesh.erosion]).")
-    contact: Optional[Contact] = Field(
+    contact: Optional[MeshContact] = Field(
         None, description="Particles of every body meet this mesh's faces by penalty "
                           "([mesh.contact]; solid meshes).")
     embed: Optional[reference_to("mesh")] = Field(

@@ -122,7 +122,7 @@ class Sph(Section):
         description="Artificial stress against the tensile instability.")
 
 
-class Contact(Section):
+class BodyContact(Section):
     """[contact]: penalty contact between particles of different bodies."""
 
     enabled: Optional[StrictBool] = Field(

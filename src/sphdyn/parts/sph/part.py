@@ -410,9 +410,8 @@ class SPHPart:
         self.step = int(scalars["step"])
         p.B = arrays["B"]
         p.dedt_av = arrays["dedt_av"]
-        if "av_signal" in arrays:  # (checkpoints before 2026-11-26 have none)
-            p.av_signal = arrays["av_signal"]
-            self._visc = None  # it holds the replaced array
+        p.av_signal = arrays["av_signal"]
+        self._visc = None  # it holds the replaced array
         nl = self.nl
         nl.offsets = arrays["nl_offsets"].copy()
         nl.idx = arrays["nl_idx"].copy()

@@ -15,10 +15,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .deck import DeckError
-from .deck.errors import format_problem
-from .geometry.lattice import rotate_about
-from .materials.explosive import H_CLOCK, detonation_velocity, lit
+from ..deck import DeckError
+from ..deck.errors import format_problem
+from ..geometry.lattice import rotate_about
+from ..materials.explosive import H_CLOCK, detonation_velocity, lit
 
 
 def lighting_times(x: np.ndarray, points: np.ndarray, times: np.ndarray,

@@ -222,7 +222,7 @@ def thin_member_warnings(deck, model=None) -> list[str]:
     smallest extent, spacing: the elements' size). None in 1D (no free
     lateral surfaces, no bending), none for bodies of a fluid (gas,
     explosive)."""
-    from .materials.registry import get_model
+    from ..materials.registry import get_model
 
     dim = deck.run.dimension
     if dim == 1:

@@ -11,25 +11,25 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .geometry import select
-from .geometry.spacing import adapted_smoothing_lengths
-from .heterogeneity.cracks import crack_mask
-from .heterogeneity.mass import body_rng, mass_field
-from .heterogeneity.mesostructure import AGGREGATE, ITZ, MORTAR, generate_phases
-from .heterogeneity.photo import photo_targets
-from .heterogeneity.variation import factor_of, quantise, standard_normal_field, variation_rng
+from ..geometry import select
+from ..geometry.spacing import adapted_smoothing_lengths
+from ..heterogeneity.cracks import crack_mask
+from ..heterogeneity.mass import body_rng, mass_field
+from ..heterogeneity.mesostructure import AGGREGATE, ITZ, MORTAR, generate_phases
+from ..heterogeneity.photo import photo_targets
+from ..heterogeneity.variation import factor_of, quantise, standard_normal_field, variation_rng
 from .initial import initial_fields
-from .interactions.wall import STIFFNESS, WallSpec
-from .deck import DeckError
-from .deck.errors import format_problem
+from ..interactions.wall import STIFFNESS, WallSpec
+from ..deck import DeckError
+from ..deck.errors import format_problem
 from .detonation import light_explosives
-from .preflight import (check_meshes_in_domain, checked_lattices, history_models,
+from ..checks.preflight import (check_meshes_in_domain, checked_lattices, history_models,
                         support_radius)
-from .materials import MaterialGroup, available_models, get_model, history_layout
-from .materials.uniaxial import UNIAXIAL, uniaxial_params
+from ..materials import MaterialGroup, available_models, get_model, history_layout
+from ..materials.uniaxial import UNIAXIAL, uniaxial_params
 from .mesh_model import MeshModel, build_meshes, mesh_node_set, pressure_faces, section_of
-from .watchers.probes import NODE_FIELDS, Probe, node_probe_field, quantity
-from .state import Particles
+from ..watchers.probes import NODE_FIELDS, Probe, node_probe_field, quantity
+from ..state import Particles
 
 
 @dataclass
@@ -197,7 +197,7 @@ def build_model(deck) -> Model:
     model would exceed ``run.memory_limit``, and before anything else if
     bodies overlap, start through a wall or outside the [domain] box or are
     smaller than their dx, and before making parts if a mesh lies outside
-    the box (:mod:`sphdyn.preflight`).
+    the box (:mod:`sphdyn.checks.preflight`).
     """
     dim = deck.run.dimension
     _, lattices = checked_lattices(deck)
@@ -423,7 +423,7 @@ def _sublayer_particles(deck, mm: MeshModel, b: int, n_hist: int) -> Particles:
     density and volume are the concrete's, set by :func:`_seat_sublayers`),
     h = sph.h_factor times the mean element length (or [mesh.sublayer]
     smoothing_length), body ``b``."""
-    from .interactions.sublayer import sublayer_masses
+    from ..interactions.sublayer import sublayer_masses
 
     mat = deck.material[int(mm.mat[0])]
     x, conn = mm.points, mm.cells

@@ -1,6 +1,6 @@
 """Deck -> meshes: the [[mesh]] tables as node coordinates, connectivity and sets.
 
-With :mod:`sphdyn.model` (particles) and :mod:`sphdyn.build` (parts and
+With :mod:`sphdyn.build.model` (particles) and :mod:`sphdyn.build` (parts and
 interactions) the only place that reads the deck's meshes. Every problem is
 found here, before a part is made or a file written, and reported as a
 :class:`~sphdyn.deck.DeckError` line ``mesh[k]...: <what>. Fix: <what>``
@@ -15,14 +15,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .deck import DeckError
-from .deck.errors import format_problem
-from .geometry import select
-from .geometry.convert import element_centroids, elements_to_particles, hybrid_points
-from .geometry.mesh import (MeshData, block_mesh, check_elements, polyline_mesh, prism_mesh,
-                            read_mesh)
-from .interactions.penalty_geometry import exterior_faces, on_nodes
-from .parts.fem import BeamSection
+from ..deck import DeckError
+from ..deck.errors import format_problem
+from ..geometry import select
+from ..geometry.convert import element_centroids, elements_to_particles, hybrid_points
+from ..geometry.mesh import MeshData, check_elements
+from ..geometry.mesh_blocks import block_mesh, polyline_mesh, prism_mesh
+from ..geometry.mesh_files import read_mesh
+from ..interactions.penalty_geometry import exterior_faces, on_nodes
+from ..parts.fem import BeamSection
 
 #: Element kind of a solid mesh by dimension.
 SOLID_KIND = {3: "hex8", 2: "quad4"}

@@ -27,9 +27,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .deck import DeckError
-from .deck.errors import format_problem
-from .geometry.lattice import ogive_profile, ogive_volume, polygon_area, rotate_about
+from ..deck import DeckError
+from ..deck.errors import format_problem
+from ..geometry.lattice import ogive_profile, ogive_volume, polygon_area, rotate_about
 
 #: Bytes of per-particle state and work arrays (besides history variables and
 #: neighbour lists): about 850 measured for block3d at 1M particles
@@ -95,7 +95,7 @@ def lattice_neighbours(radius: float, dim: int) -> float:
 def support_radius(sph) -> float:
     """The support radius in units of h for the deck's [sph] section ``sph``:
     the kernel's times ``support_scale``."""
-    from .kernels import kernel_id, support
+    from ..kernels import kernel_id, support
 
     return support(kernel_id(sph.kernel)) * sph.support_scale
 
@@ -258,7 +258,7 @@ def history_models(deck) -> list:
     """The material models whose history columns the model's items share: the
     deck's materials in order, and the uniaxial bar when a sublayer's
     particles carry the bar axially (``stiffness = "axial"``)."""
-    from .materials import UNIAXIAL, get_model
+    from ..materials import UNIAXIAL, get_model
 
     models = [get_model(m.model) for m in deck.material]
     if any(m.sublayer is not None and m.sublayer.stiffness == "axial" for m in deck.mesh):
@@ -271,7 +271,7 @@ def history_width(deck) -> int:
     laid side by side as the parts lay them
     (:func:`~sphdyn.materials.history_layout`; every material counted, an
     upper bound where a mesh has its own), at least one."""
-    from .materials import history_layout
+    from ..materials import history_layout
 
     models = history_models(deck)
     try:
@@ -302,7 +302,7 @@ def estimate_size(deck, model=None) -> SizeEstimate:
     converted element, and the hybrid layer's points) counted on the
     generated mesh when its elements fit in the memory limit; the debris of
     eroding elements at most ``particles_per_element`` per element. With a
-    built ``model`` (:func:`sphdyn.model.build_model`) the counts are its
+    built ``model`` (:func:`sphdyn.build.model.build_model`) the counts are its
     own. Neighbours per particle: the lattice points in the Verlet radius
     (:func:`verlet_radius` dx, :func:`lattice_neighbours`), at most the
     other particles. Memory: :data:`PARTICLE_BYTES` plus 8 bytes per history
@@ -335,7 +335,7 @@ def estimate_size(deck, model=None) -> SizeEstimate:
 
 def _converted_counts(deck) -> dict:
     """mesh name -> particles of the [mesh.convert] of each generated mesh."""
-    from .mesh_model import converted_count
+    from ..build.mesh_model import converted_count
 
     dim = deck.run.dimension
     return {m.name: float(converted_count(m, k, dim)) for k, m in enumerate(deck.mesh)
@@ -414,7 +414,7 @@ def has_particles(deck) -> bool:
 def _radius_field(sph, smallest: bool = False) -> tuple[str, float]:
     """The [sph] key that stretches the Verlet radius most over its
     default (``smallest``: shrinks it most), and its value."""
-    from .deck.sections.sph import Sph
+    from ..deck.sections.sph import Sph
 
     default = Sph()
     ratios = {"sph.h_factor": sph.h_factor / default.h_factor,
@@ -623,8 +623,8 @@ def node_sizes(points: np.ndarray, cells: np.ndarray, kind: str, dim: int) -> np
     its elements' sizes ``V_e^(1/d)``), with ``V_e`` the mean corner
     ``det J`` times ``2^d`` (exact for parallelepipeds); 0 for a node of no
     element."""
-    from .geometry.mesh import element_jacobians
-    from .parts.fem.solid_part import node_contact_items
+    from ..geometry.mesh import element_jacobians
+    from ..parts.fem.solid_part import node_contact_items
 
     vol = np.abs(element_jacobians(points, cells, kind).mean(axis=1)) * 2.0 ** dim
     zero = np.zeros(vol.shape[0])
@@ -669,7 +669,7 @@ def mesh_wall_problems(deck, meshes) -> list[str]:
 
 
 def check_meshes_in_domain(deck, meshes) -> None:
-    """DeckError for meshes (:class:`~sphdyn.mesh_model.MeshModel`) whose
+    """DeckError for meshes (:class:`~sphdyn.build.mesh_model.MeshModel`) whose
     nodes or converted particles lie outside the [domain] box, or that start
     inside a wall's contact (:func:`mesh_wall_problems`)."""
     problems = []
@@ -698,7 +698,7 @@ def checked_lattices(deck) -> tuple[SizeEstimate, list[np.ndarray]]:
     :func:`check_size` first (before any particle is made), then
     :func:`check_placement` on the lattices (n_b, 3) of the bodies.
     """
-    from .geometry import lattice_from_shape
+    from ..geometry import lattice_from_shape
 
     estimate = check_size(deck)
     dim = deck.run.dimension

@@ -30,11 +30,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .io.atomic import atomic_path
-from .io.plots import save_figure
-from .io import read_frame
-from .io.frames import frames_of_run
-from .io.history import read_history_csv
+from ..io.atomic import atomic_path
+from ..io.plots import save_figure
+from ..io import read_frame
+from ..io.frames import frames_of_run
+from ..io.history import read_history_csv
 
 __all__ = ["compression_curve", "ensemble_report"]
 

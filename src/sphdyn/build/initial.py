@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .deck.expressions import ExpressionError, evaluate
+from ..deck.expressions import ExpressionError, evaluate
 
 #: the stress component names and their (row, column) in the 3x3 tensor
 COMPONENTS = {"xx": (0, 0), "yy": (1, 1), "zz": (2, 2), "xy": (0, 1), "xz": (0, 2),
@@ -26,7 +26,7 @@ def read_points(path: Path, dim: int) -> dict[str, np.ndarray]:
     Needs ``x``, ``y`` (and ``z`` in 3D); other columns from ``vx, vy, vz,
     sxx, syy, szz, sxy, sxz, syz``. Returns arrays of shape (P,) by name.
     """
-    from .deck.sections.bodies import FILE_COLUMNS
+    from ..deck.sections.bodies import FILE_COLUMNS
 
     try:
         data = np.genfromtxt(path, delimiter=",", names=True, dtype=float,
