@@ -11,12 +11,18 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..deck.sections.meshes import PenaltyKeys
 from .base import InteractionBase
 from .penalty_geometry import (candidate_pairs, exterior_faces, face_anchors, face_nodes,
                                face_twins)
 from .penalty_kernels import max_shift, penalty_coupling_forces, tie_forces, withdraw_contact
 from .wall import STIFFNESS
 from .wall_contact import STIFFNESS_BULK
+
+
+#: the keys' defaults, as the deck's [mesh.contact], [mesh.convert] and
+#: [mesh.erosion] tables have them (one home: docs/deck-reference.md)
+DEFAULTS = PenaltyKeys()
 
 
 def _extended(a: np.ndarray, n: int, fill) -> np.ndarray:
@@ -72,10 +78,11 @@ class PenaltyCoupling(InteractionBase):
     been missed: a face point moves at most as far as its nodes).
     """
 
-    def __init__(self, name: str, sph_part, solid_part, faces=None, stiffness: str = "mass",
-                 alpha: float = 0.1, thickness_factor: float = 0.5, friction: float = 0.0,
-                 skin_factor: float = 1.0, tie_factor: float = 0.0,
-                 stiffness_step: str = "current"):
+    def __init__(self, name: str, sph_part, solid_part, faces=None,
+                 stiffness: str = DEFAULTS.stiffness, alpha: float = DEFAULTS.alpha,
+                 thickness_factor: float = DEFAULTS.thickness_factor,
+                 friction: float = DEFAULTS.friction, skin_factor: float = 1.0,
+                 tie_factor: float = 0.0, stiffness_step: str = DEFAULTS.stiffness_step):
         if stiffness not in STIFFNESS:
             raise ValueError(f"{name}: stiffness must be one of {tuple(STIFFNESS)}, "
                              f"got {stiffness!r}")
