@@ -69,6 +69,7 @@ __all__ = [
     "KERNEL_NAMES",
     "kernel_id",
     "support",
+    "radius_factor",
     "support_nb",
     "normalisation",
     "w",
@@ -152,6 +153,15 @@ def support(kid: int) -> float:
     ``W(r, h) = 0`` for ``r >= q_max * h``.
     """
     return _Q_MAX[_check_kid(kid)]
+
+
+def radius_factor(kid: int, support_scale: float) -> float:
+    r"""The support radius in units of ``h``: :math:`q_{max}\,\kappa`, the
+    kernel's ``q_max`` (:func:`support`) times the paper's :math:`\kappa`
+    (``sph.support_scale``; pairs use :math:`h_{ij} = \kappa (h_i + h_j)/2`).
+    The one formula of the support radius: the parts' neighbour searches
+    (:class:`KernelContext`) and the deck's checks use it."""
+    return support(kid) * support_scale
 
 
 @njit(cache=True, error_model="numpy")
@@ -547,7 +557,7 @@ class KernelContext:
 
     def __post_init__(self):
         object.__setattr__(self, "sigma", normalisation(self.kid, self.dim))
-        object.__setattr__(self, "radius_factor", support(self.kid) * self.support_scale)
+        object.__setattr__(self, "radius_factor", radius_factor(self.kid, self.support_scale))
 
     @classmethod
     def named(cls, name: str, dim: int, support_scale: float) -> "KernelContext":

@@ -93,11 +93,11 @@ def lattice_neighbours(radius: float, dim: int) -> float:
 
 
 def support_radius(sph) -> float:
-    """The support radius in units of h for the deck's [sph] section ``sph``:
-    the kernel's times ``support_scale``."""
-    from ..kernels import kernel_id, support
+    """The support radius in units of h for the deck's [sph] section ``sph``
+    (:func:`sphdyn.kernels.radius_factor`)."""
+    from ..kernels import kernel_id, radius_factor
 
-    return support(kernel_id(sph.kernel)) * sph.support_scale
+    return radius_factor(kernel_id(sph.kernel), sph.support_scale)
 
 
 def prism_volume(prism, dim: int) -> float:
