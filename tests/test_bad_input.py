@@ -17,7 +17,8 @@ import numba
 import pytest
 
 from decks import SMALL_DISC
-from sphdyn.cli import _threads, build_parser, main
+from sphdyn.cli import build_parser, main
+from sphdyn.cli.args import _threads
 from sphdyn.deck import DeckError, loads_deck
 from sphdyn.build.model import build_model
 

@@ -152,7 +152,7 @@ def test_the_material_test_takes_the_models_typical_density():
     """``sphdyn material-test`` without a density gives a solid its model's
     ``test_density`` (concrete 2400, steel 7850) and a fluid none: the
     explosive keeps its preset's (TNT 1630 kg/m^3), a gas must be given one."""
-    from sphdyn.cli import _test_density
+    from sphdyn.cli.material_test import _test_density
     from sphdyn.materials import get_model
 
     assert {name: get_model(name).test_density
