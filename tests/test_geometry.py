@@ -534,7 +534,7 @@ def test_tilted_cylinder_lattice_and_its_preflight_depth():
     from types import SimpleNamespace
 
     from sphdyn.geometry.lattice import rotate_about
-    from sphdyn.checks.preflight import depth_inside
+    from sphdyn.checks.placement import depth_inside
     c = [0.25, 0.25, 0.2]
     up = cylinder_lattice(c, 0.015, 0.07, "z", 0.003, 3)
     tilted = cylinder_lattice(c, 0.015, 0.07, "z", 0.003, 3, tilt=30.0, tilt_axis="y")
@@ -608,7 +608,8 @@ def test_ogive_preflight_depth_and_volume():
     from types import SimpleNamespace
 
     from sphdyn.geometry.lattice import ogive_lattice, ogive_profile, ogive_volume
-    from sphdyn.checks.preflight import depth_inside, shape_volume
+    from sphdyn.checks.size import shape_volume
+    from sphdyn.checks.placement import depth_inside
 
     a, length, psi = 0.01345, 0.2424, 2.0
     g = SimpleNamespace(shape="ogive", tip=(0.0, 0.0, 0.0), radius=a, length=length,

@@ -1,4 +1,4 @@
-"""The size estimate made before a model is built (sphdyn.checks.preflight)."""
+"""The size estimate made before a model is built (sphdyn.checks.size)."""
 
 import math
 from pathlib import Path
@@ -8,7 +8,7 @@ import pytest
 from sphdyn.deck import load_deck
 from sphdyn.build.model import build_model
 from sphdyn.neighbours import max_neighbours
-from sphdyn.checks.preflight import estimate_size, history_width, lattice_neighbours, shape_volume
+from sphdyn.checks.size import estimate_size, history_width, lattice_neighbours, shape_volume
 from sphdyn.simulation import Simulation
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -151,7 +151,7 @@ def test_lattice_neighbours_beyond_the_enumerated_radius_is_the_ball(radius, dim
     40 dx scaled by the volume ratio (the surface points' share there is
     3/40 at most; 1 % is what the two radii's counts differ by beyond the
     volume ratio). An overflowing radius gives inf."""
-    from sphdyn.checks.preflight import ball_volume
+    from sphdyn.checks.size import ball_volume
 
     got = lattice_neighbours(radius, dim)
     assert got == ball_volume(radius, dim) - 1.0

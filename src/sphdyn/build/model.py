@@ -23,8 +23,9 @@ from ..interactions.wall import STIFFNESS, WallSpec
 from ..deck import DeckError
 from ..deck.errors import format_problem
 from .detonation import light_explosives
-from ..checks.preflight import (check_meshes_in_domain, checked_lattices, history_models,
-                        support_radius)
+from ..checks.preflight import checked_lattices
+from ..checks.placement import check_meshes_in_domain
+from ..checks.size import history_models, support_radius
 from ..materials import MaterialGroup, available_models, get_model, history_layout
 from ..materials.uniaxial import UNIAXIAL, uniaxial_params
 from .mesh_model import MeshModel, build_meshes, mesh_node_set, pressure_faces, section_of

@@ -113,7 +113,7 @@ def cmd_ensemble(args) -> int:
 def cmd_check(args) -> int:
     from ..deck import load_deck
     from ..build.model import build_model
-    from ..checks.preflight import estimate_size, memory_limit, show_bytes
+    from ..checks.size import estimate_size, memory_limit, show_bytes
 
     deck = load_deck(args.deck, args.set)
     model = build_model(deck)  # refuses a model over the memory limit before building
