@@ -32,8 +32,8 @@ def shape_vectors(part, e: int) -> tuple[np.ndarray, float]:
     """Element ``e``'s hourglass shape vectors ``gamma`` (modes, nen) at its
     current node positions and its viscous coefficient ``a_h`` [kg/s], formed
     with NumPy (sphdyn.parts.fem.solid.hourglass_coefficient)."""
-    from sphdyn.parts.fem.solid import (HG_VISCOUS, hourglass_coefficient, hourglass_face,
-                                        volume_gradient)
+    from sphdyn.parts.fem.solid import volume_gradient
+    from sphdyn.parts.fem.hourglass import HG_VISCOUS, hourglass_coefficient, hourglass_face
 
     el, q, pts = part.el, part.nodes, part.pts
     conn = el.conn[e]

@@ -664,7 +664,7 @@ def test_the_overlap_bounds_the_angle_between_stiffness_and_hourglass_subspaces(
     OVERLAP_ROUNDOFF), and the formula's for an element distorted by 1e-3
     (mu - 1 far above it). The distorted ones reach 0.4 (the bound stays
     below 1)."""
-    from sphdyn.parts.fem.solid import hourglass_overlap
+    from sphdyn.parts.fem.hourglass import hourglass_overlap
 
     rng = np.random.default_rng(3)
     points, cells = block([0, 0, 0], [1, 1, 1], (1, 1, 1)[:dim], dim)
@@ -895,8 +895,8 @@ def test_the_hourglass_bound_and_rates():
     1/2, 1/2], [1/2, 1/4, ...]], trace 1.75, Gershgorin's largest row 2.5, so
     the trace is the smaller. hourglass_rates: (a_h lambda / (2 m), 0)
     viscous, (0, k_h lambda / m) stiffness, (0, 0) without control."""
-    from sphdyn.parts.fem.solid import (HG_STIFFNESS, HG_VISCOUS, hourglass_bound,
-                                        hourglass_rates)
+    from sphdyn.parts.fem.hourglass import (HG_STIFFNESS, HG_VISCOUS, hourglass_bound,
+                                            hourglass_rates)
 
     xl, g = np.zeros((8, 3)), np.ones((8, 3))
     gam = hourglass_vectors(3)

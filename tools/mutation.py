@@ -222,7 +222,7 @@ MUTANTS: tuple[Mutant, ...] = (
            "i_r = PSI * ms * 10.0 ** fit(", "i_r = PSI * MS_LB * 10.0 ** fit(",
            ("tests/test_blast_load.py::test_parameters_scale_with_the_cube_root_of_the_charge",),
            "reflected impulse not scaled by the cube root of the charge"),
-    Mutant("hex_lanes_viscous_quarter", "issue 15", "sphdyn/parts/fem/solid.py",
+    Mutant("hex_lanes_viscous_quarter", "issue 15", "sphdyn/parts/fem/hourglass.py",
            "return qh * rho * c * face / 4.0",
            "return qh * rho * c * face / 2.0",
            ("tests/test_fem_solid.py::test_hourglass_force_of_a_cube_matches_its_formula"
@@ -233,16 +233,16 @@ MUTANTS: tuple[Mutant, ...] = (
            ("tests/test_fem_solid.py::test_element_step_with_hourglass_terms_is_the_"
             "damped_oscillator_limit",),
            "element step: the hourglass damping rate's share A_h l / 2 -> l / 4"),
-    Mutant("hourglass_rate_no_half", "issue 53", "sphdyn/parts/fem/solid.py",
+    Mutant("hourglass_rate_no_half", "issue 53", "sphdyn/parts/fem/hourglass.py",
            "return 0.5 * coef * lam / m_share, 0.0", "return coef * lam / m_share, 0.0",
            ("tests/test_fem_solid.py::test_the_hourglass_bound_and_rates",),
            "hourglass damping rate a_h lambda / (2 m) -> a_h lambda / m"),
-    Mutant("hourglass_overlap_dimension", "issue 53", "sphdyn/parts/fem/solid.py",
+    Mutant("hourglass_overlap_dimension", "issue 53", "sphdyn/parts/fem/hourglass.py",
            "mu = t / (V * V) - (dim - 1)", "mu = t / (V * V) - dim",
            ("tests/test_fem_solid.py::test_the_overlap_bounds_the_angle_between_stiffness_"
             "and_hourglass_subspaces[3]",),
            "subspace overlap: mu = tr(Gx Gb) - (d - 1) -> - d (below the true angle)"),
-    Mutant("overlap_roundoff_wide", "issue 53", "sphdyn/parts/fem/solid.py",
+    Mutant("overlap_roundoff_wide", "issue 53", "sphdyn/parts/fem/hourglass.py",
            "OVERLAP_ROUNDOFF = 1e-10", "OVERLAP_ROUNDOFF = 1e-4",
            ("tests/test_fem_solid.py::test_the_overlap_bounds_the_angle_between_stiffness_"
             "and_hourglass_subspaces[3]",),

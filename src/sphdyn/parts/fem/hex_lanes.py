@@ -34,9 +34,9 @@ from .hex_gradient import hex_volume_gradient_lanes
 from .lane_layout import (C_, COEF_, DKK_, DT_, ELL_, F_, FACE_, G_, GM_, HEAT_, HG_, INV_, INVV_,
                           L_, LANES, LB_, M_, MSH_, MX_, OV_, POWER_, PX_, Q_, QA_, RG_, RHO_, ROW_,
                           ROWS, SIG_, TR_, VN_, VOL_, X_)
-from .solid import (HG_VISCOUS, block_count, block_span, bulk_viscosity, element_step,
-                     hourglass_coefficient, hourglass_face, hourglass_rates,
-                     length_from_gradient, overlap_from_moments)
+from .solid import block_count, block_span, bulk_viscosity, element_step, length_from_gradient
+from .hourglass import (HG_VISCOUS, hourglass_coefficient, hourglass_face, hourglass_rates,
+                        overlap_from_moments)
 
 #: hourglass base vectors (4, 8) of the hex8, a compile-time constant
 GAMMA = hourglass_vectors(3)

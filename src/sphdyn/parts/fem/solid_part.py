@@ -31,10 +31,10 @@ from ..base import register_part
 from .gather import gather_loads, node_element_list
 from .output import mesh_frame, mesh_summary
 from .hex_lanes import hex_forces, hex_strain_rate, lane_scratch
-from .solid import (DT_BLOCKS, HG_STIFFNESS, HG_VISCOUS, block_scratch, char_length,
-                    element_step, element_volumes, hourglass_bound, hourglass_overlap,
+from .solid import (DT_BLOCKS, block_scratch, char_length, element_step, element_volumes,
                     local_coordinates, min_time_step, reduced_forces, reduced_strain_rate,
                     uniform_forces, uniform_strain_rate, volume_gradient, weigh_point_work)
+from .hourglass import HG_STIFFNESS, HG_VISCOUS, hourglass_bound, hourglass_overlap
 
 INTEGRATIONS = ("one_point", "selective_reduced")
 HOURGLASS_FORMS = {"viscous": HG_VISCOUS, "stiffness": HG_STIFFNESS}
