@@ -1,7 +1,7 @@
 """The velocity-gradient pass with its row buffer against pair by pair, one process.
 
 Steps a deck ``--start`` steps, then calls
-:func:`sphdyn.parts.sph.passes.velocity_gradient` on that state in turns
+:func:`sphdyn.parts.sph.gradient.velocity_gradient` on that state in turns
 with the part's row buffer and with a zero-width one (which sends every row
 through the pair-by-pair code), ``--rounds`` times each, and prints the best
 and median nanoseconds per pair within the support. Both forms give the
@@ -26,7 +26,7 @@ import numpy as np
 from sphdyn.build import build_stepper
 from sphdyn.bench import case_deck
 from sphdyn.deck import load_deck
-from sphdyn.parts.sph.passes import GRADIENT_CHUNKS, GRADIENT_ROWS, velocity_gradient
+from sphdyn.parts.sph.gradient import GRADIENT_CHUNKS, GRADIENT_ROWS, velocity_gradient
 
 
 def main() -> None:

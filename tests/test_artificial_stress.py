@@ -9,7 +9,7 @@ from sphdyn.geometry import box_lattice
 from sphdyn.neighbours import build_neighbours
 from stepping import build_stepper
 from sphdyn.parts.sph.artificial_stress import artificial_stress_forces, artificial_stress_tensor
-from sphdyn.parts.sph.passes import gradient_scratch, velocity_gradient
+from sphdyn.parts.sph.gradient import gradient_scratch, velocity_gradient
 
 RHO = 1000.0
 EPS = 0.3

@@ -32,7 +32,7 @@ choice, docs/cscm.md: returned points move by ~1e-7 of the return
 distance), and the SPH force pass sums ``(P_i + P_j) g`` with
 ``P = sigma B / rho^2`` formed once per particle (round-off), with the
 pair factors stored in single precision (deliberate: memory; L and B are
-summed from the rounded factors, see passes.velocity_gradient). The decks
+summed from the rounded factors, see gradient.velocity_gradient). The decks
 whose results changed were rewritten; the others are bitwise as before. BENCHMARKS.md gives the effect on the coarse drop-weight's
 history.
 2026-11-26 (later): the total-Lagrangian pair loops lost their fastmath

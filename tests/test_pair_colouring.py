@@ -19,7 +19,8 @@ from sphdyn import kernels
 from sphdyn.neighbours import build_neighbours
 from sphdyn.parts.sph.colouring import (MAX_SLABS, balanced_bounds, colour_pairs,
                                         own_pairs_first, pair_colouring)
-from sphdyn.parts.sph.passes import forces, gradient_scratch, velocity_gradient
+from sphdyn.parts.sph.passes import forces
+from sphdyn.parts.sph.gradient import gradient_scratch, velocity_gradient
 
 
 def _cloud(dim, shape, dx=0.01, seed=0):

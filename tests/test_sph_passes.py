@@ -7,9 +7,9 @@ from sphdyn import kernels
 from sphdyn.geometry import box_lattice
 from sphdyn.neighbours import build_neighbours
 from sphdyn.parts.sph.colouring import colour_pairs
-from sphdyn.parts.sph.passes import (GRADIENT_CHUNKS, GRADIENT_ROWS, forces, gradient_scratch,
-                                     stress_terms,
-                                     update_density_and_h, velocity_gradient, xsph_velocity)
+from sphdyn.parts.sph.passes import forces, stress_terms, update_density_and_h, xsph_velocity
+from sphdyn.parts.sph.gradient import (GRADIENT_CHUNKS, GRADIENT_ROWS, gradient_scratch,
+                                       velocity_gradient)
 
 
 def _cloud(dim, n_side=12, dx=0.01, hfac=1.3, kernel="cubic_spline", jitter=0.0,

@@ -49,7 +49,7 @@ def set_pair_gradient(rows, member, offsets, idx, fac, pos, v, w, rho, B, Finv, 
     r"""The share of the pairs within a set in each member's velocity gradient.
 
     Updated-Lagrangian (``tl`` False; the terms of
-    :func:`sphdyn.parts.sph.passes.velocity_gradient` that those pairs gave):
+    :func:`sphdyn.parts.sph.gradient.velocity_gradient` that those pairs gave):
 
     .. math:: \mathbf L^{ss}_i = \Big[\sum_{j\ \mathrm{in\ the\ set}}
               \frac{m_j}{\rho_i}\,

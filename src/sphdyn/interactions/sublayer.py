@@ -58,7 +58,7 @@ import numpy as np
 from numba import njit, prange
 
 from ..materials.uniaxial import H_DIRECTION, UNIAXIAL
-from ..parts.sph.passes import finish_row
+from ..parts.sph.gradient import finish_row
 from ..state import BC_FREE, BC_SLAVE
 from .base import InteractionBase
 from .slaves import follow_masters, pass_on, set_pair_gradient, set_pairs_off
@@ -133,8 +133,8 @@ def gradient_without_set(rows, member, offsets, idx, fac, x, v, m, rho, dim, L, 
         \qquad \mathbf d_{ij} = \mathbf x_i - \mathbf x_j
 
     and :math:`B_i = Q_i`: the Randles-Libersky correction of
-    :func:`sphdyn.parts.sph.passes.velocity_gradient` (the same row end,
-    :func:`~sphdyn.parts.sph.passes.finish_row`) with the set's own pairs out
+    :func:`sphdyn.parts.sph.gradient.velocity_gradient` (the same row end,
+    :func:`~sphdyn.parts.sph.gradient.finish_row`) with the set's own pairs out
     of both sums, so a bar particle in a linear velocity field has its
     gradient exactly. (Out of the velocity sum only, as without correction,
     the bar's pairs in the moment matrix scaled the strain rate along the bar

@@ -157,7 +157,7 @@ def artificial_stress_forces(x, m, h, R, F, offsets, idx, kid, dim, support_scal
     m, h : (N,) mass [kg] (kg/m in 2D), smoothing length [m].
     R : (N, 3, 3) from :func:`artificial_stress_tensor` [Pa m^6/kg^2].
     F : (nnz,) pair gradient factors from
-        :func:`sphdyn.parts.sph.passes.velocity_gradient` [1/m^(d+2)]
+        :func:`sphdyn.parts.sph.gradient.velocity_gradient` [1/m^(d+2)]
         (``grad_i W_ij = F_ij (x_i - x_j)``).
     offsets, idx : CSR neighbour list.
     kid, dim, support_scale : kernel id, dimension, support scale kappa.

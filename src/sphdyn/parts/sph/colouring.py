@@ -16,7 +16,7 @@ terms are summed is fixed by the colouring, not by the number of threads.
 This is the half-list form of a pair loop (as with LAMMPS's ``newton on``)
 with the race-free scheduling of a domain colouring. It needs each pair's
 data to be the same in both of its rows (the pair factors of
-:func:`~sphdyn.parts.sph.passes.velocity_gradient` are: they depend on
+:func:`~sphdyn.parts.sph.gradient.velocity_gradient` are: they depend on
 :math:`r_{ij}^2` and :math:`h_i + h_j` only; couplings take pairs out in both
 rows) and the list to be symmetric (the Verlet list is).
 """
@@ -160,7 +160,7 @@ def own_pairs_first(rank, offsets, idx):
     """Put each row's own pairs (``rank[j] > rank[i]``, the pairs the force
     pass works from row ``i``) first, in the order they had, the others after
     them, in place (the list keeps its pairs); returns ``n_own`` (N,) int32,
-    the own pairs of each row. :func:`~sphdyn.parts.sph.passes.velocity_gradient`
+    the own pairs of each row. :func:`~sphdyn.parts.sph.gradient.velocity_gradient`
     keeps the two parts apart when it partitions the rows, so the force pass
     visits its pairs without testing the ranks."""
     n = rank.shape[0]

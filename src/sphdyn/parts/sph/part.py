@@ -43,8 +43,8 @@ from ...state import BC_FIXED, STATE, Particles
 from ..base import register_part
 from .artificial_stress import artificial_stress_forces, artificial_stress_tensor
 from .colouring import colour_pairs
-from .passes import (forces, gradient_scratch, stress_terms, update_density_and_h,
-                     velocity_gradient, xsph_velocity)
+from .passes import forces, stress_terms, update_density_and_h, xsph_velocity
+from .gradient import gradient_scratch, velocity_gradient
 from .swegle import FLAG_FRACTION, count_unstable, stress_tolerance, swegle_indicator
 from .tl_scheme import TotalLagrangian
 
@@ -475,8 +475,8 @@ class SPHPart:
             self.tl.accelerations(p, p.dedt_av)
 
     def _gradient_scratch(self):
-        """The row buffers of :func:`.passes.velocity_gradient`
-        (:func:`.passes.gradient_scratch`), widened after a neighbour rebuild
+        """The row buffers of :func:`.gradient.velocity_gradient`
+        (:func:`.gradient.gradient_scratch`), widened after a neighbour rebuild
         that made a row longer."""
         nl = self.nl
         if self._scratch_list != (id(nl), nl.n_builds):
