@@ -12,6 +12,7 @@ masses, ``[[balls]]``) and an interaction (a uniform acceleration on a part,
 import numpy as np
 import pytest
 
+from sphdyn import plugins
 from sphdyn.build import Builder, Built, builders, register, registry
 from sphdyn.deck import DeckError, deck_model, loads_deck
 from sphdyn.parts import base
@@ -116,7 +117,7 @@ def toy_installed(tmp_path, monkeypatch):
     forget = install_toy(tmp_path, monkeypatch, "toy_builders", TOY, "sphdyn.builders",
                          {"balls": "toy_builders:BALLS", "field": "toy_builders:FIELD"})
     monkeypatch.setattr(registry, "REGISTRY", dict(registry.REGISTRY))
-    monkeypatch.setattr(registry, "entry_points_loaded", False)
+    monkeypatch.setattr(plugins, "LOADED", plugins.LOADED - {registry.ENTRY_POINT_GROUP})
     monkeypatch.setattr(base, "PART_KINDS", dict(base.PART_KINDS))
     yield
     forget()

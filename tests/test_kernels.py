@@ -295,3 +295,17 @@ def test_kernel_context_holds_the_kernel_as_one_thing():
     assert k.radius_factor == 3.0 and k.support_scale == 1.5
     with pytest.raises(ValueError, match="unknown kernel"):
         K.KernelContext.named("bogus", 3, 1.0)
+
+
+def test_the_deck_check_and_the_parts_take_one_support_radius():
+    # q_max kappa: the quintic spline reaches 3 h (Morris 1996), the Wendland C2
+    # 2 h; the deck's checks (checks.size.support_radius) and the kernel
+    # context of the parts give the same radius from kernels.radius_factor
+    from sphdyn.checks.size import support_radius
+    from sphdyn.deck.sections.sph import Sph
+
+    assert K.radius_factor(K.kernel_id("quintic_spline"), 1.2) == pytest.approx(3.6)
+    assert K.radius_factor(K.kernel_id("wendland_c2"), 1.5) == pytest.approx(3.0)
+    for name in K.KERNEL_NAMES:
+        sph = Sph(kernel=name, support_scale=1.3)
+        assert support_radius(sph) == K.KernelContext.named(name, 2, 1.3).radius_factor

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from sphdyn.deck import DeckError, deck_model, loads_deck
+from sphdyn import plugins
 from sphdyn.materials import ELASTIC, MaterialModel, registry
 from sphdyn.simulation import Simulation
 from toys import install_toy
@@ -73,7 +74,7 @@ def toy_installed(tmp_path, monkeypatch):
     forget = install_toy(tmp_path, monkeypatch, "toy_material", TOY, "sphdyn.materials",
                          {"toy": "toy_material:MODEL"})
     monkeypatch.setattr(registry, "REGISTRY", dict(registry.REGISTRY))
-    monkeypatch.setattr(registry, "entry_points_loaded", False)
+    monkeypatch.setattr(plugins, "LOADED", plugins.LOADED - {registry.ENTRY_POINT_GROUP})
     yield
     forget()
 

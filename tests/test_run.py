@@ -11,6 +11,7 @@ import pytest
 from sphdyn.cli import main
 from sphdyn.deck import loads_deck
 from sphdyn.watchers.guards import SimulationFailed
+from sphdyn.analysis.fragments import window_mean_force
 from sphdyn.io import read_checkpoint, read_frame, read_history_csv, read_pvd
 from sphdyn.simulation import Simulation
 from decks import SMALL_DISC
@@ -495,3 +496,34 @@ reduce = "max"
     # where the pressure is tensile) or the ductile one (where compressive)
     assert np.all(p.damage <= np.maximum(fields["damage_brittle"],
                                          fields["damage_ductile"]) + 1e-15)
+
+
+#: a core of the small disc held fixed: its reaction carries the disc's impact
+CORE = """
+[[set]]
+name = "core"
+body = "disc"
+region = { shape = "box", lo = [-0.002, 0.004, -1], hi = [0.002, 0.008, 1] }
+[[boundary]]
+set = "core"
+type = "fixed"
+"""
+
+
+def test_the_summarys_peaks_are_those_of_the_history(tmp_path):
+    # Each wall and boundary summarises its own history columns: the largest
+    # normal force, the largest mean over the force window (from the impulse,
+    # analysis.fragments.window_mean_force) and the largest magnitude of the
+    # reaction. The history file holds the same numbers (%.17g), so the three
+    # agree to round-off of the mean's interpolation (1e-12 relative).
+    text = SMALL_DISC.format(t_end="1 ms", ck=0) + CORE
+    summary = Simulation.from_deck(loads_deck(text), tmp_path / "out").run(progress=False)
+    h = read_history_csv(tmp_path / "out" / "history.csv")
+    assert summary["peak_F_wall_floor"] == pytest.approx(np.max(h["F_wall_floor"]),
+                                                         rel=1e-12)
+    mean = window_mean_force(h["time"], h["I_wall_floor"], summary["force_window"])
+    assert summary["peak_F_wall_floor_mean"] == pytest.approx(np.max(mean), rel=1e-12)
+    assert summary["peak_F_wall_floor_mean"] < summary["peak_F_wall_floor"]
+    r = np.linalg.norm([h[f"core_reaction_{c}"] for c in "xyz"], axis=0)
+    assert summary["peak_core_reaction"] == pytest.approx(np.max(r), rel=1e-12)
+    assert summary["peak_core_reaction"] > 0.0

@@ -4,9 +4,9 @@
 
 An entry point names an object of the expected type, or a callable that
 returns one (or registers it itself and returns None). Each group is loaded
-once, when its registry is first asked; a failing entry point is skipped
-with a ``RuntimeWarning``, so a broken plugin never stops a deck that does
-not use it.
+once, when its registry is first asked (:data:`LOADED`); a failing entry
+point is skipped with a ``RuntimeWarning``, so a broken plugin never stops a
+deck that does not use it.
 """
 
 from __future__ import annotations
@@ -16,9 +16,18 @@ from importlib.metadata import entry_points
 from typing import Callable
 
 
+#: the groups loaded so far; a group taken out is loaded again when next asked (tests)
+LOADED: frozenset[str] = frozenset()
+
+
 def load_group(group: str, kind: type, add: Callable[[object], None]) -> None:
-    """Call ``add(obj)`` for each object of type ``kind`` the entry points of
-    ``group`` give (each loaded, called if it is not a ``kind``)."""
+    """Once per group: call ``add(obj)`` for each object of type ``kind`` the
+    entry points of ``group`` give (each loaded, called if it is not a
+    ``kind``)."""
+    global LOADED
+    if group in LOADED:
+        return
+    LOADED = LOADED | {group}
     for ep in entry_points(group=group):
         try:
             found = ep.load()

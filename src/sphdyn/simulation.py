@@ -307,8 +307,9 @@ class Simulation:
             drift = relative_drift(h["E_total"], [h[c] for c in energy_columns(list(h))])
             summary["energy_error_max_rel"] = float(np.max(np.abs(drift)))
         window = deck.output.force_window
-        for i in s.interactions:  # a wall's peak forces, a boundary's peak reaction
-            summary.update(i.summary(h, window) if h else {})
+        if h:
+            for i in s.interactions:  # a wall's peak forces, a boundary's peak reaction
+                summary.update(i.summary(h, window))
         if self.model.walls:
             summary["force_window"] = window
         return summary

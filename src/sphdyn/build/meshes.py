@@ -74,9 +74,9 @@ def build_mesh_parts(ctx) -> Built:
 
 def build_mesh_tables(ctx) -> Built:
     """Each mesh's sub-table builders (``Builder.mesh``), mesh by mesh."""
-    out = Built()
+    out, tables = Built(), builders(mesh=True)  # by their stages, 400-499
     for mm in ctx.model.meshes:
-        for b in builders(mesh=True):  # by their stages, 400-499
+        for b in tables:
             out.extend(b.build(ctx, mm))
     return out
 

@@ -94,9 +94,6 @@ class Builder:
 #: (table, stage) -> builder, in registration order
 REGISTRY: dict[tuple[str, int], Builder] = {}
 
-#: True once the entry points have been loaded; False loads them again (tests)
-entry_points_loaded = False
-
 _TABLE = re.compile(r"[a-z][a-z0-9_]*")
 
 
@@ -124,10 +121,6 @@ def register(builder: Builder, *, replace: bool = False) -> Builder:
 
 def load_entry_points() -> None:
     """Register the builders of the ``sphdyn.builders`` entry points (once)."""
-    global entry_points_loaded
-    if entry_points_loaded:
-        return
-    entry_points_loaded = True
     load_group(ENTRY_POINT_GROUP, Builder,
                lambda b: None if REGISTRY.get(b.key) is b else register(b))
 

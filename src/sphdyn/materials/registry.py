@@ -233,10 +233,6 @@ class MaterialModel:
 
 REGISTRY: dict[str, MaterialModel] = {}
 
-#: True once the entry points of :data:`ENTRY_POINT_GROUP` have been loaded;
-#: set it back to False to load them again (tests).
-entry_points_loaded = False
-
 
 def register(model: MaterialModel, *, replace: bool = False) -> MaterialModel:
     """Add ``model`` to :data:`REGISTRY` under ``model.name``.
@@ -257,10 +253,6 @@ def register(model: MaterialModel, *, replace: bool = False) -> MaterialModel:
 
 def load_entry_points() -> None:
     """Register the models of the ``sphdyn.materials`` entry points (once)."""
-    global entry_points_loaded
-    if entry_points_loaded:
-        return
-    entry_points_loaded = True
     load_group(ENTRY_POINT_GROUP, MaterialModel,
                lambda m: None if REGISTRY.get(m.name) is m else register(m))
 
