@@ -184,8 +184,8 @@ def test_another_part_leaves_the_sph_part_bitwise_unchanged():
     for _ in range(100):
         alone.step()
         both.step()
-    for name, arr in alone.particles.arrays().items():
-        assert np.array_equal(arr, getattr(both.particles, name)), name
+    for name, arr in alone.part("sph").kin.arrays().items():
+        assert np.array_equal(arr, getattr(both.part("sph").kin, name)), name
 
 
 def test_the_step_is_the_smallest_of_parts_interactions_and_dt_max():

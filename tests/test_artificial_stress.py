@@ -195,7 +195,7 @@ def test_solver_with_artificial_stress_conserves_momentum():
     # free body in uniform motion: total momentum unchanged to round-off
     d = loads_deck(DECK.format(eps=0.3))
     s = build_stepper(d)
-    p = s.particles
+    p = s.part("sph").kin
     p.v[:, 1] = 0.3 * np.sin(300.0 * p.x[:, 0])  # shear, tension and compression
     p0 = (p.m[:, None] * p.v).sum(axis=0)
     for _ in range(30):
@@ -219,12 +219,12 @@ geometry = { shape = "box", lo = [0.02, 0], hi = [0.03, 0.01] }
 """
     d = loads_deck(second)
     s = build_stepper(d)
-    p = s.particles
-    assert np.array_equal(s.particles.as_eps, np.where(p.body == 0, 0.3, 0.0))
+    p = s.part("sph").kin
+    assert np.array_equal(s.part("sph").kin.as_eps, np.where(p.body == 0, 0.3, 0.0))
     p.sig[:] = 0.0
     p.sig[:, 0, 0] = 1e5  # uniaxial tension everywhere
     s.part("sph")._accelerations()
-    R = s.particles.R
+    R = s.part("sph").kin.R
     assert np.all(R[p.body == 1] == 0.0)
     # first body: R = diag(-eps sigma_xx / rho^2, 0, 0) (Gray et al. 2001,
     # eq. 4.8) with its own density; a diagonal stress needs no Jacobi

@@ -144,8 +144,8 @@ def test_the_toy_part_and_interaction_run_from_a_deck(toy_installed, tmp_path):
     x0 = np.array([[0.012, 0.015, 0.0], [0.014, 0.02, 0.0]])
     exact = x0 + np.array([1.0, 2.0, 0.0]) * s.t + 0.5 * np.array([0, -9.81, 0]) * s.t ** 2
     assert np.abs(balls.kin.x - exact).max() < 1e-12 * np.abs(exact - x0).max()
-    for name, arr in alone.particles.arrays().items():
-        assert np.array_equal(arr, getattr(s.particles, name)), name
+    for name, arr in alone.part("sph").kin.arrays().items():
+        assert np.array_equal(arr, getattr(s.part("sph").kin, name)), name
 
 
 def test_the_toy_deck_runs_as_a_simulation(toy_installed, tmp_path):

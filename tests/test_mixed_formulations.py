@@ -44,7 +44,7 @@ def test_mixed_bodies_keep_separate_lists_and_collide_through_contact():
     # contact (on by default because one body is total-Lagrangian).
     d = loads_deck(DECK)
     s = build_stepper(d)
-    p = s.particles
+    p = s.part("sph").kin
     tl = p.body == 1
     assert s.part("sph").tl is not None and s.interactions[0].name == "contact"
     ul_rows = np.repeat(np.arange(p.n), np.diff(s.part("sph").nl.offsets))
@@ -83,7 +83,7 @@ def test_reference_update_restarts_F_and_keeps_L_exact():
     d = loads_deck(DECK.replace('formulation = "total_lagrangian"\n', "").replace(
         "[sph]", '[sph]\nformulation = "total_lagrangian"'))
     s = build_stepper(d)
-    p, tl = s.particles, s.part("sph").tl
+    p, tl = s.part("sph").kin, s.part("sph").tl
     A = np.array([[1.2, 0.3, 0.0], [-0.1, 0.9, 0.0], [0.0, 0.0, 1.0]])
     W = np.array([[0.0, 2.0, 0.0], [-1.0, 0.5, 0.0], [0.0, 0.0, 0.0]])
     p.x[:] = p.x0 @ A.T

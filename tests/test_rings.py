@@ -114,13 +114,13 @@ def _rings(eps):
 
 
 def _left_velocity(s):
-    left = s.particles.body == 0
-    return float((s.particles.m[left] * s.particles.v[left, 0]).sum() / s.particles.m[left].sum())
+    left = s.part("sph").kin.body == 0
+    return float((s.part("sph").kin.m[left] * s.part("sph").kin.v[left, 0]).sum() / s.part("sph").kin.m[left].sum())
 
 
 def _largest_share(s):
     """Smallest over the rings of (largest fragment) / (ring particles), link 1.5 dx."""
-    p = s.particles
+    p = s.part("sph").kin
     lab = fragment_labels(p.x, 1.5 * DX, p.body)
     sizes = fragment_sizes(lab)
     return min(sizes[np.unique(lab[p.body == b])].max() / (p.body == b).sum()
@@ -142,7 +142,7 @@ def test_plain_sph_rings_fracture():
     # largest, far from the intact values (1 and 100 %).
     s = _rings(0.0)
     _run(s, 6.5e-3)
-    frags = count_fragments(s.particles.x, 1.5 * DX, s.particles.body)
+    frags = count_fragments(s.part("sph").kin.x, 1.5 * DX, s.part("sph").kin.body)
     assert min(frags.values()) >= 3, frags
     assert _largest_share(s) < 0.8
     assert _left_velocity(s) > 0.1 * V0  # still approaching: no rebound
@@ -160,7 +160,7 @@ def test_artificial_stress_keeps_rings_intact_and_they_bounce():
     t_check = [2e-3, 4e-3, 6e-3, 8e-3, 10.5e-3]
     for t in t_check:
         _run(s, t)
-        assert count_fragments(s.particles.x, 1.5 * DX, s.particles.body) == {0: 1, 1: 1}, t
+        assert count_fragments(s.part("sph").kin.x, 1.5 * DX, s.part("sph").kin.body) == {0: 1, 1: 1}, t
     v1 = _left_velocity(s)
     _run(s, 11e-3)
     v2 = _left_velocity(s)
@@ -172,9 +172,9 @@ def test_artificial_stress_keeps_rings_intact_and_they_bounce():
     rec = s.record(kinetic=s.kinetic_now(), dt=0.0)
     assert abs(rec["E_total"] - e0) < 0.015 * e0
     # separated by more than the support radius 2 h
-    xl = s.particles.x[s.particles.body == 0, 0].max()
-    xr = s.particles.x[s.particles.body == 1, 0].min()
-    assert xr - xl > 2 * s.particles.h.max()
+    xl = s.part("sph").kin.x[s.part("sph").kin.body == 0, 0].max()
+    xr = s.part("sph").kin.x[s.part("sph").kin.body == 1, 0].min()
+    assert xr - xl > 2 * s.part("sph").kin.h.max()
 
 
 # ------------------------------------------------------- total-Lagrangian rings
@@ -201,7 +201,7 @@ def test_total_lagrangian_rings_bounce_back_intact():
     e0 = s.record(kinetic=s.kinetic_now(), dt=0.0)["E_total"]
     for t in (2e-3, 4e-3, 6e-3, 8e-3, 10e-3):
         _run(s, t)
-        assert count_fragments(s.particles.x, 1.5 * DX, s.particles.body) == {0: 1, 1: 1}, t
+        assert count_fragments(s.part("sph").kin.x, 1.5 * DX, s.part("sph").kin.body) == {0: 1, 1: 1}, t
     v1 = _left_velocity(s)
     _run(s, 10.5e-3)
     rec = s.record(kinetic=s.kinetic_now(), dt=0.0)
@@ -235,7 +235,7 @@ def test_total_lagrangian_rings_with_reference_updates():
     e0 = s.record(kinetic=s.kinetic_now(), dt=0.0)["E_total"]
     _run(s, 10.5e-3)
     assert s.part("sph").tl.n_updates >= 25
-    assert count_fragments(s.particles.x, 1.5 * DX, s.particles.body) == {0: 1, 1: 1}
+    assert count_fragments(s.part("sph").kin.x, 1.5 * DX, s.part("sph").kin.body) == {0: 1, 1: 1}
     rec = s.record(kinetic=s.kinetic_now(), dt=0.0)
     assert _left_velocity(s) < -0.6 * V0
     assert abs(rec["E_total"] - e0) < 0.04 * e0

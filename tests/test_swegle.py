@@ -156,19 +156,19 @@ fields = ["swegle"]
 def test_solver_output_field_and_history_column():
     d = loads_deck(DECK)
     s = build_stepper(d)
-    s.particles.sig[:] = _uniform(s.particles.n, sxx=S)
-    f = particle_fields(s.particles, ["swegle"], s.part("sph").fields())["swegle"]
-    assert f.shape == (s.particles.n,)
+    s.part("sph").kin.sig[:] = _uniform(s.part("sph").kin.n, sxx=S)
+    f = particle_fields(s.part("sph").kin, ["swegle"], s.part("sph").fields())["swegle"]
+    assert f.shape == (s.part("sph").kin.n,)
     assert np.all(f > FLAG_FRACTION)
     rec = s.record(kinetic=0.0, dt=0.0)
-    assert rec["swegle_unstable"] == s.particles.n
+    assert rec["swegle_unstable"] == s.part("sph").kin.n
     # the field is a copy; a stress-free state after a step flags nothing
     f[:] = -1.0
-    s.particles.sig[:] = 0.0
-    s.particles.v[:] = 0.0
+    s.part("sph").kin.sig[:] = 0.0
+    s.part("sph").kin.v[:] = 0.0
     s.step()
-    s.particles.sig[:] = 0.0
-    assert np.all(particle_fields(s.particles, ["swegle"], s.part("sph").fields())["swegle"] == 0.0)
+    s.part("sph").kin.sig[:] = 0.0
+    assert np.all(particle_fields(s.part("sph").kin, ["swegle"], s.part("sph").fields())["swegle"] == 0.0)
     assert s.record(kinetic=0.0, dt=0.0)["swegle_unstable"] == 0.0
 
 

@@ -162,7 +162,7 @@ def test_tie_map_is_the_derivative_of_the_anchor(dim):
 def test_tied_slaves_give_their_mass_to_the_face_nodes_and_move_with_them():
     deck = bar3d("tied")
     s = build_stepper(deck)
-    p, q = s.particles, s.part("bar").kin
+    p, q = s.part("sph").kin, s.part("bar").kin
     cpl = s.interactions[-1]
     # 3 x 2 x 2 converted elements: both end layers (4 each) are tied
     assert cpl.slaves.size == 8 and np.all(p.bc[cpl.slaves] == BC_SLAVE)
@@ -208,7 +208,7 @@ def test_hybrid_points_fill_the_layer_next_to_the_converted_elements(one_point):
 def test_hybrid_particles_ride_their_elements_and_skip_each_other():
     deck = bar2d("hybrid", nx=40)
     s = build_stepper(deck)
-    p, solid = s.particles, s.part("bar")
+    p, solid = s.part("sph").kin, s.part("bar")
     cpl = s.interactions[-1]
     assert cpl.rows.size == 2  # one element layer of 2 next to x = 1
     sph = s.parts[0]
@@ -242,7 +242,7 @@ def test_total_lagrangian_hybrid_pairs_leave_the_forces_but_not_the_gradient():
     # same convention: sign, transpose and factor).
     s = build_stepper(loads_deck(bar3d_text("hybrid") + TL))
     sph = s.parts[0]
-    t, cpl, p = sph.tl, s.interactions[-1], s.particles
+    t, cpl, p = sph.tl, s.interactions[-1], s.part("sph").kin
     assert cpl.tl and cpl.rows.size == 8  # one layer of 2 x 2 elements, 2 sides
     rows = np.repeat(np.arange(t.offsets.size - 1), np.diff(t.offsets))
     cut = cpl.hybrid[rows] & cpl.hybrid[t.idx]
@@ -311,7 +311,7 @@ def test_compression_pulse_passes_from_particles_into_elements(kind):
     # artificial viscosity takes some on the way). Energy: the total at the
     # end is the initial kinetic energy, none created (< 0.1 %).
     s = build_stepper(bar2d(kind, nx=320))
-    p, q = s.particles, s.part("bar").kin
+    p, q = s.part("sph").kin, s.part("bar").kin
     free = p.bc != BC_SLAVE
     v0, lam, x0 = 1.0, 0.3, 0.45
     z = (p.x[free, 0] - x0) / lam
@@ -384,6 +384,6 @@ def test_converted_region_without_coupling_is_damped_as_a_whole():
     names = [type(i).__name__ for i in s.interactions]
     assert "TiedCoupling" not in names
     damp = [i for i in s.interactions if getattr(i, "name", "") == "bar_particles"]
-    assert len(damp) == 1 and damp[0].idx.size == s.particles.n
+    assert len(damp) == 1 and damp[0].idx.size == s.part("sph").kin.n
     for _ in range(3):
         s.step()

@@ -64,13 +64,13 @@ velocity = [{v0}, 0, 0]
 
 def _front_arrival(solver, deck_dx, positions, v0, t_end):
     """Times at which the particle velocity on the centre line reaches v0/2."""
-    p = solver.particles
+    p = solver.part("sph").kin
     x0 = p.x0
     yc = 0.5 * (x0[:, 1].min() + x0[:, 1].max())
     zc = 0.5 * (x0[:, 2].min() + x0[:, 2].max())
     probes = [np.argmin((x0[:, 0] - xp) ** 2 + (x0[:, 1] - yc) ** 2 + (x0[:, 2] - zc) ** 2)
               for xp in positions]
-    hist = _run_until(solver, t_end, lambda s: s.particles.v[probes, 0].copy())
+    hist = _run_until(solver, t_end, lambda s: s.part("sph").kin.v[probes, 0].copy())
     t = np.array([h[0] for h in hist])
     v = np.array([h[1] for h in hist])
     arrivals = []
@@ -158,7 +158,7 @@ def test_elastic_disc_bounces_with_energy_conserved(stiffness, alpha):
     # of the disc and to artificial viscosity only) and at most 100.5 %.
     # Measured: drift 0.55 % (mass) / 0.39 % (bulk), rebound 95 % / 96 %.
     s, _ = _solver(_disc_on_wall(stiffness, alpha))
-    m = s.particles.m
+    m = s.part("sph").kin.m
     vel0 = 5.0
     records = []
     t_end = 0.003  # contact lasts from 0.12 to 0.76 ms
@@ -167,7 +167,7 @@ def test_elastic_disc_bounces_with_energy_conserved(stiffness, alpha):
     e = np.array([r["E_total"] for r in records])
     ke0 = records[0]["E_kinetic"]
     assert np.abs(e - e[0]).max() < 0.02 * ke0
-    vcm = (m[:, None] * s.particles.v).sum(axis=0) / m.sum()
+    vcm = (m[:, None] * s.part("sph").kin.v).sum(axis=0) / m.sum()
     assert vcm[1] > 0.8 * vel0 and vcm[1] < 1.005 * vel0, vcm
     assert max(r["F_wall_floor"] for r in records) > 0
     assert records[-1]["contacts_floor"] == 0  # it has left the wall
@@ -184,14 +184,14 @@ def test_bulk_wall_with_random_masses_keeps_the_time_step_and_energy():
     text = _disc_on_wall("bulk", 0.5).replace(
         "[[wall]]", '[body.mass]\ndistribution = "uniform"\nlow = 0.0\nhigh = 2.0\n[[wall]]')
     s, _ = _solver(text)
-    assert s.particles.m.min() < 0.01 * s.particles.m.mean()  # some very light particles
+    assert s.part("sph").kin.m.min() < 0.01 * s.part("sph").kin.m.mean()  # some very light particles
     assert wall(s, "floor").stable_dt() == wall(hom, "floor").stable_dt()
     records = []
     while s.t < 0.003:
         records.append(step(s))
     e = np.array([r["E_total"] for r in records])
     assert np.abs(e - e[0]).max() < 0.02 * records[0]["E_kinetic"]
-    vcm = (s.particles.m[:, None] * s.particles.v).sum(axis=0) / s.particles.m.sum()
+    vcm = (s.part("sph").kin.m[:, None] * s.part("sph").kin.v).sum(axis=0) / s.part("sph").kin.m.sum()
     assert vcm[1] > 0.5 * 5.0  # bounced
 
 
@@ -203,7 +203,7 @@ def test_friction_slows_sliding_but_not_without_it():
         s, _ = _solver(_disc_on_wall(friction=mu, vx=3.0))
         while s.t < 0.006:
             s.step()
-        vt.append((s.particles.m * s.particles.v[:, 0]).sum() / s.particles.m.sum())
+        vt.append((s.part("sph").kin.m * s.part("sph").kin.v[:, 0]).sum() / s.part("sph").kin.m.sum())
     assert abs(vt[0] - 3.0) < 1e-9
     assert vt[1] < 2.9
 
@@ -217,11 +217,11 @@ def test_wall_impulse_equals_the_momentum_change(stiffness, alpha, mu):
     # momentum (round-off over ~700 steps; measured 5e-15 and 7e-15). Oblique
     # impact with friction, so the tangential component is checked too.
     s, _ = _solver(_disc_on_wall(stiffness, alpha, friction=mu, vx=2.0))
-    p0 = (s.particles.m[:, None] * s.particles.v).sum(axis=0)
+    p0 = (s.part("sph").kin.m[:, None] * s.part("sph").kin.v).sum(axis=0)
     records = []
     while s.t < 0.002:
         records.append(step(s))
-    dp = (s.particles.m[:, None] * s.particles.v).sum(axis=0) - p0
+    dp = (s.part("sph").kin.m[:, None] * s.part("sph").kin.v).sum(axis=0) - p0
     scale = np.linalg.norm(p0)
     assert np.abs(dp - wall(s, "floor").impulse).max() < 1e-9 * scale
     assert dp[1] > 1.5 * abs(p0[1])  # it bounced: the impulse is no trivial 0
@@ -392,15 +392,15 @@ velocity = [-4.0, 0, 0]
 geometry = {{ shape = "ring", centre = [0.0085, 0, 0], inner_radius = 0.003, outer_radius = 0.007 }}
 """
     s, _ = _solver(text)
-    p0 = (s.particles.m[:, None] * s.particles.v).sum(axis=0)
-    scale = (s.particles.m * np.linalg.norm(s.particles.v, axis=1)).sum()
-    body_a = s.particles.body == 0
-    pa0 = (s.particles.m[body_a, None] * s.particles.v[body_a]).sum(axis=0)
+    p0 = (s.part("sph").kin.m[:, None] * s.part("sph").kin.v).sum(axis=0)
+    scale = (s.part("sph").kin.m * np.linalg.norm(s.part("sph").kin.v, axis=1)).sum()
+    body_a = s.part("sph").kin.body == 0
+    pa0 = (s.part("sph").kin.m[body_a, None] * s.part("sph").kin.v[body_a]).sum(axis=0)
     while s.t < 0.002:
         s.step()
-    p1 = (s.particles.m[:, None] * s.particles.v).sum(axis=0)
+    p1 = (s.part("sph").kin.m[:, None] * s.part("sph").kin.v).sum(axis=0)
     assert np.abs(p1 - p0).max() < 1e-12 * scale
-    pa1 = (s.particles.m[body_a, None] * s.particles.v[body_a]).sum(axis=0)
+    pa1 = (s.part("sph").kin.m[body_a, None] * s.part("sph").kin.v[body_a]).sum(axis=0)
     assert abs(pa1[0] - pa0[0]) > 0.1 * abs(pa0[0])  # they did collide
 
 
@@ -440,11 +440,11 @@ def test_thesis_two_boxes(gap_in_dx, interacts):
     # facing particle rows are 2.4 dx apart never see each other (lateral
     # momentum exchanged exactly zero), at 1.0 dx apart they interact.
     s, _ = _solver(_boxes(gap_in_dx))
-    lower = s.particles.body == 0
+    lower = s.part("sph").kin.body == 0
     while s.t < 12e-6:
         s.step()
-    py = (s.particles.m[lower] * s.particles.v[lower, 1]).sum()
-    scale = (s.particles.m[lower] * 300.0).sum()
+    py = (s.part("sph").kin.m[lower] * s.part("sph").kin.v[lower, 1]).sum()
+    scale = (s.part("sph").kin.m[lower] * 300.0).sum()
     if interacts:
         assert abs(py) > 1e-6 * scale
     else:

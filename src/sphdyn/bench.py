@@ -194,8 +194,8 @@ def run_bench(case: str, steps: int = 1000, threads: int | None = None,
             "compile_seconds": compile_s, "element_steps_per_s": ne * steps / seconds,
             "peak_rss_mb": peak / 2**20, "bytes_per_element": peak / ne,
         }
-    n = stepper.particles.n
     sph = stepper.part("sph")
+    n = sph.kin.n
     out = {
         "case": case, "particles": n, "steps": steps,
         "threads": numba.get_num_threads(), "seconds": seconds,

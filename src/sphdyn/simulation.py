@@ -38,7 +38,6 @@ from .watchers.interrupt import StopRequests
 from .watchers.monitors import (Checkpoints, EnergyGuard, FrameOutput, Guards,
                                 HistoryFlush, HistoryRecorder, Progress)
 from .watchers.threads import ThreadTuner
-from .neighbours import max_neighbours, mean_neighbours
 from .stepper import Stepper
 
 RESOLVED = "deck.resolved.toml"
@@ -68,7 +67,8 @@ class Simulation:
         self.wall_seconds = 0.0
         self.output = FrameOutput(self._write_frame, deck.frame_interval(), next_frame,
                                   deck.run.t_end)
-        self.recorder = HistoryRecorder(history, out.history_every, self.model.probes)
+        self.recorder = HistoryRecorder(history, out.history_every, self.model.probes,
+                                        self.model.particles)
         self.gauges = GaugeRecorder(build_gauges(deck, stepper.parts) if gauges is None
                                     else gauges)
         run = deck.run
@@ -243,7 +243,7 @@ class Simulation:
         s = self.stepper
         computed = {}
         for part in s.parts:
-            if part.kind == "sph":  # mesh parts' fields go to their own blocks
+            if part.kin is self.particles:  # the others draw their own blocks
                 computed.update(part.fields())
         fields = particle_fields(self.particles, self.fields, computed)
         self.frames.write(s.t, s.step_count, fields, meshes=mesh_frames(s.parts),
@@ -269,7 +269,7 @@ class Simulation:
         s, deck = self.stepper, self.deck
         steps = s.step_count - start_step
         n = sum(part.kin.n for part in s.parts)
-        sph = next((p for p in s.parts if p.kind == "sph"), None)
+        particles = self.particles.n
         h = self.history.as_arrays() if len(self.history.columns) else {}
         if failure is not None:
             status = failure.status  # "failed", or "energy_error" (the energy guard)
@@ -282,21 +282,21 @@ class Simulation:
             "signal": interrupted if status == "interrupted" else None,
             "diagnosis": None if failure is None else failure.diagnosis,
             # items: particles and mesh nodes (the rate below counts both)
-            "particles": 0 if sph is None else sph.kin.n, "nodes": n - (
-                0 if sph is None else sph.kin.n), "items": n,
+            "particles": particles, "nodes": n - particles, "items": n,
             "dimension": deck.run.dimension, "time": s.t,
             "steps": s.step_count, "steps_this_run": steps,
             "wall_seconds": self.wall_seconds,
             "particle_steps_per_s": n * steps / max(self.wall_seconds, 1e-12),
             "initial_dt": s.dt0,
         }
-        if sph is not None:
-            summary.update(neighbours_mean=mean_neighbours(sph.nl),
-                           neighbours_max=max_neighbours(sph.nl),
-                           neighbour_builds=sph.nl.n_builds)
-        for part in s.parts:  # the parts that report themselves (the meshes)
-            if hasattr(part, "summary"):
-                summary.setdefault("meshes", {})[part.name] = part.summary()
+        for part in s.parts:  # the parts that report themselves: the
+            report = getattr(part, "summary", None)  # particles' at the top
+            if report is None:
+                continue
+            if part.kin is self.particles:
+                summary.update(report())
+            else:
+                summary.setdefault("meshes", {})[part.name] = report()
         if s.mass_scaling is not None:
             summary["mass_scaling"] = s.mass_scaling.summary()
         if self.energy_guard is not None and self.energy_guard.warning is not None:

@@ -21,10 +21,14 @@ Central differences (leapfrog, :mod:`sphdyn.integrate`), state at
    ``after_step`` (guards, history, frames, checkpoints).
 
 The energy balance :math:`E_{total} = E_{kin} + E_{int} + E_{contact} -
-W_{ext} + E_{removed}`, with :math:`E_{contact} = -W_{contact}` the negative
-work of the interaction forces and :math:`E_{removed}` the energy events took
-out of the model (an event's ``energy_removed``: plain erosion), is recorded
-by :meth:`Stepper.record` with the events' ``columns(t)``.
+W_{ext} + E_{removed} - E_{chemical}`, with :math:`E_{contact} = -W_{contact}`
+the negative work of the interaction forces, is recorded by
+:meth:`Stepper.record` with the items' ``columns``. Two optional books of any
+part, interaction or event enter it: ``energy_removed`` [J], energy taken out
+of the model and still counted (an erosion event's eroded elements, particles
+that left the domain; column ``E_removed``), and ``energy_released`` [J],
+energy the model was given from inside (an explosive's chemical energy;
+column ``E_chemical``); an item without a book leaves it None.
 """
 
 from __future__ import annotations
@@ -47,6 +51,13 @@ def _own_state(scalars: dict, groups: dict, key: str) -> tuple[dict, dict]:
     pre = key + "."
     return ({k[len(pre):]: v for k, v in scalars.items() if k.startswith(pre)},
             groups.get(key, {}))
+
+
+def _book(items, name: str) -> float | None:
+    """The sum of the items' energy book ``name`` [J]; None if no item keeps
+    one (the optional ``energy_removed`` and ``energy_released``)."""
+    values = [v for v in (getattr(item, name, None) for item in items) if v is not None]
+    return float(sum(values)) if values else None
 
 
 def dofs(part) -> list:
@@ -118,7 +129,7 @@ class Stepper:
             dt_before = self.dt0
             self.dt0, _, _ = self.stable_dt()
             mass_scaling.steps = (dt_before, self.dt0)
-        self.dt_contact_step = self.dt0  # the step the penalty springs use
+        self.dt_stable = self.dt0  # the step before shortening to land on t_stop
         self._interaction_forces(self.dt0)
 
     # ------------------------------------------------------------- access
@@ -128,11 +139,6 @@ class Stepper:
             if p.name == name:
                 return p
         raise KeyError(f"no part {name!r}; parts: {[p.name for p in self.parts]}")
-
-    @property
-    def particles(self):
-        """The particles of the first SPH part (the common case); None without one."""
-        return next((p.p for p in self.parts if p.kind == "sph"), None)
 
     def add_monitor(self, monitor) -> None:
         self.monitors.append(monitor)
@@ -183,9 +189,10 @@ class Stepper:
         """Advance one step; ``t_stop`` shortens it so that the run ends there."""
         dt, k, part = self.stable_dt()
         self._notify("before_step", dt, k, part)
-        # penalty springs use the stable step, not one shortened to end the
-        # run: k = alpha m / dt^2 (paper eq. 8) would grow by (dt / dt_short)^2
-        self.dt_contact_step = dt
+        # interactions get the stable step, not one shortened to end the run:
+        # a penalty spring k = alpha m / dt^2 (paper eq. 8) would grow by
+        # (dt / dt_short)^2
+        self.dt_stable = dt
         if t_stop is not None and self.t + dt > t_stop:
             dt = max(t_stop - self.t, 0.0)
         dt_kick = 0.5 * dt if self.step_count == 0 else 0.5 * (self.dt_prev + dt)
@@ -229,7 +236,7 @@ class Stepper:
             inter.update_geometry(self.t)
         for part in self.parts:
             part.internal_forces(self.t, dt)
-        self._interaction_forces(self.dt_contact_step)
+        self._interaction_forces(self.dt_stable)
         if self.books is not None and self.events:
             self.books.before()
         for event in self.events:
@@ -253,12 +260,10 @@ class Stepper:
             a, b = part.energies()
             ie, iav = _add(ie, a), _add(iav, b)
         e_contact = -self.work_contact
-        # energy events took out of the model (plain erosion), still in the balance
-        removed = [ev.energy_removed for ev in self.events if hasattr(ev, "energy_removed")]
-        e_removed = float(sum(removed))
-        # energy materials released into the model (an explosive's chemical energy)
-        sources = [p for p in self.parts if getattr(p, "has_sources", False)]
-        e_chemical = float(sum(p.supplied_energy() for p in sources))
+        items = (*self.parts, *self.interactions, *self.events)
+        removed, released = _book(items, "energy_removed"), _book(items, "energy_released")
+        e_removed = 0.0 if removed is None else removed
+        e_chemical = 0.0 if released is None else released
         rec = {
             "time": self.t, "step": float(self.step_count),
             "dt": self.dt_step if dt is None else dt,
@@ -269,9 +274,9 @@ class Stepper:
             # how quasi-static the run is: small (< 0.05 say) for a static answer
             "KE_IE_ratio": kinetic / ie if ie > 0.0 else 0.0,
         }
-        if removed:
+        if removed is not None:
             rec["E_removed"] = e_removed
-        if sources:
+        if released is not None:
             rec["E_chemical"] = e_chemical
         for part in self.parts:
             rec.update(part.columns())
@@ -297,7 +302,7 @@ class Stepper:
     def state(self) -> tuple[dict, dict[str, dict[str, np.ndarray]]]:
         """Scalars and array groups of a checkpoint (parts, interactions, events)."""
         scalars = {"t": self.t, "step": self.step_count, "dt_prev": self.dt_prev,
-                   "dt0": self.dt0, "dt_contact_step": self.dt_contact_step,
+                   "dt0": self.dt0, "dt_stable": self.dt_stable,
                    "dt_step": self.dt_step, "work_contact": self.work_contact,
                    "work_external": self.work_external}
         groups = {}
@@ -350,7 +355,7 @@ class Stepper:
         self.step_count = int(scalars["step"])
         self.dt_prev = float(scalars["dt_prev"])
         self.dt0 = float(scalars["dt0"])
-        self.dt_contact_step = float(scalars["dt_contact_step"])
+        self.dt_stable = float(scalars["dt_stable"])
         self.dt_step = float(scalars["dt_step"])
         self.work_contact = float(scalars["work_contact"])
         self.work_external = float(scalars["work_external"])
@@ -372,7 +377,7 @@ class Stepper:
         # run had it, so that state is put back after it
         scratch = {id(p.kin): np.zeros_like(p.kin.a_ext) for p in self.parts}
         for inter in self.interactions:
-            inter.forces(self.t, self.dt_contact_step, scratch[id(inter.part.kin)])
+            inter.forces(self.t, self.dt_stable, scratch[id(inter.part.kin)])
             inter.restore(*_own_state(scalars, groups, f"interaction.{inter.name}"))
         if self.books is not None:
             self.books.restore(_own_state(scalars, groups, "books")[0],

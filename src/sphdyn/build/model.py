@@ -220,17 +220,8 @@ def build_model(deck) -> Model:
         mat = mats[body.material]
         mat_ids, ph = _phase_materials(deck, b, body, x, dim, mat_index, photos)
         phase_parts.append(np.full(n, -1, np.int8) if ph is None else ph)
-        p = Particles.allocate(n, dim, n_hist)
-        p.x[:] = x
-        p.x0[:] = x
-        p.v[:] = np.asarray(body.velocity, dtype=float)
-        if body.initial is not None:
-            _apply_initial(deck, body, p, models, mat_ids, dim)
         vol = body.dx ** dim
-        p.vol0[:] = vol
-        p.mat[:] = mat_ids
-        p.rho[:] = density_of[mat_ids]
-        p.rho0[:] = p.rho
+        rho0 = density_of[mat_ids]
         # numerical heterogeneity (paper sec. 4, 5.2): crack particles get zero
         # mass, the others a random mass field of the homogeneous total
         cracks = [c.model_dump() for c in body.crack]
@@ -238,19 +229,21 @@ def build_model(deck) -> Model:
         spec = None if body.mass is None else body.mass.model_dump()
         if ph is not None:  # phases of different densities: factors times rho_i dx^d
             factors, scale = mass_field(1.0, spec, solid, body_rng(deck.run.seed, b))
-            p.m[:] = factors * p.rho0 * vol
+            m = factors * rho0 * vol
         else:
-            p.m[:], scale = mass_field(mat.density * vol, spec, solid,
-                                       body_rng(deck.run.seed, b))
-            factors = p.m / (mat.density * vol)
+            m, scale = mass_field(mat.density * vol, spec, solid,
+                                  body_rng(deck.run.seed, b))
+            factors = m / (mat.density * vol)
         if spec is not None:
             draws[body.name] = MassDraw(np.arange(start, start + n), solid,
                                         factors[solid] / scale, scale,
                                         mat.density * vol, spec)
         start += n
-        p.h[:] = deck.sph.h_factor * body.dx
-        p.h0[:] = p.h
-        p.body[:] = b
+        p = Particles.allocate(n, dim, n_hist)
+        p.place(slice(None), x=x, v=np.asarray(body.velocity, dtype=float), m=m,
+                vol0=vol, rho0=rho0, h=deck.sph.h_factor * body.dx, mat=mat_ids, body=b)
+        if body.initial is not None:
+            _apply_initial(deck, body, p, models, mat_ids, dim)
         parts.append(p)
     body_names = particle_body_names(deck)
     for mm in meshes:
@@ -431,16 +424,12 @@ def _sublayer_particles(deck, mm: MeshModel, b: int, n_hist: int) -> Particles:
     m = sublayer_masses(x, conn, section_of(mm.spec).area, mat.density,
                         mm.spec.sublayer.mass_ratio)
     length = float(np.mean(np.linalg.norm(x[conn[:, 1]] - x[conn[:, 0]], axis=1)))
-    p = Particles.allocate(x.shape[0], deck.run.dimension, n_hist)
-    p.x[:] = x
-    p.x0[:] = x
-    p.v[:] = np.asarray(mm.spec.velocity, dtype=float)
-    p.m[:] = m
-    p.mat[:] = int(mm.mat[0])
     h = mm.spec.sublayer.smoothing_length
-    p.h[:] = deck.sph.h_factor * length if h is None else h
-    p.h0[:] = p.h
-    p.body[:] = b
+    p = Particles.allocate(x.shape[0], deck.run.dimension, n_hist)
+    # density and volume 0 until the bar is seated in its concrete
+    p.place(slice(None), x=x, v=np.asarray(mm.spec.velocity, dtype=float), m=m,
+            vol0=0.0, rho0=0.0, h=deck.sph.h_factor * length if h is None else h,
+            mat=int(mm.mat[0]), body=b)
     return p
 
 
@@ -553,15 +542,7 @@ def _converted_particles(deck, mm: MeshModel, b: int, density_of, n_hist: int) -
         mat = np.concatenate([mat, hy.mat])
         size = np.concatenate([size, (hy.vol * per) ** (1.0 / dim)])
     p = Particles.allocate(x.shape[0], dim, n_hist)
-    p.x[:] = x
-    p.x0[:] = x
-    p.v[:] = np.asarray(mm.spec.velocity, dtype=float)
-    p.vol0[:] = vol
-    p.mat[:] = mat
-    p.rho[:] = density_of[mat]
-    p.rho0[:] = p.rho
-    p.m[:] = p.rho0 * vol
-    p.h[:] = deck.sph.h_factor * size
-    p.h0[:] = p.h
-    p.body[:] = b
+    p.place(slice(None), x=x, v=np.asarray(mm.spec.velocity, dtype=float),
+            m=density_of[mat] * vol, vol0=vol, rho0=density_of[mat],
+            h=deck.sph.h_factor * size, mat=mat, body=b)
     return p

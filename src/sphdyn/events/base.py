@@ -10,7 +10,8 @@ an event must remember across a restart (whether it fired).
 
 Optional: ``columns(t)``, the event's history columns, and
 ``energy_removed`` [J], energy the event took out of the model, which the
-stepper's ``E_total`` counts (:mod:`.erosion`). An event that changes a mesh
+stepper's ``E_total`` books (:mod:`.erosion`, :mod:`.domain_exit`; any
+part or interaction may keep this book too). An event that changes a mesh
 calls ``withdraw_forces()`` (if they have it) before the change and
 ``mesh_changed()`` after it on the interactions whose ``solid`` is that part.
 """

@@ -66,6 +66,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..deck.sections.sph import Sph
 from ..geometry.shapes import corner_signs, shape_functions
 from ..parts.fem.erosion_criteria import (BY_TIME_STEP, REASONS, erosion_flags,
                                           reference_gradients)
@@ -131,12 +132,14 @@ class ElementErosion:
     per_element : 1 or 8 particles per element (4 in 2D for 8).
     sph : the SPH part that takes the particles (``to = "particles"``).
     body : the particles' body index in ``sph``.
-    h_factor : smoothing length over particle size.
+    h_factor : smoothing length over particle size (default: the deck's
+        ``[sph] h_factor``).
     every : check every this many steps.
     """
 
     def __init__(self, name: str, solid, rules: dict, to: str = "particles",
-                 per_element: int = 1, sph=None, body: int = 0, h_factor: float = 1.2,
+                 per_element: int = 1, sph=None, body: int = 0,
+                 h_factor: float = Sph.model_fields["h_factor"].default,
                  every: int = 1):
         if to not in TARGETS:
             raise ValueError(f"{name}: to must be one of {TARGETS}, got {to!r}")
@@ -246,20 +249,14 @@ class ElementErosion:
         p = self.sph.p
         k = f["x"].shape[0]
         rows = p.grow(k, notify=False)
-        p.x[rows] = f["x"]
-        p.x0[rows] = f["x"]
-        p.v[rows] = f["v"]
+        p.place(rows, x=f["x"], v=f["v"], m=f["m"], vol0=f["m"] / f["rho0"],
+                rho0=f["rho0"], rho=f["rho"], h=self.h_factor * f["size"],
+                mat=f["mat"], body=self.body)
         p.a[rows] = f["a"]
         p.a_ext[rows] = f["a_ext"]
-        p.m[rows] = f["m"]
         p.bc[rows] = BC_FREE
         p.bc_v[rows] = 0.0
         p.active[rows] = 1
-        p.rho[rows] = f["rho"]
-        p.rho0[rows] = f["rho0"]
-        p.vol0[rows] = f["m"] / f["rho0"]
-        p.h[rows] = self.h_factor * f["size"]
-        p.h0[rows] = p.h[rows]
         p.e[rows] = f["e"]
         p.e_av[rows] = f["e_av"]
         p.sig[rows] = f["sig"]
@@ -269,8 +266,6 @@ class ElementErosion:
         p.hist[rows] = 0.0  # the element's history, column by column by name
         for col, name in enumerate(self.solid.pts.hist_names):
             p.hist[rows, p.hist_names.index(name)] = f["hist"][:, col]
-        p.mat[rows] = f["mat"]
-        p.body[rows] = self.body
         p.notify_grown(rows.start, rows.stop)
         self.born += k
 

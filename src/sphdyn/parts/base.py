@@ -15,6 +15,13 @@ The :class:`~sphdyn.stepper.Stepper` knows no physics; it asks each part
 * ``columns()``: its history columns; ``fields()``: output fields it computes;
 * ``state()`` / ``restore(scalars, arrays)``: its checkpoint data.
 
+Optional: ``frame()``, its own picture in a frame (a mesh's cells; a part
+without it moves the frame's points, the particles), ``summary()``, what it
+adds to the run's summary, ``describe_limit(k)`` and ``hotspot()``, its words
+in a diagnosis, ``items_label``, what its items are called there ("node(s)
+of mesh 'beam'"), and ``energy_released`` [J], energy its materials released
+into the model (an explosive's), which the stepper's ``E_total`` books.
+
 Parts register by kind in :data:`PART_KINDS` (the FEM issue adds mesh parts).
 """
 

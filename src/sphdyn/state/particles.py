@@ -138,6 +138,31 @@ class Particles(Kinematics):
         """Zero-initialised particles (density, h etc. must be set by the caller)."""
         return cls(n, dim, n_history)
 
+    def place(self, rows, *, x, v, m, vol0, rho0, h, mat, body, rho=None) -> None:
+        """Give the particles ``rows`` (a slice or an index array, k of them)
+        their birth state: the one recipe of every particle (a body's
+        lattice, a bar's sublayer, a mesh's converted elements, eroded
+        elements).
+
+        ``x`` (k, 3) [m], also the reference ``x0``; velocity ``v`` ((3,) or
+        (k, 3)) [m/s]; mass ``m`` [kg, kg/m in 2D]; nominal volume ``vol0``
+        [m^3, m^2 in 2D]; initial density ``rho0`` and current density ``rho``
+        (``rho0`` if None) [kg/m^3]; smoothing length ``h``, also ``h0`` [m];
+        material and body indices. Scalars broadcast. The rest (stress,
+        energies, history, flags) is left as it is.
+        """
+        self.x[rows] = x
+        self.x0[rows] = x
+        self.v[rows] = v
+        self.m[rows] = m
+        self.vol0[rows] = vol0
+        self.rho0[rows] = rho0
+        self.rho[rows] = rho0 if rho is None else rho
+        self.h[rows] = h
+        self.h0[rows] = h
+        self.mat[rows] = mat
+        self.body[rows] = body
+
     @classmethod
     def concatenate(cls, parts: list["Particles"]) -> "Particles":
         """Join several particle sets (bodies) into one."""

@@ -95,10 +95,10 @@ def _candidates(deck, parts, spec):
     for pk, part in enumerate(parts):
         q = part.kin
         if spec.mesh is not None:
-            if part.kind != "sph" and part.name == spec.mesh:
+            if part.name == spec.mesh:
                 out.append((pk, np.arange(q.n)))
         elif spec.body is not None:
-            if part.kind == "sph":
+            if "body" in q.names():  # items labelled by body: the particles
                 from ..build.model import particle_body_names
 
                 k = particle_body_names(deck).index(spec.body)

@@ -55,8 +55,7 @@ def energy_diagnosis(s, error: float, limit: float, scale: float, growth: float)
         now = s.part_kinetic[part.name] + part.energies()[0]
         gain = now - s.part_start.get(part.name, now)
         made = gain - s.part_work[part.name]
-        if getattr(part, "has_sources", False):
-            made -= part.supplied_energy()
+        made -= getattr(part, "energy_released", None) or 0.0
         rows.append((made, gain, part))
     made, gain, part = max(rows, key=lambda r: r[0])
     lines.append(f"  Part '{part.name}' gained the most beyond "

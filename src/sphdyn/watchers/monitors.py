@@ -39,22 +39,23 @@ class Guards:
     def after_step(self, s) -> None:
         for part in s.parts:
             q = part.kin
-            label = "" if part.kind == "sph" else f"node(s) of mesh '{part.name}'"
-            check_particles(q, self.lo, self.hi, s.t, s.step_count, q.guard_work, label)
+            check_particles(q, self.lo, self.hi, s.t, s.step_count, q.guard_work,
+                            getattr(part, "items_label", ""))
 
 
 class HistoryRecorder:
     """Append a history row (the stepper's record and the probes) every
     ``every`` steps, taken at the kick's time and kept once the step has
-    passed the guards."""
+    passed the guards; ``particles`` the state the particle probes read."""
 
-    def __init__(self, history, every: int, probes=()):
+    def __init__(self, history, every: int, probes=(), particles=None):
         self.history, self.every, self.probes = history, every, list(probes)
+        self.particles = particles
         self._row = None
 
     def row(self, s, **kw) -> dict:
         rec = s.record(**kw)
-        rec.update(probe_record(s.particles, self.probes,
+        rec.update(probe_record(self.particles, self.probes,
                                 meshes={q.name: q.kin for q in s.parts}))
         return rec
 

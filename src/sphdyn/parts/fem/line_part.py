@@ -78,6 +78,7 @@ from .beam import (N_RES, RES_L, RES_MY_A, RES_MY_B, RES_MZ_A, RES_MZ_B, RES_N, 
                    truss_element_steps, truss_forces, truss_gradient, truss_kinematics,
                    truss_stable_dt)
 from .gather import gather_loads, node_element_list
+from .solid_part import DEFAULTS
 from .output import mesh_frame, mesh_summary
 
 
@@ -179,8 +180,9 @@ class LinePart:
 
     def __init__(self, name: str, nodes, conn, *, element: str = "beam",
                  section: BeamSection, material, orientation=(0.0, 0.0, 1.0),
-                 rotary_inertia_scale: float = 3.0, damping: float = 0.0,
-                 dt_scale: float = 0.9, lateral_rtol: float = 1e-10,
+                 rotary_inertia_scale: float = 3.0,
+                 damping: float = DEFAULTS["damping"].default,
+                 dt_scale: float = DEFAULTS["cfl"].default, lateral_rtol: float = 1e-10,
                  lateral_iterations: int = 8):
         if element not in ("beam", "truss"):
             raise ValueError(f"element must be 'beam' or 'truss', got {element!r}")
@@ -310,6 +312,11 @@ class LinePart:
             for side in (0, 1):
                 np.add.at(added["rot"], el.conn[:, side], f * self.inertia_e)
         return added
+
+    @property
+    def items_label(self) -> str:
+        """What its items are called in a diagnosis (:mod:`sphdyn.watchers.monitors`)."""
+        return f"node(s) of mesh '{self.name}'"
 
     def describe_limit(self, k: int) -> str:
         """What element ``k`` of :meth:`stable_dt` is, for a diagnosis."""

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...deck.sections.meshes import Mesh
 from ...geometry.mesh import MESH_KINDS
 from ...geometry.shapes import gauss_derivatives, hourglass_vectors, volume_table
 from ...integrate import drift, internal_energies, ordered_sum
@@ -39,6 +40,9 @@ from .hourglass import HG_STIFFNESS, HG_VISCOUS, hourglass_bound, hourglass_over
 INTEGRATIONS = ("one_point", "selective_reduced")
 HOURGLASS_FORMS = {"viscous": HG_VISCOUS, "stiffness": HG_STIFFNESS}
 
+#: the deck's [[mesh]] keys: their defaults are the settings' (one home)
+DEFAULTS = Mesh.model_fields
+
 
 @dataclass(frozen=True)
 class SolidSettings:
@@ -52,12 +56,12 @@ class SolidSettings:
     cfl : factor on the stable element step (0.9, LS-DYNA's TSSFAC).
     """
 
-    integration: str = "one_point"
-    hourglass: str = "viscous"
-    hourglass_coefficient: float = 0.1
-    q1: float = 1.5
-    q2: float = 0.06
-    cfl: float = 0.9
+    integration: str = DEFAULTS["integration"].default
+    hourglass: str = DEFAULTS["hourglass"].default
+    hourglass_coefficient: float = DEFAULTS["hourglass_coefficient"].default
+    q1: float = DEFAULTS["q1"].default
+    q2: float = DEFAULTS["q2"].default
+    cfl: float = DEFAULTS["cfl"].default
 
     def __post_init__(self):
         if self.integration not in INTEGRATIONS:
@@ -230,6 +234,11 @@ class SolidPart:
         added = np.zeros(self.nodes.n)
         np.add.at(added, el.conn.ravel(), np.repeat((g * g - 1.0) * el.m / el.nen, el.nen))
         return {"kin": added}
+
+    @property
+    def items_label(self) -> str:
+        """What its items are called in a diagnosis (:mod:`sphdyn.watchers.monitors`)."""
+        return f"node(s) of mesh '{self.name}'"
 
     def describe_limit(self, k: int) -> str:
         """What element ``k`` of :meth:`stable_dt` is, for a diagnosis."""

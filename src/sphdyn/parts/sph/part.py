@@ -38,7 +38,8 @@ from ...integrate import (add_heat, cfl_mass_factors, cfl_time_step, drift,
                           internal_energies)
 from ...kernels import KernelContext
 from ...materials.base import young_modulus
-from ...neighbours import build_neighbours, mean_neighbours, update_neighbours
+from ...neighbours import (build_neighbours, max_neighbours, mean_neighbours,
+                           update_neighbours)
 from ...state import BC_FIXED, STATE, Particles
 from ..base import register_part
 from .artificial_stress import artificial_stress_forces, artificial_stress_tensor
@@ -355,13 +356,13 @@ class SPHPart:
                 f"energy, {p.e[k]:.4g} J/kg; {fastest(p, 'particle')}")
 
     @property
-    def has_sources(self) -> bool:
-        """Whether a material of the part releases energy (an explosive)."""
-        return any(g.model.released_energy is not None for g in self.groups)
-
-    def supplied_energy(self) -> float:
+    def energy_released(self) -> float | None:
         """Energy [J] the materials have released into the particles so far
-        (:attr:`~sphdyn.materials.MaterialModel.released_energy`)."""
+        (:attr:`~sphdyn.materials.MaterialModel.released_energy`: an
+        explosive's chemical energy); None if no material of the part releases
+        any (the stepper's book ``E_chemical``)."""
+        if all(g.model.released_energy is None for g in self.groups):
+            return None
         p, total = self.p, 0.0
         for g in self.groups:
             if g.model.released_energy is not None and g.idx.size:
@@ -526,6 +527,13 @@ class SPHPart:
             self.swegle_unstable = int(count_unstable(p.swegle, p.m, FLAG_FRACTION))
             self._swegle_at = self.step
         return self.p.swegle
+
+    def summary(self) -> dict:
+        """The current neighbour list's mean and largest neighbours per
+        particle and how often it was built (the run's summary.json)."""
+        return {"neighbours_mean": mean_neighbours(self.nl),
+                "neighbours_max": max_neighbours(self.nl),
+                "neighbour_builds": self.nl.n_builds}
 
     @property
     def mean_neighbours(self) -> float:
