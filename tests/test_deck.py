@@ -63,9 +63,9 @@ xsph = 0.1
 viscosity = { alpha = 0.5, beta = 1.0 }
 smoothing_length = { mode = "benz", min_factor = 0.4, max_factor = 3 }
 neighbours = { skin_factor = 0.3 }
+cfl = 0.25
 
 [time]
-cfl = 0.25
 dt_max = "1 us"
 collapse_ratio = 1e-3
 
@@ -210,7 +210,7 @@ def test_minimal_deck_is_converted_to_si_with_defaults():
     # defaults
     assert deck.sph.kernel == "cubic_spline" and deck.sph.h_factor == 1.2
     assert deck.sph.viscosity.alpha == 1.0 and deck.sph.viscosity.beta == 2.0
-    assert deck.time.cfl == 0.3 and deck.time.dt_max is None
+    assert deck.sph.cfl == 0.3 and deck.time.dt_max is None
     assert deck.wall[0].stiffness == "mass" and deck.wall[0].alpha == 0.1
     # Autodyn's SPH density factors; not parameters of the model
     assert (rubber.min_density_factor, rubber.max_density_factor) == (0.2, 3.0)
@@ -415,12 +415,12 @@ ERROR_CASES = [
      ["out of range [0, 1)"]),
     (_set(["material", 0, "max_density_factor"], 0.9), "material[0].max_density_factor",
      ["out of range (1, inf)"]),
-    (_set(["time"], {"cfl": 0}), "time.cfl", ["out of range (0, 1]"]),
+    (_set(["sph"], {"cfl": 0}), "sph.cfl", ["out of range (0, 1]"]),
     (_set(["body", 0, "dx"], -1e-3), "body[0].dx",
      ["out of range (0, inf)", "above 0"]),
     (_set(["output"], {"history_every": 0}), "output.history_every",
      ["at least 1"]),
-    (_set(["time"], {"cfl": math.nan}), "time.cfl", ["not finite"]),
+    (_set(["sph"], {"cfl": math.nan}), "sph.cfl", ["not finite"]),
     # wrong unit dimension
     (_set(["body", 0, "dx"], "3 MPa"), "body[0].dx",
      ["'3 MPa' is not a length",
@@ -574,7 +574,7 @@ def test_type_error_does_not_hide_reference_errors():
 
 def test_overrides_are_applied_before_validation():
     deck = loads_deck(MINIMAL, overrides=[
-        "time.cfl=0.2",                       # TOML number
+        "sph.cfl=0.2",                        # TOML number
         "material.rubber.E=20 MPa",           # by name; not TOML -> string
         "body.0.velocity=[1, 2]",             # by index; TOML array
         "sph.viscosity.alpha=0.5",            # creates missing tables
@@ -582,7 +582,7 @@ def test_overrides_are_applied_before_validation():
         'output.fields=["velocity"]',
         "output.vtk=false",
     ])
-    assert deck.time.cfl == 0.2
+    assert deck.sph.cfl == 0.2
     assert deck.material[0].E == pytest.approx(2e7)
     assert deck.body[0].velocity == (1.0, 2.0, 0.0)
     assert deck.sph.viscosity.alpha == 0.5
@@ -593,18 +593,30 @@ def test_overrides_are_applied_before_validation():
 @pytest.mark.parametrize("override, path, fragment", [
     ("material.rubbr.E=1", "material.rubbr.E", "did you mean 'rubber'"),
     ("material.3.E=1", "material.3.E", "index 3 is out of range"),
-    ("time.cfl", "time.cfl", "key=value"),
+    ("sph.cfl", "sph.cfl", "key=value"),
     ("=3", "=3", "key=value"),
     ("run.t_end.x=1", "run.t_end.x", "not a table"),
     ("run.t_end.x.y=1", "run.t_end.x.y", "not a table"),
     ("wall.0.point.7=1", "wall.0.point.7", "out of range"),
     ("set.0.name=a", "set.0.name", "no [[set]] tables"),
-    ("time.cfll=0.2", "time.cfll", "did you mean 'cfl'"),
-    ("time.cfl=2", "time.cfl", "out of range"),
+    ("sph.cfll=0.2", "sph.cfll", "did you mean 'cfl'"),
+    ("sph.cfl=2", "sph.cfl", "out of range"),
 ])
 def test_bad_override(override, path, fragment):
     problems = problems_of(MINIMAL, overrides=[override])
     assert fragment in line_for(problems, path)
+
+
+@pytest.mark.parametrize("override, path, fix", [
+    ("time.cfl=0.2", "time.cfl", "write it as [sph] cfl"),
+    ("sph.hourglass=10", "sph.hourglass", "write it as hourglass_coefficient"),
+])
+def test_a_moved_key_is_refused_naming_where_it_went(override, path, fix):
+    # one meaning per name: [time] cfl went to [sph] (each part kind has its
+    # own factor on its stable step), [sph] hourglass became
+    # hourglass_coefficient ([[mesh]] hourglass names the control's form)
+    line = line_for(problems_of(MINIMAL, overrides=[override]), path)
+    assert "the key moved" in line and fix in line
 
 
 def test_missing_file(tmp_path):

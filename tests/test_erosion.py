@@ -43,7 +43,7 @@ def empty_sph(dim, mat, n_hist=1):
     s = SPHSettings(correction=False, alpha=1.0, beta=2.0, xsph=0.0, benz=False,
                     h_min_factor=0.5, h_max_factor=2.0, skin_factor=0.1, cfl=0.3,
                     stress_exponent=4.0, epsilon=(0.0,), total_lagrangian=(False,),
-                    hourglass=0.0, reference_update_every=0, crack_band=2.0)
+                    hourglass_coefficient=0.0, reference_update_every=0, crack_band=2.0)
     return SPHPart(p, [g], KernelContext.named("cubic_spline", dim, 2.0), s)
 
 

@@ -151,7 +151,7 @@ def _settings(correction, limits, cfl=0.3):
     return SPHSettings(correction=correction, alpha=1.0, beta=2.0, xsph=0.0, benz=True,
                        h_min_factor=0.1, h_max_factor=20.0, skin_factor=0.2, cfl=cfl,
                        stress_exponent=4.0, epsilon=(0.0,), total_lagrangian=(False,),
-                       hourglass=0.0, reference_update_every=0, crack_band=2.0,
+                       hourglass_coefficient=0.0, reference_update_every=0, crack_band=2.0,
                        density_limits=limits)
 
 

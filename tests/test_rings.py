@@ -179,7 +179,7 @@ def test_artificial_stress_keeps_rings_intact_and_they_bounce():
 
 # ------------------------------------------------------- total-Lagrangian rings
 def _tl_rings(contact=None, hourglass=10.0, update=0):
-    extra = (f'formulation = "total_lagrangian"\nhourglass = {hourglass}\n'
+    extra = (f'formulation = "total_lagrangian"\nhourglass_coefficient = {hourglass}\n'
              f'reference_update_every = {update}')
     deck = RINGS.format(eps=0.0, dx=DX, v=V0).replace("[sph]", "[sph]\n" + extra)
     if contact is not None:

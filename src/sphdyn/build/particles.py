@@ -16,7 +16,7 @@ from .registry import Builder, Built, register
 
 def sph_settings(deck, converted: int = 0, sublayer: int = 0,
                  debris: int = 0) -> SPHSettings:
-    """The SPH scheme's settings from ``[sph]``, ``[time]`` and the bodies;
+    """The SPH scheme's settings from ``[sph]`` and the bodies;
     ``converted`` bodies made of mesh elements follow after the deck's, with
     the [sph] formulation and artificial stress, then the ``sublayer`` bodies
     of bars and the ``debris`` bodies of eroded elements, updated-Lagrangian
@@ -34,9 +34,10 @@ def sph_settings(deck, converted: int = 0, sublayer: int = 0,
         benz=sph.smoothing_length.mode == "benz",
         h_min_factor=sph.smoothing_length.min_factor,
         h_max_factor=sph.smoothing_length.max_factor,
-        skin_factor=sph.neighbours.skin_factor, cfl=deck.time.cfl,
+        skin_factor=sph.neighbours.skin_factor, cfl=sph.cfl,
         stress_exponent=sph.artificial_stress.n, epsilon=eps, total_lagrangian=tl,
-        hourglass=sph.hourglass, reference_update_every=sph.reference_update_every,
+        hourglass_coefficient=sph.hourglass_coefficient,
+        reference_update_every=sph.reference_update_every,
         crack_band=sph.crack_band,
         density_limits=tuple((m.min_density_factor, m.max_density_factor)
                              for m in deck.material),

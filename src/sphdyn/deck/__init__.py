@@ -1,6 +1,6 @@
 """Input decks: TOML files validated into a frozen :class:`Deck` in SI units.
 
->>> deck = load_deck("impact.toml", overrides=["time.cfl=0.2"])  # doctest: +SKIP
+>>> deck = load_deck("impact.toml", overrides=["sph.cfl=0.2"])  # doctest: +SKIP
 
 Every problem found in a deck is reported at once in a :class:`DeckError`,
 one line per problem: ``<path>: <what is wrong>. Fix: <what to write>``.
@@ -102,7 +102,7 @@ def loads_deck(text: str, base_dir: str | Path = ".",
     overrides : list of str, optional
         ``"dotted.key=value"`` settings applied to the parsed TOML before
         validation.  The value is read as a TOML value if possible
-        (``time.cfl=0.2``, ``body.0.velocity=[0, -5, 0]``) and as a string
+        (``sph.cfl=0.2``, ``body.0.velocity=[0, -5, 0]``) and as a string
         otherwise (``body.disc.dx=0.5 mm``).  List entries are chosen by
         index or by name: ``material.0.E`` or ``material.steel.E``.
     source : str
@@ -153,7 +153,7 @@ def _apply_override(raw: dict, item: str) -> None:
     if not sep or not key or not all(parts):
         raise _OverrideError(format_problem(
             key or item, f"the override '{item}' is not of the form key=value",
-            "write e.g. time.cfl=0.2 or material.steel.E=\"210 GPa\""))
+            "write e.g. sph.cfl=0.2 or material.steel.E=\"210 GPa\""))
     try:
         value = tomllib.loads(f"v = {text.strip()}")["v"]
     except tomllib.TOMLDecodeError:

@@ -36,8 +36,6 @@ t_end = "1 ms"                # impact and rebound, inside the guard box
 [sph]
 kernel = "cubic_spline"
 h_factor = 1.2
-
-[time]
 cfl = 0.3
 
 [[material]]
@@ -103,7 +101,7 @@ Tables written `[[name]]` may appear several times; their `name` must be
 unique within the kind, and other tables refer to them by that name.
 
 Any key can be overridden from the command line with `dotted.key=value`
-(`time.cfl=0.2`, `material.rubber.E="12 MPa"`, `body.0.dx=1e-3`).  The
+(`sph.cfl=0.2`, `material.rubber.E="12 MPa"`, `body.0.dx=1e-3`).  The
 fully resolved deck (all defaults filled in, SI numbers) can be written with
 `sphdyn.deck.dump_resolved`.
 
@@ -227,7 +225,10 @@ def _section(title: str, model: type[BaseModel], level: int, path: str = "",
     if doc.startswith("[") and ": " in doc:  # drop the "[run]: " prefix
         doc = doc.split(": ", 1)[1]
     doc = doc[:1].upper() + doc[1:]
+    moved = [f"`{key}` moved: write it as {where}." for key, where in
+             getattr(model, "moved", {}).items()]
     return ([f"{'#' * level} {title}", "", doc, ""] + _rows(model) + [""]
+            + ([" ".join(moved), ""] if moved else [])
             + _subsections(path, model, level + 1, seen))
 
 

@@ -146,6 +146,9 @@ def _explain_one(err: dict, where: Where, params: tuple = ()) -> tuple[str, str]
     if kind == "missing":
         return "a required key is missing", f"add {_example(where)}"
     if kind == "extra_forbidden":
+        moved = getattr(where.owner, "moved", {}).get(str(where.key))
+        if moved is not None:
+            return "the key moved", f"write it as {moved}"
         valid = list(where.owner.model_fields) if where.owner else []
         return "unknown key", suggest(
             str(where.key), valid,

@@ -11,7 +11,7 @@ every deck table.
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any, Literal, Optional
+from typing import Annotated, Any, ClassVar, Literal, Optional
 
 from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict,
                       Strict, ValidationInfo)
@@ -23,9 +23,15 @@ from .units import (ACCELERATION, LENGTH, PRESSURE, TIME, VELOCITY, Dimension,
 
 
 class Section(BaseModel):
-    """Base of all deck tables: frozen, unknown keys rejected."""
+    """Base of all deck tables: frozen, unknown keys rejected.
+
+    ``moved`` names keys a table no longer has and where they went (a key of
+    this table or another table's ``[t] key``): a deck using one is refused
+    with that fix.
+    """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+    moved: ClassVar[dict[str, str]] = {}
 
 
 @dataclass(frozen=True)

@@ -81,7 +81,7 @@ def energy_diagnosis(s, error: float, limit: float, scale: float, growth: float)
                      "between parts; the residuals include what they moved.")
     lines.append("  Likely causes: an element or particle crushed or inverted (see its "
                  "specific energy), a time step too large for a contact or material "
-                 "(lower time.cfl or the contact's alpha), an interaction changing "
+                 "(lower sph.cfl or the contact's alpha), an interaction changing "
                  "velocities outside the work books, or a model error in the named "
                  "part. Raise [run] energy_error_limit or set energy_error_action = "
                  "\"warn\" only if the error is understood.")
@@ -157,7 +157,7 @@ def check_particles(p, lo, hi, t, step, work: np.ndarray, label: str = "") -> No
         lines.append(f"  {nonfinite.size} {what} with non-finite values in "
                      f"{', '.join(which) or 'state'}; first: "
                      + _describe(p, nonfinite[:5]))
-        lines.append("  Likely causes: time step too large (lower time.cfl), too "
+        lines.append("  Likely causes: time step too large (lower sph.cfl), too "
                      "stiff contact (lower wall.alpha), or a material failing to converge.")
     if outside.size:
         lines.append(f"  {outside.size} {what} left the domain box "

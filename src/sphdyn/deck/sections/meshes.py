@@ -433,7 +433,8 @@ class Mesh(Section):
     q2: real("linear bulk viscosity", lo=0) = Field(
         0.06, description="Linear bulk-viscosity coefficient.")
     cfl: real("element step factor", lo=0, hi=1, lo_open=True) = Field(
-        0.9, description="Factor on the element stable step (LS-DYNA TSSFAC).")
+        0.9, description="Factor on the element stable step (LS-DYNA TSSFAC; the "
+                         "particles have theirs: [sph] cfl).")
     velocity: VelocityVector = Field((0.0, 0.0, 0.0),
                                      description="Initial velocity of the nodes.")
     damping: quantity(RATE, "damping coefficient", lo=0) = Field(

@@ -1,6 +1,6 @@
 """Deck sections [run], [time] and [domain]: what is simulated, how it steps."""
 
-from typing import Annotated, Literal, Optional
+from typing import Annotated, ClassVar, Literal, Optional
 
 from pydantic import AfterValidator, BeforeValidator, Field, StrictStr
 
@@ -94,8 +94,9 @@ class MassScaling(Section):
 class Time(Section):
     """[time]: explicit time stepping."""
 
-    cfl: real("CFL number", lo=0, hi=1, lo_open=True) = Field(
-        0.3, description="Courant number: dt = cfl * min(h / (c + |v|)).")
+    moved: ClassVar[dict[str, str]] = {
+        "cfl": "[sph] cfl (each part kind has its own: [sph] cfl for particles, "
+               "[[mesh]] cfl for elements)"}
     dt_max: Optional[quantity(TIME, "time step", lo=0, lo_open=True)] = Field(
         None, description="Upper bound on the time step (absent: no bound).")
     collapse_ratio: real("ratio", lo=0, hi=1, lo_open=True, hi_open=True) = \

@@ -5,7 +5,7 @@ total-Lagrangian bodies need because they see no other body through the SPH
 sums.
 """
 
-from typing import Literal, Optional
+from typing import ClassVar, Literal, Optional
 
 from pydantic import Field, StrictBool
 
@@ -74,7 +74,15 @@ class Sph(Section):
         "gradients in the initial configuration (no tensile instability; "
         "separate bodies then interact only through [contact]). See "
         "docs/tensile-instability.md.")
-    hourglass: real("hourglass coefficient", lo=0) = Field(
+    moved: ClassVar[dict[str, str]] = {
+        "hourglass": "hourglass_coefficient (as in [[mesh]], where hourglass "
+                     "names the control's form)"}
+
+    cfl: real("CFL number", lo=0, hi=1, lo_open=True) = Field(
+        0.3, description="Factor on the particles' stable step (Courant number): "
+        "dt = cfl * min(h / (c + |v|)) over the particles (the elements of a mesh "
+        "have theirs: [[mesh]] cfl).")
+    hourglass_coefficient: real("hourglass coefficient", lo=0) = Field(
         10.0, description="Ganzenmueller (2015) hourglass coefficient alpha "
                           "of total-Lagrangian bodies (0 = off; 10-50 "
                           "recommended). Unused by updated-Lagrangian bodies.")

@@ -75,7 +75,7 @@ class SPHSettings:
     stress_exponent: float  # artificial stress n (Monaghan 2000)
     epsilon: tuple  # artificial stress epsilon per body
     total_lagrangian: tuple  # per body
-    hourglass: float  # total-Lagrangian hourglass coefficient
+    hourglass_coefficient: float  # total-Lagrangian hourglass coefficient
     reference_update_every: int  # total-Lagrangian reference update (0: never)
     crack_band: float  # fracture-energy length of a particle, in particle sizes
     #: (min, max) density factors per material index (``particles.mat``): the
@@ -165,7 +165,7 @@ class SPHPart:
         self.tl = None
         if p.tl.any():
             self.tl = TotalLagrangian(p, np.flatnonzero(p.tl), kernel, p.young,
-                                      settings.hourglass, settings.alpha, settings.beta)
+                                      settings.hourglass_coefficient, settings.alpha, settings.beta)
         p.on_grow(self._grown)
 
     # ------------------------------------------------------- derived arrays
@@ -220,7 +220,7 @@ class SPHPart:
         self.nl = update_neighbours(self.nl, p.x, p.h, self.dim, self.ul_active)
         if self.tl is None and p.tl.any():  # the first total-Lagrangian particles
             self.tl = TotalLagrangian(p, np.flatnonzero(p.tl), self.kernel, p.young,
-                                      self.s.hourglass, self.s.alpha, self.s.beta)
+                                      self.s.hourglass_coefficient, self.s.alpha, self.s.beta)
         elif self.tl is not None:
             self.tl.rows = np.flatnonzero(p.tl).astype(np.int64)
             self.tl.young = p.young
@@ -315,7 +315,7 @@ class SPHPart:
             raise SimulationFailed(
                 f"run stopped at t = {t:.6e} s: {exc} ({bad.size} particle(s), first "
                 f"{bad[:5].tolist()}). Likely causes: a time step too large for the "
-                "material (lower time.cfl; check density and moduli) or too stiff "
+                "material (lower sph.cfl; check density and moduli) or too stiff "
                 "contact.") from None
         if self.tl is not None and s.reference_update_every and \
                 self.step % s.reference_update_every == 0:
