@@ -266,6 +266,40 @@ vtk = false
 """
 
 
+def test_output_fields_name_the_cells_of_meshes_too():
+    """The output-field registry covers mesh cells: every cell field a solid,
+    a beam and a truss part offers is registered as a cell field (or is a
+    history column of its material), and the deck's output.fields picks the
+    ones a mesh frame writes; the particles' frame skips the cells' fields."""
+    from sphdyn.fields import FIELDS, default_fields
+    from sphdyn.io import particle_fields
+
+    solid = bar_deck()
+    beam = CANTILEVER.format(materials=MATERIALS, damping="0 1/s", ramp="1 ms",
+                             t_end="1 ms")
+    truss = beam.replace('element = "beam"', 'element = "truss"').replace(
+        'rotations = "fixed"\n', '')
+    offered = set()
+    for deck in (solid, loads_deck(beam), loads_deck(truss)):
+        for part in build_stepper(deck).parts:
+            fields = part.fields()
+            history = set(getattr(getattr(part, "pts", None), "hist_names", ()))
+            history |= set(getattr(getattr(part, "model", None), "history_names", ()))
+            for name in fields:
+                assert name in history or (name in FIELDS and FIELDS[name].cells), name
+            offered |= set(fields)
+            # the defaults write every cell field a part has (as before the
+            # registry knew them); a named list only those named
+            assert set(part.frame().cell_data) == set(fields)
+            picked = [n for n in fields if n in ("von_mises", "axial_force")]
+            assert set(part.frame(["velocity", *picked]).cell_data) == set(picked)
+    assert {"hourglass_energy", "axial_force", "moment_y", "lateral_stress"} <= offered
+    assert {"hourglass_energy", "axial_force"} <= set(default_fields())
+    deck = bar_deck(extra='fields = ["velocity", "axial_force", "hourglass_energy"]')
+    assert set(particle_fields(build_model(deck).particles, list(deck.output.fields))) \
+        == {"position", "mass", "velocity"}
+
+
 def test_cantilever_of_beams_from_a_deck_deflects_as_PL3_over_3EI():
     # I about the local y axis: the height (80 mm) runs along local z = x X y
     # = global z, the load's direction: I = b h^3 / 12

@@ -1,4 +1,4 @@
-"""Registry of per-particle output fields: what frames, the deck and probes may name.
+"""Registry of output fields: what frames, the deck and probes may name.
 
 Each :class:`OutputField` has a name, a shape per particle (``scalar``,
 ``vector`` (3), ``tensor`` (3x3, written as 9 row-major values) or
@@ -9,6 +9,10 @@ zero-argument callables for fields a part evaluates itself (e.g.
 ``"swegle"``, ``"phase"``, ``"variation"``; ``SPHPart.fields()``).
 Getters return fresh arrays for all particles, so the state can keep
 evolving.
+
+Fields marked ``cells`` are also (or only) cell fields of meshes: a mesh
+frame writes those of ``output.fields`` its part has, with every history
+column of its materials (:func:`sphdyn.parts.fem.output.mesh_frame`).
 
 Readers: :func:`sphdyn.io.fields.particle_fields` (frames), the deck's
 ``output.fields`` check and default, the ``[[probe]]`` quantities
@@ -63,16 +67,22 @@ class OutputField:
     probe : bool
         A ``[[probe]]`` quantity (vector and tensor fields: each component,
         ``velocity_x``, ``stress_xy``).
+    cells : bool
+        Also a cell field of meshes: each mesh that has it writes its value
+        per element (the part's own ``fields()``). A field of cells only has
+        no getter (``None``) and shape ``pair`` for two values per element
+        (a beam's end moments).
     """
 
     name: str
-    shape: Literal["scalar", "vector", "tensor", "history"]
+    shape: Literal["scalar", "vector", "tensor", "history", "pair"]
     unit: str
     description: str
-    getter: Getter
+    getter: Getter | None
     default: bool = False
     always: bool = False
     probe: bool = False
+    cells: bool = False
 
 
 FIELDS: dict[str, OutputField] = {}
@@ -174,34 +184,38 @@ _BUILT_IN = (
     OutputField("displacement", "vector", "m", "Displacement x - x0.",
                 lambda p, c: p.x - p.x0, default=True, probe=True),
     OutputField("stress", "tensor", "Pa", "Cauchy stress, tension positive.",
-                lambda p, c: p.sig.reshape(p.n, 9).copy(), default=True, probe=True),
+                lambda p, c: p.sig.reshape(p.n, 9).copy(), default=True, probe=True,
+                cells=True),
     OutputField("pressure", "scalar", "Pa", "Pressure -tr(sig)/3, positive in "
                 "compression.", lambda p, c: pressure(p.sig), default=True, probe=True),
     OutputField("von_mises", "scalar", "Pa", "Von Mises stress sqrt(3/2 s:s), s "
                 "the deviatoric stress.", lambda p, c: von_mises(p.sig), default=True,
-                probe=True),
+                probe=True, cells=True),
     OutputField("density", "scalar", "kg/m^3", "Current density rho.",
-                _array("rho"), default=True, probe=True),
+                _array("rho"), default=True, probe=True, cells=True),
     OutputField("mass", "scalar", "kg", "Mass m (kg/m in 2D, kg/m^2 in 1D).",
                 _array("m"), always=True),
     OutputField("smoothing_length", "scalar", "m", "Smoothing length h.",
                 _array("h"), default=True, probe=True),
     OutputField("damage", "scalar", "-", "Scalar damage in [0, 1].",
-                _array("damage"), default=True, probe=True),
+                _array("damage"), default=True, probe=True, cells=True),
     OutputField("internal_energy", "scalar", "J/kg", "Specific internal energy e.",
                 _array("e"), default=True, probe=True),
     OutputField("plastic_strain", "history", "-", "Equivalent plastic strain "
                 "(history of j2 materials).",
-                lambda p, c: history_column(p, "plastic_strain"), probe=True),
+                lambda p, c: history_column(p, "plastic_strain"), probe=True,
+                cells=True),
     # the CSCM's two damage modes apart (LS-DYNA MAT_159's NPLOT = 2 and 3);
     # ``damage`` is the applied one (their maximum, brittle recovered in
     # compression)
     OutputField("damage_brittle", "history", "-", "Brittle (tensile) damage in [0, 1] "
                 "(history of cscm materials).",
-                lambda p, c: history_column(p, "damage_brittle"), probe=True),
+                lambda p, c: history_column(p, "damage_brittle"), probe=True,
+                cells=True),
     OutputField("damage_ductile", "history", "-", "Ductile (compressive) damage in [0, 1] "
                 "(history of cscm materials).",
-                lambda p, c: history_column(p, "damage_ductile"), probe=True),
+                lambda p, c: history_column(p, "damage_ductile"), probe=True,
+                cells=True),
     OutputField("bc", "scalar", "-", "Boundary-condition flag (int8).", _array("bc")),
     OutputField("body", "scalar", "-", "Body index (int32).", _array("body")),
     OutputField("material", "scalar", "-", "Material index (int32).", _array("mat")),
@@ -216,6 +230,27 @@ _BUILT_IN = (
     OutputField("variation", "scalar", "-", "Factor of the [material.variation] "
                 "parameter (1 for materials without variation).",
                 _computed_or("variation", lambda p: np.ones(p.n))),
+    # cell fields of meshes only (their parts' fields())
+    OutputField("hourglass_energy", "scalar", "J", "Hourglass energy of a solid element.",
+                None, default=True, cells=True),
+    OutputField("volume", "scalar", "m^3", "Current volume of a solid element (m^2 in "
+                "2D).", None, default=True, cells=True),
+    OutputField("axial_force", "scalar", "N", "Axial force of a bar or beam element, "
+                "tension positive.", None, default=True, cells=True),
+    OutputField("axial_stress", "scalar", "Pa", "Axial force over the section area of "
+                "a bar or beam element.", None, default=True, cells=True),
+    OutputField("lateral_stress", "scalar", "Pa", "Mean lateral stress of a truss "
+                "element's material point.", None, default=True, cells=True),
+    OutputField("torque", "scalar", "N m", "Torque of a beam element.", None,
+                default=True, cells=True),
+    OutputField("moment_y", "pair", "N m", "Bending moments about the section's y "
+                "axis at a beam element's two ends.", None, default=True, cells=True),
+    OutputField("moment_z", "pair", "N m", "Bending moments about the section's z "
+                "axis at a beam element's two ends.", None, default=True, cells=True),
+    OutputField("shear_y", "scalar", "N", "Shear force along the section's y axis of "
+                "a beam element.", None, default=True, cells=True),
+    OutputField("shear_z", "scalar", "N", "Shear force along the section's z axis of "
+                "a beam element.", None, default=True, cells=True),
 )
 
 for _field in _BUILT_IN:

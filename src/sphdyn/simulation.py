@@ -246,7 +246,7 @@ class Simulation:
             if part.kin is self.particles:  # the others draw their own blocks
                 computed.update(part.fields())
         fields = particle_fields(self.particles, self.fields, computed)
-        self.frames.write(s.t, s.step_count, fields, meshes=mesh_frames(s.parts),
+        self.frames.write(s.t, s.step_count, fields, meshes=mesh_frames(s.parts, self.fields),
                           attrs=attrs)
         if attrs is None:  # a stop frame leaves the schedule as it was
             self.output.written(s.t)
@@ -374,11 +374,12 @@ def summary_text(summary: dict, outdir) -> str:
     return "\n".join(lines)
 
 
-def mesh_frames(parts) -> dict[str, MeshFrame]:
+def mesh_frames(parts, fields=None) -> dict[str, MeshFrame]:
     """Each part's own picture in a frame, by part name: the parts that draw one
-    (``frame()``, :func:`sphdyn.parts.fem.output.mesh_frame`); the particles
-    are written as the frame's points instead."""
-    return {part.name: part.frame() for part in parts if hasattr(part, "frame")}
+    (``frame(fields)``, :func:`sphdyn.parts.fem.output.mesh_frame`; ``fields``
+    the deck's ``output.fields``); the particles are written as the frame's
+    points instead."""
+    return {part.name: part.frame(fields) for part in parts if hasattr(part, "frame")}
 
 
 def _output_failure(exc: OSError, s) -> str:

@@ -262,12 +262,14 @@ def _subsections(path: str, model: type[BaseModel], level: int,
 def _field_rows() -> list[str]:
     """The output-field registry as a table."""
     size = {"scalar": "1", "vector": "3", "tensor": "9 (3x3, row-major)",
-            "history": "1 (history column)"}
-    rows = ["| name | values per particle | unit | default | description |",
-            "|---|---|---|---|---|"]
+            "history": "1 (history column)", "pair": "2 (one per end)"}
+    rows = ["| name | of | values per item | unit | default | description |",
+            "|---|---|---|---|---|---|"]
     for f in FIELDS.values():
+        of = ("particles, cells" if f.cells and f.getter is not None
+              else "cells" if f.cells else "particles")
         rows.append("| " + " | ".join(_cell(c) for c in (
-            f"`{f.name}`", size[f.shape], f.unit,
+            f"`{f.name}`", of, size[f.shape], f.unit,
             "always" if f.always else "yes" if f.default else "", f.description)) + " |")
     return rows
 
@@ -283,9 +285,12 @@ def generate() -> str:
     lines += ["## Output fields", "",
               "Names accepted in `output.fields` (frames always hold "
               + ", ".join(always) + "; *default* marks the fields written when "
-              "`output.fields` is not given). A `[[probe]]` records scalar fields and "
-              "the components of vector and tensor fields (`velocity_x`, "
-              "`stress_xy`).", ""] + _field_rows() + [""]
+              "`output.fields` is not given). Fields *of particles* go to the "
+              "frames' points; fields *of cells* to each mesh's block, where the mesh "
+              "has them (its nodes always carry displacement, velocity and mass, its "
+              "cells every history column of its materials). A `[[probe]]` records "
+              "scalar fields and the components of vector and tensor fields "
+              "(`velocity_x`, `stress_xy`).", ""] + _field_rows() + [""]
     return "\n".join(lines).rstrip("\n") + "\n"
 
 

@@ -41,7 +41,8 @@ def particle_fields(p: "Particles", names: list[str],
     -------
     dict of str to ndarray
         The fields written in every frame (``"position"``) first, then the
-        requested fields in the order given. Every array is a fresh copy.
+        requested fields in the order given (not the cell fields of
+        meshes only). Every array is a fresh copy.
 
     Raises
     ------
@@ -57,8 +58,8 @@ def particle_fields(p: "Particles", names: list[str],
     always = [n for n, f in FIELDS.items() if f.always]
     out: dict[str, np.ndarray] = {}
     for name in [*always, *names]:
-        if name in out:
-            continue
+        if name in out or (name in FIELDS and FIELDS[name].getter is None):
+            continue  # (a cell field of meshes only)
         if name in built_in:
             out[name] = FIELDS[name].getter(p, computed or {})
         else:

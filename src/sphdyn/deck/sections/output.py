@@ -51,8 +51,12 @@ class Output(Section):
                                               "for ParaView.")
     fields: tuple[Annotated[str, Strict(), AfterValidator(known_field)],
                   ...] = Field(default_fields(),
-                               description="Particle fields written in "
-                                           "frames.")
+                               description="Fields written in frames: the "
+                               "particles' (those of the particle fields), and "
+                               "each mesh's cells' (those of the cell fields "
+                               "it has, besides its materials' history "
+                               "columns, always written). See the output "
+                               "fields below.")
     history_every: integer("step count", lo=1) = Field(
         10, description="Steps between history records (energies, contact "
                         "forces).")

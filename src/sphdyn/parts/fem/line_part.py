@@ -377,9 +377,10 @@ class LinePart:
             out[f"{p}_lateral_unconverged"] = float(self.lateral_unconverged)
         return out
 
-    def frame(self):
-        """The part's picture in an output frame (:func:`.output.mesh_frame`)."""
-        return mesh_frame(self, self.elements, "line2")
+    def frame(self, fields=None):
+        """The part's picture in an output frame, with the cell ``fields``
+        named (:func:`.output.mesh_frame`)."""
+        return mesh_frame(self, self.elements, "line2", fields)
 
     def summary(self) -> dict:
         """The part's entry in the run's summary (:func:`.output.mesh_summary`)."""

@@ -463,9 +463,10 @@ class SolidPart:
             out[name] = (lambda k=k: self.element_mean(self.pts.hist[:, k]))
         return out
 
-    def frame(self):
-        """The part's picture in an output frame (:func:`.output.mesh_frame`)."""
-        return mesh_frame(self, self.el, self.element_kind)
+    def frame(self, fields=None):
+        """The part's picture in an output frame, with the cell ``fields``
+        named (:func:`.output.mesh_frame`)."""
+        return mesh_frame(self, self.el, self.element_kind, fields)
 
     def summary(self) -> dict:
         """The part's entry in the run's summary (:func:`.output.mesh_summary`)."""
