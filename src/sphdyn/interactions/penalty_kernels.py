@@ -153,6 +153,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from ..algebra3 import load3
 from .penalty_geometry import closest_point, face_point, face_shapes
 from .wall_contact import (STIFFNESS_MASS, contact_thickness, keep_spring_energy,
                            spring_acceleration)
@@ -180,9 +181,7 @@ def _relative_velocity(vp, vn, i, face, N):
     r""":math:`\mathbf v_p - \sum_a N_a \mathbf v_a` [m/s] (3 floats) of particle
     ``i`` (``vp`` (N, 3)) against the point of ``face`` (nf,) with shape values
     ``N`` (``vn`` (M, 3) node velocities)."""
-    w0 = vp[i, 0]
-    w1 = vp[i, 1]
-    w2 = vp[i, 2]
+    w0, w1, w2 = load3(vp, i)
     for a in range(face.shape[0]):
         w0 -= N[a] * vn[face[a], 0]
         w1 -= N[a] * vn[face[a], 1]

@@ -68,6 +68,8 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from ...algebra3 import load9, matmul9, tmatmul9
+
 #: columns of the beam's element resultants ``res`` (E, 9)
 RES_N, RES_T, RES_MY_A, RES_MY_B, RES_MZ_A, RES_MZ_B, RES_VY, RES_VZ, RES_L = range(9)
 N_RES = 9
@@ -121,40 +123,6 @@ def rotation_vector(r):
     return (f * w0, f * w1, f * w2)
 
 
-@njit(cache=True, error_model="numpy")
-def _load9(t, i):
-    return (t[i, 0, 0], t[i, 0, 1], t[i, 0, 2], t[i, 1, 0], t[i, 1, 1], t[i, 1, 2],
-            t[i, 2, 0], t[i, 2, 1], t[i, 2, 2])
-
-
-@njit(cache=True, error_model="numpy")
-def _matmul(a, b):
-    """``a b`` of two 9-tuples (row by row)."""
-    return (a[0] * b[0] + a[1] * b[3] + a[2] * b[6],
-            a[0] * b[1] + a[1] * b[4] + a[2] * b[7],
-            a[0] * b[2] + a[1] * b[5] + a[2] * b[8],
-            a[3] * b[0] + a[4] * b[3] + a[5] * b[6],
-            a[3] * b[1] + a[4] * b[4] + a[5] * b[7],
-            a[3] * b[2] + a[4] * b[5] + a[5] * b[8],
-            a[6] * b[0] + a[7] * b[3] + a[8] * b[6],
-            a[6] * b[1] + a[7] * b[4] + a[8] * b[7],
-            a[6] * b[2] + a[7] * b[5] + a[8] * b[8])
-
-
-@njit(cache=True, error_model="numpy")
-def _tmatmul(a, b):
-    """``a^T b`` of two 9-tuples (row by row)."""
-    return (a[0] * b[0] + a[3] * b[3] + a[6] * b[6],
-            a[0] * b[1] + a[3] * b[4] + a[6] * b[7],
-            a[0] * b[2] + a[3] * b[5] + a[6] * b[8],
-            a[1] * b[0] + a[4] * b[3] + a[7] * b[6],
-            a[1] * b[1] + a[4] * b[4] + a[7] * b[7],
-            a[1] * b[2] + a[4] * b[5] + a[7] * b[8],
-            a[2] * b[0] + a[5] * b[3] + a[8] * b[6],
-            a[2] * b[1] + a[5] * b[4] + a[8] * b[7],
-            a[2] * b[2] + a[5] * b[5] + a[8] * b[8])
-
-
 @njit(cache=True, error_model="numpy", parallel=True)
 def drift_rotations(triad, w, rot_x, dt):
     r"""Advance the nodal triads by the incremental rotation of one step.
@@ -169,7 +137,7 @@ def drift_rotations(triad, w, rot_x, dt):
     """
     for i in prange(triad.shape[0]):
         q = rotation_from_vector(dt * w[i, 0], dt * w[i, 1], dt * w[i, 2])
-        r = _matmul(q, _load9(triad, i))
+        r = matmul9(q, load9(triad, i))
         for k in range(9):
             triad[i, k // 3, k % 3] = r[k]
         rot_x[i, 0] += dt * w[i, 0]
@@ -212,9 +180,9 @@ def beam_forces(x, triad, conn, frame0, L0, EA, GJ, EIy, EIz, phi_y, phi_z, fe, 
         x0 = d0 / l
         x1 = d1 / l
         x2 = d2 / l
-        f0 = _load9(frame0, e)
-        ma = _matmul(_load9(triad, a), f0)  # material frames of the element at a, b
-        mb = _matmul(_load9(triad, b), f0)
+        f0 = load9(frame0, e)
+        ma = matmul9(load9(triad, a), f0)  # material frames of the element at a, b
+        mb = matmul9(load9(triad, b), f0)
         q0 = ma[1] + mb[1]
         q1 = ma[4] + mb[4]
         q2 = ma[7] + mb[7]
@@ -229,8 +197,8 @@ def beam_forces(x, triad, conn, frame0, L0, EA, GJ, EIy, EIz, phi_y, phi_z, fe, 
         y1 = z2 * x0 - z0 * x2
         y2 = z0 * x1 - z1 * x0
         fr = (x0, y0, z0, x1, y1, z1, x2, y2, z2)
-        ta = rotation_vector(_tmatmul(fr, ma))
-        tb = rotation_vector(_tmatmul(fr, mb))
+        ta = rotation_vector(tmatmul9(fr, ma))
+        tb = rotation_vector(tmatmul9(fr, mb))
         u = l - L0[e]
         n = EA[e] * u / L0[e]
         t = GJ[e] * (tb[0] - ta[0]) / L0[e]

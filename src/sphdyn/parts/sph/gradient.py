@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from ...algebra3 import inverse_sym3, load3
 from ...kernels import dwdq_over_q, support_nb
 from ...simd import sqrt as simd_sqrt
 
@@ -32,12 +33,8 @@ def _gradient_row(i, x, v, h, m, rho, offsets, idx, n_own, kid, sigma, dim, supp
     l00 = l01 = l02 = l10 = l11 = l12 = l20 = l21 = l22 = 0.0
     # the moment matrix (symmetric: its upper triangle)
     m00 = m01 = m02 = m11 = m12 = m22 = 0.0
-    xi0 = x[i, 0]
-    xi1 = x[i, 1]
-    xi2 = x[i, 2]
-    vi0 = v[i, 0]
-    vi1 = v[i, 1]
-    vi2 = v[i, 2]
+    xi0, xi1, xi2 = load3(x, i)
+    vi0, vi1, vi2 = load3(v, i)
     three = dim == 3
     hi = h[i]
     irho = 1.0 / rho[i]
@@ -123,18 +120,7 @@ def finish_row(i, dim, correct, l00, l01, l02, l10, l11, l12, l20, l21, l22,
         if dim == 1:
             m01 = 0.0
             m11 = 1.0
-        c00 = m11 * m22 - m12 * m12
-        c01 = m02 * m12 - m01 * m22
-        c02 = m01 * m12 - m02 * m11
-        det = m00 * c00 + m01 * c01 + m02 * c02
-        if abs(det) > _DET_TOL:
-            inv = 1.0 / det
-            q00 = c00 * inv
-            q01 = c01 * inv
-            q02 = c02 * inv
-            q11 = (m00 * m22 - m02 * m02) * inv
-            q12 = (m02 * m01 - m00 * m12) * inv
-            q22 = (m00 * m11 - m01 * m01) * inv
+        q00, q01, q02, q11, q12, q22 = inverse_sym3(m00, m01, m02, m11, m12, m22, _DET_TOL)
     L[i, 0, 0] = l00 * q00 + l01 * q01 + l02 * q02
     L[i, 0, 1] = l00 * q01 + l01 * q11 + l02 * q12
     L[i, 0, 2] = l00 * q02 + l01 * q12 + l02 * q22
@@ -190,12 +176,8 @@ def _buffered_row(i, x, v, h, m, rho, offsets, idx, n_own, sigma, support_scale,
     Three numbers per pair go through the buffer, not the sums' twelve: the
     first loop was bound by its stores (BENCHMARKS.md, 2026-11-28 later),
     and reading a neighbour again, just read, costs less."""
-    xi0 = x[i, 0]
-    xi1 = x[i, 1]
-    xi2 = x[i, 2]
-    vi0 = v[i, 0]
-    vi1 = v[i, 1]
-    vi2 = v[i, 2]
+    xi0, xi1, xi2 = load3(x, i)
+    vi0, vi1, vi2 = load3(v, i)
     hi = h[i]
     irho = 1.0 / rho[i]
     o = offsets[i]

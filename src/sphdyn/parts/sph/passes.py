@@ -45,6 +45,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from ...algebra3 import load3, load9
 from ...kernels import kernel_value
 
 
@@ -73,21 +74,9 @@ def _force_row(i, x, v, m, rho, h, c, P, F, offsets, count, idx, three, support_
     row ``j``."""
     per_particle = alpha.shape[0] > 1
     want_signal = signal.shape[0] > 0
-    p00 = P[i, 0, 0]
-    p01 = P[i, 0, 1]
-    p02 = P[i, 0, 2]
-    p10 = P[i, 1, 0]
-    p11 = P[i, 1, 1]
-    p12 = P[i, 1, 2]
-    p20 = P[i, 2, 0]
-    p21 = P[i, 2, 1]
-    p22 = P[i, 2, 2]
-    xi0 = x[i, 0]
-    xi1 = x[i, 1]
-    xi2 = x[i, 2]
-    vi0 = v[i, 0]
-    vi1 = v[i, 1]
-    vi2 = v[i, 2]
+    p00, p01, p02, p10, p11, p12, p20, p21, p22 = load9(P, i)
+    xi0, xi1, xi2 = load3(x, i)
+    vi0, vi1, vi2 = load3(v, i)
     hi = h[i]
     ci = c[i]
     rhoi = rho[i]

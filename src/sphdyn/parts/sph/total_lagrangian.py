@@ -31,6 +31,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from ...algebra3 import det9, inverse3, load3, load9
 from ...kernels import dwdq_over_q, kernel_value, support_nb
 
 _DET_TOL = 1e-12
@@ -42,31 +43,6 @@ _DET_TOL = 1e-12
 # (the 600 m/s penetration stopped in one process and ran through in another:
 # tests/test_reproducible.py). Strict IEEE order costs the 2D rings nothing
 # measurable (BENCHMARKS.md).
-
-
-@njit(cache=True, error_model="numpy")
-def _inverse3(a00, a01, a02, a10, a11, a12, a20, a21, a22, out):
-    """Inverse of a 3x3 matrix into ``out`` (3, 3); identity if singular."""
-    c00 = a11 * a22 - a12 * a21
-    c01 = a02 * a21 - a01 * a22
-    c02 = a01 * a12 - a02 * a11
-    det = a00 * c00 + a10 * c01 + a20 * c02
-    if abs(det) < _DET_TOL:
-        for r in range(3):
-            for s in range(3):
-                out[r, s] = 1.0 if r == s else 0.0
-        return 0.0
-    inv = 1.0 / det
-    out[0, 0] = c00 * inv
-    out[0, 1] = c01 * inv
-    out[0, 2] = c02 * inv
-    out[1, 0] = (a12 * a20 - a10 * a22) * inv
-    out[1, 1] = (a00 * a22 - a02 * a20) * inv
-    out[1, 2] = (a02 * a10 - a00 * a12) * inv
-    out[2, 0] = (a10 * a21 - a11 * a20) * inv
-    out[2, 1] = (a01 * a20 - a00 * a21) * inv
-    out[2, 2] = (a00 * a11 - a01 * a10) * inv
-    return det
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
@@ -144,7 +120,7 @@ def reference_gradients(rows, X, h0, vol, offsets, idx, kid, sigma, dim, support
             m22 = 1.0
             s2 = 0.0
         inv = np.empty((3, 3))
-        _inverse3(m00, m01, m02, m10, m11, m12, m20, m21, m22, inv)
+        inverse3(m00, m01, m02, m10, m11, m12, m20, m21, m22, inv, _DET_TOL)
         for a in range(3):
             for b in range(3):
                 B0[i, a, b] = inv[b, a]  # B = M^{-T}
@@ -181,15 +157,9 @@ def deformation_gradient(rows, x, v, X, vol, offsets, idx, fac, B0, dim, Fdef, F
     # updated-Lagrangian ``passes.forces``: same gather pattern, other scheme
     for t in prange(rows.shape[0]):
         i = rows[t]
-        xi0 = x[i, 0]
-        xi1 = x[i, 1]
-        xi2 = x[i, 2]
-        vi0 = v[i, 0]
-        vi1 = v[i, 1]
-        vi2 = v[i, 2]
-        Xi0 = X[i, 0]
-        Xi1 = X[i, 1]
-        Xi2 = X[i, 2]
+        xi0, xi1, xi2 = load3(x, i)
+        vi0, vi1, vi2 = load3(v, i)
+        Xi0, Xi1, Xi2 = load3(X, i)
         # uncorrected sums A (positions) and D (velocities)
         a00 = a01 = a10 = a11 = 0.0
         e00 = e01 = e10 = e11 = 0.0
@@ -269,9 +239,8 @@ def _finish_gradients(i, a00, a01, a02, a10, a11, a12, a20, a21, a22,
         L[i, 0, s] = e00 * b0 + e01 * b1 + e02 * b2
         L[i, 1, s] = e10 * b0 + e11 * b1 + e12 * b2
         L[i, 2, s] = e20 * b0 + e21 * b1 + e22 * b2
-    det = _inverse3(Fdef[i, 0, 0], Fdef[i, 0, 1], Fdef[i, 0, 2], Fdef[i, 1, 0],
-                    Fdef[i, 1, 1], Fdef[i, 1, 2], Fdef[i, 2, 0], Fdef[i, 2, 1],
-                    Fdef[i, 2, 2], Finv[i])
+    f00, f01, f02, f10, f11, f12, f20, f21, f22 = load9(Fdef, i)
+    det = inverse3(f00, f01, f02, f10, f11, f12, f20, f21, f22, Finv[i], _DET_TOL)
     for r in range(3):
         t0 = L[i, r, 0]
         t1 = L[i, r, 1]
@@ -281,14 +250,6 @@ def _finish_gradients(i, a00, a01, a02, a10, a11, a12, a20, a21, a22,
                 L[i, r, s] = t0 * Finv[i, 0, s] + t1 * Finv[i, 1, s] + t2 * Finv[i, 2, s]
             else:
                 L[i, r, s] = 0.0
-
-
-@njit(cache=True, error_model="numpy")
-def _det(F, i):
-    """Determinant of ``F[i]`` (3, 3)."""
-    return (F[i, 0, 0] * (F[i, 1, 1] * F[i, 2, 2] - F[i, 1, 2] * F[i, 2, 1])
-            - F[i, 0, 1] * (F[i, 1, 0] * F[i, 2, 2] - F[i, 1, 2] * F[i, 2, 0])
-            + F[i, 0, 2] * (F[i, 1, 0] * F[i, 2, 1] - F[i, 1, 1] * F[i, 2, 0]))
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
@@ -302,7 +263,7 @@ def tl_density(rows, Fdef, rho0, h0, rho, h):
     """
     for t in prange(rows.shape[0]):
         i = rows[t]
-        det = _det(Fdef, i)
+        det = det9(Fdef, i)
         if det > 0.0:
             rho[i] = rho0[i] / det
         h[i] = h0[i]
@@ -321,7 +282,7 @@ def piola_stress(rows, Fdef, Finv, sig, vol, B0, P, Q):
     """
     for t in prange(rows.shape[0]):
         i = rows[t]
-        det = _det(Fdef, i)
+        det = det9(Fdef, i)
         for a in range(3):
             for b in range(3):
                 P[i, a, b] = det * (sig[i, a, 0] * Finv[i, b, 0] + sig[i, a, 1] * Finv[i, b, 1]
@@ -434,27 +395,13 @@ def tl_forces(rows, x, v, X, m, rho, rho0, c, h0, vol, offsets, idx, fac, hgk, g
     three = dim == 3
     for t in prange(rows.shape[0]):
         i = rows[t]
-        xi0 = x[i, 0]
-        xi1 = x[i, 1]
-        xi2 = x[i, 2]
-        vi0 = v[i, 0]
-        vi1 = v[i, 1]
-        vi2 = v[i, 2]
+        xi0, xi1, xi2 = load3(x, i)
+        vi0, vi1, vi2 = load3(v, i)
         ci = c[i]
         rhoi = rho[i]
         hi = h0[i]
-        f00 = Fdef[i, 0, 0]
-        f01 = Fdef[i, 0, 1]
-        f02 = Fdef[i, 0, 2]
-        f10 = Fdef[i, 1, 0]
-        f11 = Fdef[i, 1, 1]
-        f12 = Fdef[i, 1, 2]
-        f20 = Fdef[i, 2, 0]
-        f21 = Fdef[i, 2, 1]
-        f22 = Fdef[i, 2, 2]
-        Xi0 = X[i, 0]
-        Xi1 = X[i, 1]
-        Xi2 = X[i, 2]
+        f00, f01, f02, f10, f11, f12, f20, f21, f22 = load9(Fdef, i)
+        Xi0, Xi1, Xi2 = load3(X, i)
         a0 = a1 = a2 = 0.0  # sum_j fac Q_j (X_i - X_j)
         q0 = q1 = q2 = 0.0  # viscous acceleration
         fh0 = fh1 = fh2 = 0.0  # hourglass force [N]
