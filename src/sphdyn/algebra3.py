@@ -15,13 +15,13 @@ from __future__ import annotations
 from numba import njit
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def load3(a, i):
     """Row ``i`` of an (N, 3) array as 3 scalars."""
     return a[i, 0], a[i, 1], a[i, 2]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def load9(t, i):
     """Matrix ``i`` of an (N, 3, 3) array as 9 scalars, row-major."""
     return (t[i, 0, 0], t[i, 0, 1], t[i, 0, 2], t[i, 1, 0], t[i, 1, 1], t[i, 1, 2],

@@ -275,11 +275,11 @@ class PenaltyCoupling(InteractionBase):
         ``a_p`` and ``a_n``; its count and total normal force kept."""
         p, q = self.part.p, self.solid.nodes
         self.count = int(penalty_coupling_forces(
-            p.x, p.v, p.m, p.vol0, p.rho0, p.bulk_modulus, p.dim, q.x, q.v, q.m, self.faces,
-            self.offsets, self.cand, self.thickness_factor, self.method, self.alpha,
-            self.friction, dt, a_p, a_n, self.face_of, self.shares, self.force,
-            self.normal_force, self.accel, self.skip, self.pen0, self.last_face, self.d_last,
-            self.k_last, motion_dt))
+            (p.x, p.v, p.m, p.vol0, p.rho0, p.bulk_modulus), (q.x, q.v, q.m), p.dim,
+            self.faces, self.offsets, self.cand,
+            (self.thickness_factor, self.method, self.alpha, self.friction, dt), self.skip,
+            motion_dt, a_p, a_n, self.face_of, self.shares, self.force, self.normal_force,
+            self.accel, self.pen0, self.last_face, self.d_last, self.k_last))
         self.total_normal = float(self.normal_force.sum())
 
     # ----------------------------------------------------------- protocol

@@ -205,59 +205,182 @@ def spring_mass(m_p, inv_f):
 JUMP_FRACTION = 0.5
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _nearest_face(i, xp, xn, faces, offsets, cand):
+    """The candidate face nearest to particle ``i`` (a tie to the lower face
+    index, so the result does not depend on the candidates' order) and its
+    closest point (:func:`~.penalty_geometry.closest_point`): ``(face, xi,
+    eta, cx, cy, cz, nx, ny, nz, clamped)``; face -1 if it has none."""
+    best = np.inf
+    bf = -1
+    xi, eta, cx, cy, cz, nx, ny, nz, clamped = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, False
+    for k in range(offsets[i], offsets[i + 1]):
+        f = cand[k]
+        res = closest_point(xp[i], xn, faces[f])
+        r0 = xp[i, 0] - res[2]
+        r1 = xp[i, 1] - res[3]
+        r2 = xp[i, 2] - res[4]
+        d2 = r0 * r0 + r1 * r1 + r2 * r2
+        if d2 < best or (d2 == best and f < bf):
+            best = d2
+            bf = f
+            xi, eta, cx, cy, cz, nx, ny, nz, clamped = res
+    return bf, xi, eta, cx, cy, cz, nx, ny, nz, clamped
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _gap_and_direction(i, xp, cx, cy, cz, nx, ny, nz, clamped, tp):
+    r"""``(touching, gap, e0, e1, e2)`` of particle ``i`` against its face's
+    closest point ``c`` (normal ``n``): inside the face's outline (or within
+    ``_INSIDE_RTOL tp`` of it) the gap along the normal, :math:`g = (\mathbf
+    x - \mathbf c)\cdot\mathbf n - t_p`, direction :math:`\mathbf n`; beyond
+    an edge, in front of the face's plane, the distance to the edge point
+    and its direction; behind the plane beyond an edge, no contact
+    (``touching`` False)."""
+    r0 = xp[i, 0] - cx
+    r1 = xp[i, 1] - cy
+    r2 = xp[i, 2] - cz
+    rn = r0 * nx + r1 * ny + r2 * nz
+    l0 = r0 - rn * nx
+    l1 = r1 - rn * ny
+    l2 = r2 - rn * nz
+    lat = np.sqrt(l0 * l0 + l1 * l1 + l2 * l2)
+    if (not clamped) or lat <= _INSIDE_RTOL * tp:
+        return True, rn - tp, nx, ny, nz
+    if rn > 0.0:
+        dist = np.sqrt(r0 * r0 + r1 * r1 + r2 * r2)
+        return True, dist - tp, r0 / dist, r1 / dist, r2 / dist
+    return False, 0.0, 0.0, 0.0, 0.0
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _extension(i, bf, gap, pen, tp, vp, vn, face, N, motion_dt, pen0, last_face, d_last):
+    r"""The spring's extension :math:`\delta - \delta_0` of particle ``i`` at
+    face ``bf`` (nodes ``face``, shape values ``N``), penetration ``pen`` =
+    :math:`\max(-g, 0)`, after the allowance :math:`\delta_0` (``pen0``)
+    takes what the motion cannot explain: at a switch of face any excess of
+    the depth's growth over the approach :math:`|\mathbf v_r|`
+    ``motion_dt``, on the same face an excess beyond ``JUMP_FRACTION`` of
+    the thickness ``tp`` (module docstring); the face and depth kept for the
+    next evaluation."""
+    leap = 0.0 if bf != last_face[i] else JUMP_FRACTION * tp
+    if last_face[i] != -1 and -gap - d_last[i] > leap:  # (else the excess is less)
+        w0, w1, w2 = _relative_velocity(vp, vn, i, face, N)
+        excess = -gap - d_last[i] - motion_dt * np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+        if excess > leap:  # deeper than the motion can take it: geometry
+            pen0[i] = min(pen0[i] + excess, pen)
+    if pen < pen0[i]:
+        pen0[i] = pen
+    last_face[i] = bf
+    d_last[i] = -gap
+    return pen - pen0[i]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _with_friction(f0, f1, f2, fn, e0, e1, e2, friction, dt, inv_meff, vp, vn, i, face,
+                   N):
+    r"""The force ``f`` with Coulomb friction added against the tangential
+    relative velocity :math:`\mathbf v_t`: :math:`\min(\mu F_n, |\mathbf
+    v_t| / (\Delta t\, m_{eff}^{-1}))`, the second bound stopping the
+    sliding within the step (``inv_meff`` :math:`1/m_p + 1/m_f`)."""
+    w0, w1, w2 = _relative_velocity(vp, vn, i, face, N)
+    wn = w0 * e0 + w1 * e1 + w2 * e2
+    t0 = w0 - wn * e0
+    t1 = w1 - wn * e1
+    t2 = w2 - wn * e2
+    vt = np.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
+    if vt > 0.0:
+        ft = min(friction * fn, vt / (dt * inv_meff))
+        f0 -= ft * t0 / vt
+        f1 -= ft * t1 / vt
+        f2 -= ft * t2 / vt
+    return f0, f1, f2
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _accelerate(i, c0, c1, c2, accel, a_p):
+    """Particle ``i``'s contact acceleration ``c`` kept in ``accel`` and added to ``a_p``."""
+    accel[i, 0] = c0
+    accel[i, 1] = c1
+    accel[i, 2] = c2
+    a_p[i, 0] += accel[i, 0]
+    a_p[i, 1] += accel[i, 1]
+    a_p[i, 2] += accel[i, 2]
+
+
+@njit(cache=True, error_model="numpy")
+def _gather_shares(face_of, faces, shares, mn, a_n):
+    """The face nodes' shares of the contact forces into ``a_n`` (M, 3)
+    [m/s^2]: serial, in particle order (deterministic on any number of
+    threads)."""
+    nf = faces.shape[1]
+    for i in range(face_of.shape[0]):
+        f = face_of[i]
+        if f < 0:
+            continue
+        for a in range(nf):
+            node = faces[f, a]
+            if mn[node] > 0.0:
+                a_n[node, 0] += shares[i, a, 0] / mn[node]
+                a_n[node, 1] += shares[i, a, 1] / mn[node]
+                a_n[node, 2] += shares[i, a, 2] / mn[node]
+
+
 @njit(cache=True, error_model="numpy", parallel=True)
-def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, faces,
-                            offsets, cand, thickness_factor, method, alpha, friction, dt,
-                            a_p, a_n, face_of, shares, force, normal_force, accel, skip,
-                            pen0, last_face, d_last, k_last, motion_dt):
+def penalty_coupling_forces(particles, nodes, dim, faces, offsets, cand, law, skip,
+                            motion_dt, a_p, a_n, face_of, shares, force, normal_force, accel,
+                            pen0, last_face, d_last, k_last):
     r"""Particle-face penalty forces (module docstring) into the particles' and nodes' ``a``.
 
     Parameters
     ----------
-    xp, vp : (N, 3) particle positions [m] and mid-step velocities [m/s].
-    mp, vol0, rho0, kbulk : (N,) mass [kg], nominal volume [m^dim], reference
-        density [kg/m^3], bulk modulus [Pa] (kg/m, m^2 per unit depth in 2D).
+    particles : ``(xp, vp, mp, vol0, rho0, kbulk)``: (N, 3) positions [m] and
+        mid-step velocities [m/s]; (N,) mass [kg], nominal volume [m^dim],
+        reference density [kg/m^3], bulk modulus [Pa] (kg/m, m^2 per unit
+        depth in 2D).
+    nodes : ``(xn, vn, mn)``: (M, 3), (M, 3), (M,) node positions,
+        velocities, masses.
     dim : 2 or 3.
-    xn, vn, mn : (M, 3), (M, 3), (M,) node positions, velocities, masses.
     faces : (F, nf) master faces (4 nodes in 3D, 2 in 2D).
     offsets, cand : CSR candidate faces of each particle
         (:func:`~.penalty_geometry.candidate_pairs`).
-    thickness_factor, method, alpha, friction, dt : the contact law
-        (:func:`~.wall_contact.spring_acceleration`, Coulomb coefficient,
+    law : ``(thickness_factor, method, alpha, friction, dt)``: the contact
+        law (:func:`~.wall_contact.spring_acceleration`, Coulomb coefficient,
         stable step [s]).
-    a_p : (N, 3) in/out, the particles' accelerations are **added** [m/s^2].
-    a_n : (M, 3) in/out, the nodes' accelerations are **added** [m/s^2].
-    face_of : (N,) out, the face each particle touches (-1: none).
-    shares : (N, 4, 3) out, the force on each node of that face [N]
-        (:math:`-N_a \mathbf F_p`; rows past nf unused).
-    force : (N, 3) out, the force on each particle [N] (N/m in 2D).
-    normal_force : (N,) out, its component along the contact direction [N].
-    accel : (N, 3) out, the acceleration added to each particle [m/s^2]
-        (:func:`withdraw_contact` takes it back).
     skip : (N,) bool, particles left out (those tied by :func:`tie_forces`).
-    pen0 : (N,) in/out, penetration each particle is allowed without force
-        [m] (a particle born or exposed inside the contact thickness): the
-        spring acts on :math:`\delta - \delta_0`, and :math:`\delta_0` only
-        shrinks, to the smallest penetration seen (LS-DYNA's IGNORE = 2).
-    last_face, d_last : (N,) in/out, the face each particle faced at the last
-        evaluation (-1: none, so no switch is checked; -2: unknown, a particle
-        born since or faces renumbered, so any face is a switch) and its
-        signed penetration there :math:`d = -g` [m] (:math:`-\infty` with -2
-        for a particle that faced none: its whole penetration is allowed). At a
-        switch of face the spring's extension grows
-        by at most the approach the motion allows, :math:`|\mathbf v_r|`
-        ``motion_dt``; the allowance takes the excess (module docstring); on
-        the same face, an excess beyond ``JUMP_FRACTION`` of the contact
-        thickness.
-    k_last : (N,) in/out, each particle's spring stiffness :math:`k` [N/m]
-        (:math:`F_n = k(\delta - \delta_0)`) at the last evaluation (0: not
-        loaded).
-        When it changes under load (the face point's mass, the step, a new
-        face) the extension is scaled so that the spring's energy
-        :math:`\tfrac12 k(\delta - \delta_0)^2` stays what it was
-        (module docstring, "A spring's stiffness changes").
     motion_dt : time [s] the particles moved since the last evaluation (the
         step; 0 when the faces changed under unmoved particles).
+    a_p, a_n : (N, 3) and (M, 3) in/out, the particles' and the nodes'
+        accelerations are **added** [m/s^2].
+    face_of, shares, force, normal_force, accel : out: ``face_of`` (N,) the
+        face each particle touches (-1: none); ``shares`` (N, 4, 3) the force
+        on each node of that face [N] (:math:`-N_a \mathbf F_p`; rows past nf
+        unused); ``force`` (N, 3) the force on each particle [N] (N/m in 2D);
+        ``normal_force`` (N,) its component along the contact direction [N];
+        ``accel`` (N, 3) the acceleration added to each particle [m/s^2]
+        (:func:`withdraw_contact` takes it back).
+    pen0, last_face, d_last, k_last : in/out: ``pen0`` (N,) the
+        penetration each particle is allowed without force [m] (a particle
+        born or exposed inside the contact thickness): the spring acts on
+        :math:`\delta - \delta_0`, and :math:`\delta_0` only shrinks, to the
+        smallest penetration seen (LS-DYNA's IGNORE = 2). ``last_face``,
+        ``d_last`` (N,) the face each particle faced at the last evaluation
+        (-1: none, so no switch is checked; -2: unknown, a particle born
+        since or faces renumbered, so any face is a switch) and its signed
+        penetration there :math:`d = -g` [m] (:math:`-\infty` with -2 for a
+        particle that faced none: its whole penetration is allowed); at a
+        switch of face the spring's extension grows by at most the approach
+        the motion allows (:func:`_extension`). ``k_last`` (N,) each
+        particle's spring stiffness :math:`k` [N/m] (:math:`F_n = k(\delta -
+        \delta_0)`) at the last evaluation (0: not loaded); when it changes
+        under load (the face point's mass, the step, a new face) the
+        extension is scaled so that the spring's energy :math:`\tfrac12
+        k(\delta - \delta_0)^2` stays what it was (module docstring, "A
+        spring's stiffness changes").
+
+    The inputs come grouped in tuples, the arrays it writes one by one:
+    Numba's parallel loops drop the writes into an array unpacked from a
+    tuple argument (docs/architecture.md, "Numba conventions").
 
     Returns
     -------
@@ -267,6 +390,9 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
     share is then gathered serially, in particle order (4 adds per contact;
     deterministic on any number of threads).
     """
+    xp, vp, mp, vol0, rho0, kbulk = particles
+    xn, vn, mn = nodes
+    thickness_factor, method, alpha, friction, dt = law
     n = xp.shape[0]
     nf = faces.shape[1]
     count = 0
@@ -281,60 +407,24 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
         accel[i, 2] = 0.0
         if skip[i]:
             continue
-        best = np.inf
-        bf = -1
-        xi, eta, cx, cy, cz, nx, ny, nz, clamped = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, False
-        for k in range(offsets[i], offsets[i + 1]):
-            f = cand[k]
-            res = closest_point(xp[i], xn, faces[f])
-            r0 = xp[i, 0] - res[2]
-            r1 = xp[i, 1] - res[3]
-            r2 = xp[i, 2] - res[4]
-            d2 = r0 * r0 + r1 * r1 + r2 * r2
-            if d2 < best or (d2 == best and f < bf):
-                best = d2
-                bf = f
-                xi, eta, cx, cy, cz, nx, ny, nz, clamped = res
+        bf, xi, eta, cx, cy, cz, nx, ny, nz, clamped = _nearest_face(i, xp, xn, faces,
+                                                                     offsets, cand)
         if bf < 0:
             pen0[i] = 0.0
             last_face[i] = -1
             k_last[i] = 0.0
             continue
-        r0 = xp[i, 0] - cx
-        r1 = xp[i, 1] - cy
-        r2 = xp[i, 2] - cz
-        rn = r0 * nx + r1 * ny + r2 * nz
         tp = contact_thickness(vol0[i], dim, thickness_factor)
-        l0 = r0 - rn * nx
-        l1 = r1 - rn * ny
-        l2 = r2 - rn * nz
-        lat = np.sqrt(l0 * l0 + l1 * l1 + l2 * l2)
-        if (not clamped) or lat <= _INSIDE_RTOL * tp:
-            gap = rn - tp
-            e0, e1, e2 = nx, ny, nz
-        elif rn > 0.0:
-            dist = np.sqrt(r0 * r0 + r1 * r1 + r2 * r2)
-            gap = dist - tp
-            e0, e1, e2 = r0 / dist, r1 / dist, r2 / dist
-        else:  # behind the plane of a face's boundary: no contact and no depth to
-            # measure, so the allowance and the last face's depth are kept
+        touching, gap, e0, e1, e2 = _gap_and_direction(i, xp, cx, cy, cz, nx, ny, nz,
+                                                       clamped, tp)
+        if not touching:  # behind the plane of a face's boundary: no contact and no
+            # depth to measure, so the allowance and the last face's depth are kept
             k_last[i] = 0.0
             continue
         pen = max(-gap, 0.0)
         N = face_shapes(xi, eta, nf)
-        # the excess over the motion's approach that counts as geometry: any at
-        # a switch of face, beyond JUMP_FRACTION of the thickness on the same face
-        leap = 0.0 if bf != last_face[i] else JUMP_FRACTION * tp
-        if last_face[i] != -1 and -gap - d_last[i] > leap:  # (else the excess is less)
-            w0, w1, w2 = _relative_velocity(vp, vn, i, faces[bf], N)
-            excess = -gap - d_last[i] - motion_dt * np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
-            if excess > leap:  # deeper than the motion can take it: geometry
-                pen0[i] = min(pen0[i] + excess, pen)
-        if pen < pen0[i]:
-            pen0[i] = pen
-        last_face[i] = bf
-        d_last[i] = -gap
-        ext = pen - pen0[i]
+        ext = _extension(i, bf, gap, pen, tp, vp, vn, faces[bf], N, motion_dt, pen0,
+                         last_face, d_last)
         if ext <= 0.0:
             k_last[i] = 0.0
             continue
@@ -344,12 +434,7 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
         if mp[i] <= 0.0:  # pushed out, no force of its own
             k_last[i] = 0.0
             an = a1 * ext
-            accel[i, 0] = an * e0
-            accel[i, 1] = an * e1
-            accel[i, 2] = an * e2
-            a_p[i, 0] += accel[i, 0]
-            a_p[i, 1] += accel[i, 1]
-            a_p[i, 2] += accel[i, 2]
+            _accelerate(i, an * e0, an * e1, an * e2, accel, a_p)
             continue
         inv_f = face_inverse_mass(mn, faces[bf], N)
         kk = a1 * (spring_mass(mp[i], inv_f) if method == STIFFNESS_MASS else mp[i])
@@ -359,24 +444,9 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
         f1 = fn * e1
         f2 = fn * e2
         if friction > 0.0:
-            w0, w1, w2 = _relative_velocity(vp, vn, i, faces[bf], N)
-            inv_meff = 1.0 / mp[i] + inv_f
-            wn = w0 * e0 + w1 * e1 + w2 * e2
-            t0 = w0 - wn * e0
-            t1 = w1 - wn * e1
-            t2 = w2 - wn * e2
-            vt = np.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
-            if vt > 0.0:
-                ft = min(friction * fn, vt / (dt * inv_meff))
-                f0 -= ft * t0 / vt
-                f1 -= ft * t1 / vt
-                f2 -= ft * t2 / vt
-        accel[i, 0] = f0 / mp[i]
-        accel[i, 1] = f1 / mp[i]
-        accel[i, 2] = f2 / mp[i]
-        a_p[i, 0] += accel[i, 0]
-        a_p[i, 1] += accel[i, 1]
-        a_p[i, 2] += accel[i, 2]
+            f0, f1, f2 = _with_friction(f0, f1, f2, fn, e0, e1, e2, friction, dt,
+                                        1.0 / mp[i] + inv_f, vp, vn, i, faces[bf], N)
+        _accelerate(i, f0 / mp[i], f1 / mp[i], f2 / mp[i], accel, a_p)
         force[i, 0] = f0
         force[i, 1] = f1
         force[i, 2] = f2
@@ -387,16 +457,7 @@ def penalty_coupling_forces(xp, vp, mp, vol0, rho0, kbulk, dim, xn, vn, mn, face
             shares[i, a, 0] = -s * f0
             shares[i, a, 1] = -s * f1
             shares[i, a, 2] = -s * f2
-    for i in range(n):
-        f = face_of[i]
-        if f < 0:
-            continue
-        for a in range(nf):
-            node = faces[f, a]
-            if mn[node] > 0.0:
-                a_n[node, 0] += shares[i, a, 0] / mn[node]
-                a_n[node, 1] += shares[i, a, 1] / mn[node]
-                a_n[node, 2] += shares[i, a, 2] / mn[node]
+    _gather_shares(face_of, faces, shares, mn, a_n)
     return count
 
 
