@@ -111,10 +111,10 @@ def _acc(b, x, P, F, hg=0.0, young=3e10, v=None, av=0.0, heat=None):
     hgk = np.zeros(b["w"].size, dtype=np.float32)
     hourglass_coefficients(np.arange(n), b["X"], b["vol"], nl.offsets, nl.idx, b["w"],
                            np.full(n, young), hg, hgk)
-    tl_forces(np.arange(n), x, v, b["X"], b["m"], b["rho0"], b["rho0"],
-              np.full(n, 3000.0), np.full(n, 1.3 * 0.01), b["vol"], nl.offsets, nl.idx,
-              b["fac"], hgk, b["gsum"], P, _Q(b, P), b["B0"], F, b["dim"], av, av, 1.0, a,
-              dedt)
+    tl_forces(np.arange(n), (x, v, b["X"]),
+              (b["m"], b["rho0"], b["rho0"], np.full(n, 3000.0), np.full(n, 1.3 * 0.01),
+               b["vol"]), (nl.offsets, nl.idx, b["fac"], hgk),
+              (P, _Q(b, P), b["B0"], F, b["gsum"]), b["dim"], (av, av, 1.0), a, dedt)
     return a
 
 
@@ -243,9 +243,10 @@ def test_passes_write_only_their_rows():
     hgk = np.zeros(b["w"].size, dtype=np.float32)
     hourglass_coefficients(np.arange(n), b["X"], b["vol"], nl.offsets, nl.idx, b["w"],
                            np.full(n, 3e10), 20.0, hgk)
-    tl_forces(rows, x, v, b["X"], b["m"], b["rho0"], b["rho0"], np.full(n, 3000.0),
-              np.full(n, 0.013), b["vol"], nl.offsets, nl.idx, b["fac"], hgk, b["gsum"],
-              P, _Q(b, P), b["B0"], F, 2, 1.0, 1.0, 1.0, a, heat)
+    tl_forces(rows, (x, v, b["X"]),
+              (b["m"], b["rho0"], b["rho0"], np.full(n, 3000.0), np.full(n, 0.013), b["vol"]),
+              (nl.offsets, nl.idx, b["fac"], hgk), (P, _Q(b, P), b["B0"], F, b["gsum"]), 2,
+              (1.0, 1.0, 1.0), a, heat)
     odd = np.arange(1, n, 2)
     assert np.all(a[odd] == 7.0) and np.all(heat[odd] == 7.0)
     assert np.all(a[rows] != 7.0)
@@ -280,8 +281,9 @@ def test_pair_viscosity_and_hourglass_match_their_formulas(approach):
     alpha, beta, support_scale = 1.0, 2.0, 1.0
     a = np.zeros((2, 3))
     heat = np.zeros(2)
-    tl_forces(np.arange(2), x, v, X, m, rho, rho, c, h0, m / rho, offsets, idx, fac, hgk,
-              np.zeros((2, 3)), zero, zero, eye, eye, 2, alpha, beta, support_scale, a, heat)
+    tl_forces(np.arange(2), (x, v, X), (m, rho, rho, c, h0, m / rho), (offsets, idx, fac, hgk),
+              (zero, zero, eye, eye, np.zeros((2, 3))), 2, (alpha, beta, support_scale), a,
+              heat)
     d = x[0] - x[1]
     r2 = d @ d
     vx = min((v[0] - v[1]) @ d, 0.0)

@@ -158,11 +158,11 @@ class TotalLagrangian:
         """Overwrite ``p.a`` and ``dedt_av`` rows with the TL stress, viscosity
         and hourglass terms."""
         piola_stress(self.rows, self.F, self.Finv, p.sig, self.vol, self.B0, self.P, self.Q)
-        tl_forces(self.rows, p.x, p.v, self.X, p.m, p.rho, self.rho_ref, p.c, p.h0,
-                  self.vol, self.offsets, self.idx, self.fac_f, self.hgk, self.gsum_f,
-                  self.P, self.Q, self.B0, self.F, self.dim, self.alpha, self.beta,
-                  self.kernel.support_scale,
-                  p.a, dedt_av)
+        tl_forces(self.rows, (p.x, p.v, self.X),
+                  (p.m, p.rho, self.rho_ref, p.c, p.h0, self.vol),
+                  (self.offsets, self.idx, self.fac_f, self.hgk),
+                  (self.P, self.Q, self.B0, self.F, self.gsum_f), self.dim,
+                  (self.alpha, self.beta, self.kernel.support_scale), p.a, dedt_av)
 
     @property
     def mean_neighbours(self) -> float:

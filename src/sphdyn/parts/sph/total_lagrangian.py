@@ -316,9 +316,110 @@ def _viscous_hourglass(fk, hk, d0, d1, d2, w0, w1, w2, s0, s1, s2, hij, csum, rh
     return mj * pi_ij * fk, coef
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _row_sums(i, three, kin, props, pairs, stress, viscosity):
+    """Row ``i``'s pair sums of :func:`tl_forces`: ``(a0, a1, a2)``, the sum
+    of fac Q_j (X_i - X_j); ``(q0, q1, q2)``, the viscous acceleration;
+    ``(fh0, fh1, fh2)``, the hourglass force [N]; ``heat``, the viscous
+    heating rate [W/kg]."""
+    x, v, X = kin
+    m, rho, _, c, h0, _ = props
+    offsets, idx, fac, hgk = pairs
+    _, Q, _, Fdef, _ = stress
+    av_alpha, av_beta, support_scale = viscosity
+    xi0, xi1, xi2 = load3(x, i)
+    vi0, vi1, vi2 = load3(v, i)
+    ci = c[i]
+    rhoi = rho[i]
+    hi = h0[i]
+    f00, f01, f02, f10, f11, f12, f20, f21, f22 = load9(Fdef, i)
+    Xi0, Xi1, Xi2 = load3(X, i)
+    a0 = a1 = a2 = 0.0  # sum_j fac Q_j (X_i - X_j)
+    q0 = q1 = q2 = 0.0  # viscous acceleration
+    fh0 = fh1 = fh2 = 0.0  # hourglass force [N]
+    heat = 0.0
+    k0 = offsets[i]
+    k1 = offsets[i + 1]
+    # deliberate 2D/3D variant pair (``duplicates`` lists it): two loops
+    # instead of a dimension test per pair (about 1.5x faster)
+    if three:
+        for k in range(k0, k1):
+            j = idx[k]
+            fk = np.float64(fac[k])
+            X0 = X[j, 0] - Xi0  # X_ij = X_j - X_i
+            X1 = X[j, 1] - Xi1
+            X2 = X[j, 2] - Xi2
+            a0 -= fk * (Q[j, 0, 0] * X0 + Q[j, 0, 1] * X1 + Q[j, 0, 2] * X2)
+            a1 -= fk * (Q[j, 1, 0] * X0 + Q[j, 1, 1] * X1 + Q[j, 1, 2] * X2)
+            a2 -= fk * (Q[j, 2, 0] * X0 + Q[j, 2, 1] * X1 + Q[j, 2, 2] * X2)
+            d0 = xi0 - x[j, 0]  # d = x_i - x_j = -x_ij
+            d1 = xi1 - x[j, 1]
+            d2 = xi2 - x[j, 2]
+            # s = (F_i + F_j) X_ij - 2 x_ij
+            s0 = ((f00 + Fdef[j, 0, 0]) * X0 + (f01 + Fdef[j, 0, 1]) * X1
+                  + (f02 + Fdef[j, 0, 2]) * X2 + 2.0 * d0)
+            s1 = ((f10 + Fdef[j, 1, 0]) * X0 + (f11 + Fdef[j, 1, 1]) * X1
+                  + (f12 + Fdef[j, 1, 2]) * X2 + 2.0 * d1)
+            s2 = ((f20 + Fdef[j, 2, 0]) * X0 + (f21 + Fdef[j, 2, 1]) * X1
+                  + (f22 + Fdef[j, 2, 2]) * X2 + 2.0 * d2)
+            w0 = vi0 - v[j, 0]
+            w1 = vi1 - v[j, 1]
+            w2 = vi2 - v[j, 2]
+            mpf, coef = _viscous_hourglass(
+                fk, np.float64(hgk[k]), d0, d1, d2, w0, w1, w2, s0, s1, s2,
+                support_scale * 0.5 * (hi + h0[j]), ci + c[j], rhoi + rho[j], m[j],
+                av_alpha, av_beta)
+            q0 -= mpf * d0
+            q1 -= mpf * d1
+            q2 -= mpf * d2
+            heat += 0.5 * mpf * min(w0 * d0 + w1 * d1 + w2 * d2, 0.0)
+            fh0 += coef * d0
+            fh1 += coef * d1
+            fh2 += coef * d2
+    else:
+        for k in range(k0, k1):
+            j = idx[k]
+            fk = np.float64(fac[k])
+            X0 = X[j, 0] - Xi0
+            X1 = X[j, 1] - Xi1
+            a0 -= fk * (Q[j, 0, 0] * X0 + Q[j, 0, 1] * X1)
+            a1 -= fk * (Q[j, 1, 0] * X0 + Q[j, 1, 1] * X1)
+            d0 = xi0 - x[j, 0]
+            d1 = xi1 - x[j, 1]
+            s0 = (f00 + Fdef[j, 0, 0]) * X0 + (f01 + Fdef[j, 0, 1]) * X1 + 2.0 * d0
+            s1 = (f10 + Fdef[j, 1, 0]) * X0 + (f11 + Fdef[j, 1, 1]) * X1 + 2.0 * d1
+            w0 = vi0 - v[j, 0]
+            w1 = vi1 - v[j, 1]
+            mpf, coef = _viscous_hourglass(
+                fk, np.float64(hgk[k]), d0, d1, 0.0, w0, w1, 0.0, s0, s1, 0.0,
+                support_scale * 0.5 * (hi + h0[j]), ci + c[j], rhoi + rho[j], m[j],
+                av_alpha, av_beta)
+            q0 -= mpf * d0
+            q1 -= mpf * d1
+            heat += 0.5 * mpf * min(w0 * d0 + w1 * d1, 0.0)
+            fh0 += coef * d0
+            fh1 += coef * d1
+    return a0, a1, a2, q0, q1, q2, fh0, fh1, fh2, heat
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _own_share(i, P, B0, gsum):
+    r"""Row ``i``'s own share of :func:`tl_forces`, :math:`P_i B_i\,\mathbf{gsum}_i`."""
+    # own share P_i B_i gsum_i
+    pb0 = pb1 = pb2 = 0.0
+    for s in range(3):
+        gs = gsum[i, s]
+        pb0 += (P[i, 0, 0] * B0[i, 0, s] + P[i, 0, 1] * B0[i, 1, s]
+                + P[i, 0, 2] * B0[i, 2, s]) * gs
+        pb1 += (P[i, 1, 0] * B0[i, 0, s] + P[i, 1, 1] * B0[i, 1, s]
+                + P[i, 1, 2] * B0[i, 2, s]) * gs
+        pb2 += (P[i, 2, 0] * B0[i, 0, s] + P[i, 2, 1] * B0[i, 1, s]
+                + P[i, 2, 2] * B0[i, 2, s]) * gs
+    return pb0, pb1, pb2
+
+
 @njit(cache=True, error_model="numpy", parallel=True)
-def tl_forces(rows, x, v, X, m, rho, rho0, c, h0, vol, offsets, idx, fac, hgk, gsum,
-              P, Q, B0, Fdef, dim, av_alpha, av_beta, support_scale, a, dedt_av):
+def tl_forces(rows, kin, props, pairs, stress, dim, viscosity, a, dedt_av):
     r"""Acceleration of the total-Lagrangian scheme with hourglass control.
 
     Momentum balance :math:`\rho_0 \dot{\mathbf v} = \nabla_X\cdot P` in the
@@ -378,105 +479,37 @@ def tl_forces(rows, x, v, X, m, rho, rho0, c, h0, vol, offsets, idx, fac, hgk, g
     ----------
     rows : (n_tl,) int64, the particles evaluated (rows of ``a`` and
         ``dedt_av`` written; other rows untouched).
-    x, v, X : (N, 3) current positions [m], velocities [m/s], reference positions.
-    m, rho, rho0, c, h0, vol : (N,) mass [kg], current and reference density
-        [kg/m^3], wave speed [m/s], reference smoothing length [m],
-        reference volume m/rho0.
-    fac, gsum, B0 : from :func:`reference_gradients`.
-    hgk : (nnz,) float32 hourglass pair factors from
+    kin : ``(x, v, X)``, (N, 3) current positions [m], velocities [m/s],
+        reference positions.
+    props : ``(m, rho, rho0, c, h0, vol)``, (N,) mass [kg], current and
+        reference density [kg/m^3], wave speed [m/s], reference smoothing
+        length [m], reference volume m/rho0.
+    pairs : ``(offsets, idx, fac, hgk)``: the reference pairs (CSR) and
+        their kernel factors from :func:`reference_gradients`; ``hgk``
+        (nnz,) float32 hourglass pair factors from
         :func:`hourglass_coefficients` (all zero = hourglass control off).
-    P, Q : (N, 3, 3) first Piola-Kirchhoff stress [Pa] and V P B (:func:`piola_stress`).
-    Fdef : (N, 3, 3) deformation gradient.
+    stress : ``(P, Q, B0, Fdef, gsum)``: (N, 3, 3) first Piola-Kirchhoff
+        stress [Pa] and V P B (:func:`piola_stress`), the correction B0 and
+        the reference sums ``gsum`` (:func:`reference_gradients`), the
+        deformation gradient.
     dim : 2 or 3 (2: z components skipped; they are zero).
-    av_alpha, av_beta : artificial viscosity coefficients; support_scale: support scale.
+    viscosity : ``(av_alpha, av_beta, support_scale)``, the artificial
+        viscosity's coefficients and the kernel's support scale.
     a : (N, 3) out, acceleration [m/s^2].
     dedt_av : (N,) out, viscous + hourglass heating rate [W/kg].
+
+    The inputs come grouped in tuples, the arrays it writes one by one
+    (docs/architecture.md, "Numba conventions").
     """
+    v = kin[1]
+    m, _, rho0, _, _, _ = props
+    P, _, B0, _, gsum = stress
     three = dim == 3
     for t in prange(rows.shape[0]):
         i = rows[t]
-        xi0, xi1, xi2 = load3(x, i)
-        vi0, vi1, vi2 = load3(v, i)
-        ci = c[i]
-        rhoi = rho[i]
-        hi = h0[i]
-        f00, f01, f02, f10, f11, f12, f20, f21, f22 = load9(Fdef, i)
-        Xi0, Xi1, Xi2 = load3(X, i)
-        a0 = a1 = a2 = 0.0  # sum_j fac Q_j (X_i - X_j)
-        q0 = q1 = q2 = 0.0  # viscous acceleration
-        fh0 = fh1 = fh2 = 0.0  # hourglass force [N]
-        heat = 0.0
-        k0 = offsets[i]
-        k1 = offsets[i + 1]
-        # deliberate 2D/3D variant pair (``duplicates`` lists it): two loops
-        # instead of a dimension test per pair (about 1.5x faster)
-        if three:
-            for k in range(k0, k1):
-                j = idx[k]
-                fk = np.float64(fac[k])
-                X0 = X[j, 0] - Xi0  # X_ij = X_j - X_i
-                X1 = X[j, 1] - Xi1
-                X2 = X[j, 2] - Xi2
-                a0 -= fk * (Q[j, 0, 0] * X0 + Q[j, 0, 1] * X1 + Q[j, 0, 2] * X2)
-                a1 -= fk * (Q[j, 1, 0] * X0 + Q[j, 1, 1] * X1 + Q[j, 1, 2] * X2)
-                a2 -= fk * (Q[j, 2, 0] * X0 + Q[j, 2, 1] * X1 + Q[j, 2, 2] * X2)
-                d0 = xi0 - x[j, 0]  # d = x_i - x_j = -x_ij
-                d1 = xi1 - x[j, 1]
-                d2 = xi2 - x[j, 2]
-                # s = (F_i + F_j) X_ij - 2 x_ij
-                s0 = ((f00 + Fdef[j, 0, 0]) * X0 + (f01 + Fdef[j, 0, 1]) * X1
-                      + (f02 + Fdef[j, 0, 2]) * X2 + 2.0 * d0)
-                s1 = ((f10 + Fdef[j, 1, 0]) * X0 + (f11 + Fdef[j, 1, 1]) * X1
-                      + (f12 + Fdef[j, 1, 2]) * X2 + 2.0 * d1)
-                s2 = ((f20 + Fdef[j, 2, 0]) * X0 + (f21 + Fdef[j, 2, 1]) * X1
-                      + (f22 + Fdef[j, 2, 2]) * X2 + 2.0 * d2)
-                w0 = vi0 - v[j, 0]
-                w1 = vi1 - v[j, 1]
-                w2 = vi2 - v[j, 2]
-                mpf, coef = _viscous_hourglass(
-                    fk, np.float64(hgk[k]), d0, d1, d2, w0, w1, w2, s0, s1, s2,
-                    support_scale * 0.5 * (hi + h0[j]), ci + c[j], rhoi + rho[j], m[j],
-                    av_alpha, av_beta)
-                q0 -= mpf * d0
-                q1 -= mpf * d1
-                q2 -= mpf * d2
-                heat += 0.5 * mpf * min(w0 * d0 + w1 * d1 + w2 * d2, 0.0)
-                fh0 += coef * d0
-                fh1 += coef * d1
-                fh2 += coef * d2
-        else:
-            for k in range(k0, k1):
-                j = idx[k]
-                fk = np.float64(fac[k])
-                X0 = X[j, 0] - Xi0
-                X1 = X[j, 1] - Xi1
-                a0 -= fk * (Q[j, 0, 0] * X0 + Q[j, 0, 1] * X1)
-                a1 -= fk * (Q[j, 1, 0] * X0 + Q[j, 1, 1] * X1)
-                d0 = xi0 - x[j, 0]
-                d1 = xi1 - x[j, 1]
-                s0 = (f00 + Fdef[j, 0, 0]) * X0 + (f01 + Fdef[j, 0, 1]) * X1 + 2.0 * d0
-                s1 = (f10 + Fdef[j, 1, 0]) * X0 + (f11 + Fdef[j, 1, 1]) * X1 + 2.0 * d1
-                w0 = vi0 - v[j, 0]
-                w1 = vi1 - v[j, 1]
-                mpf, coef = _viscous_hourglass(
-                    fk, np.float64(hgk[k]), d0, d1, 0.0, w0, w1, 0.0, s0, s1, 0.0,
-                    support_scale * 0.5 * (hi + h0[j]), ci + c[j], rhoi + rho[j], m[j],
-                    av_alpha, av_beta)
-                q0 -= mpf * d0
-                q1 -= mpf * d1
-                heat += 0.5 * mpf * min(w0 * d0 + w1 * d1, 0.0)
-                fh0 += coef * d0
-                fh1 += coef * d1
-        # own share P_i B_i gsum_i
-        pb0 = pb1 = pb2 = 0.0
-        for s in range(3):
-            gs = gsum[i, s]
-            pb0 += (P[i, 0, 0] * B0[i, 0, s] + P[i, 0, 1] * B0[i, 1, s]
-                    + P[i, 0, 2] * B0[i, 2, s]) * gs
-            pb1 += (P[i, 1, 0] * B0[i, 0, s] + P[i, 1, 1] * B0[i, 1, s]
-                    + P[i, 1, 2] * B0[i, 2, s]) * gs
-            pb2 += (P[i, 2, 0] * B0[i, 0, s] + P[i, 2, 1] * B0[i, 1, s]
-                    + P[i, 2, 2] * B0[i, 2, s]) * gs
+        a0, a1, a2, q0, q1, q2, fh0, fh1, fh2, heat = _row_sums(i, three, kin, props,
+                                                                 pairs, stress, viscosity)
+        pb0, pb1, pb2 = _own_share(i, P, B0, gsum)
         inv_rho0 = 1.0 / rho0[i]
         a[i, 0] = (a0 + pb0) * inv_rho0 + q0
         a[i, 1] = (a1 + pb1) * inv_rho0 + q1
@@ -485,7 +518,7 @@ def tl_forces(rows, x, v, X, m, rho, rho0, c, h0, vol, offsets, idx, fac, hgk, g
             a[i, 0] += fh0 / m[i]
             a[i, 1] += fh1 / m[i]
             a[i, 2] += fh2 / m[i]
-            heat -= (fh0 * vi0 + fh1 * vi1 + fh2 * vi2) / m[i]
+            heat -= (fh0 * v[i, 0] + fh1 * v[i, 1] + fh2 * v[i, 2]) / m[i]
         dedt_av[i] = heat
 
 
