@@ -20,7 +20,7 @@ from sphdyn.heterogeneity.mesostructure import (generate_phase_grid, phase_slice
 from sphdyn.io.hdf5 import write_frame
 from sphdyn.io.plots import (history_figures, per_depth, plot_history, scaled_unit,
                              time_unit)
-from sphdyn.io.snapshots import run_labels
+from sphdyn.io.frame_data import run_labels
 from sphdyn.materials.driver import drive, result_figure, result_title
 
 

@@ -1,4 +1,4 @@
-"""Snapshot panels (sphdyn.io.snapshots): frame and slab selection, fields, PNGs, CLI."""
+"""Snapshot panels (sphdyn.io.snapshots, .frame_data): frames, slabs, fields, PNGs, CLI."""
 
 import matplotlib.image as mpimg
 import numba
@@ -8,8 +8,8 @@ import pytest
 from sphdyn.cli import main
 from sphdyn.deck import loads_deck
 from sphdyn.io import list_frames, plot_snapshots, read_frame_header
-from sphdyn.io.snapshots import (available_fields, field_values, particle_spacing,
-                                 select_frames, slab_mask)
+from sphdyn.io.frame_data import (available_fields, field_values, particle_spacing,
+                                  select_frames, slab_mask)
 from sphdyn.simulation import Simulation
 
 # A rubber disc (about 200 particles) hitting a wall: ~200 steps, 7 frames.

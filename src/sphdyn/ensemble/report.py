@@ -116,7 +116,8 @@ def damage_grid_figure(out: str | Path, recs: list[dict] | None = None,
     from matplotlib.figure import Figure
 
     from ..io.plots import time_unit
-    from ..io.snapshots import particle_spacing, particle_squares
+    from ..io.frame_data import particle_spacing
+    from ..io.snapshots import particle_squares
 
     out = Path(out)
     recs = _records(out) if recs is None else recs

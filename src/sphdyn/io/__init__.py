@@ -14,7 +14,8 @@ directory and atomically renamed onto its destination
   VTK/CSV export,
 * :mod:`~sphdyn.io.history` -- global time histories (CSV),
 * :mod:`~sphdyn.io.plots` -- figures of a history (Matplotlib, Agg),
-* :mod:`~sphdyn.io.snapshots` -- panels of particle frames coloured by a field.
+* :mod:`~sphdyn.io.snapshots` -- panels of particle frames coloured by a field,
+  :mod:`~sphdyn.io.frame_data` -- the frames, slab and field values they show.
 """
 
 from .atomic import atomic_path, atomic_write_bytes, atomic_write_text
