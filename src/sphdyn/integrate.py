@@ -18,6 +18,8 @@ time :math:`t^n` uses :math:`\mathbf v^n = (\mathbf v^{n-1/2} + \mathbf
 v^{n+1/2})/2`, and the work of contact and boundary forces over the kick is
 :math:`\sum_i m_i \mathbf a^c_i\cdot\mathbf v^n_i \Delta t^n`, which makes the
 discrete work-energy balance exact for the kick.
+
+The model and its tests: docs/theory.md, "Time integration".
 """
 
 from __future__ import annotations

@@ -55,6 +55,8 @@ Johnson, G.R., Stryk, R.A., Beissel, S.R. (1996). SPH for high velocity
 Swegle, J.W., Hicks, D.L., Attaway, S.W. (1995). Smoothed particle
     hydrodynamics stability analysis. J. Comput. Phys. 116, 123-134.
 Hušek, M. SPH for concrete under impact (PhD thesis), eq. 2.2.2, Fig. 2.4.
+
+The model and its tests: docs/theory.md, "Kernels".
 """
 
 from __future__ import annotations

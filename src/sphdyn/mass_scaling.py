@@ -44,6 +44,8 @@ added mass takes part in the motion (a bar's inertia in a beam's
 vibration). ``max_added`` bounds it as a fraction of the model's mass (as
 LS-DYNA's reports of the added mass are); the summary and the history
 report it per part (``mass_added_<part>`` [kg], kg/m in 2D).
+
+The model and its tests: docs/theory.md, "Selective mass scaling".
 """
 
 from __future__ import annotations

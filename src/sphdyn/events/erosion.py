@@ -58,6 +58,8 @@ kinetic energy of the nodes' shares and the internal energy leave the model;
 the history reports them (``m_eroded_<mesh>``, ``E_eroded_<mesh>``) and the
 energy balance counts the removed energy (``E_removed``), so ``E_total``
 still closes.
+
+The model and its tests: docs/theory.md, "Element erosion".
 """
 
 from __future__ import annotations

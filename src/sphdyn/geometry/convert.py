@@ -21,6 +21,8 @@ integrands are polynomials of degree at most 3 in each natural coordinate
 (:math:`\mathbf x` is of degree 1, :math:`\det J` of degree 2), so the
 :math:`2^d` Gauss points integrate both exactly. The particle's mass is the
 element's, :math:`\rho V_e`, when the particle gets the element's material.
+
+The model and its tests: docs/theory.md, "SPH-FEM coupling by a hybrid transition layer".
 """
 
 from __future__ import annotations

@@ -37,6 +37,8 @@ set says which faces the wave reaches.
 The work of the load is external work (``W_external``); column
 ``W_<name>`` is its total, ``<name>_force_x|y|z`` the force now and
 ``<name>_impulse_x|y|z`` its time integral [N s] (N s/m in 2D).
+
+The model and its tests: docs/theory.md, "Empirical blast loads".
 """
 
 from __future__ import annotations

@@ -4,6 +4,8 @@ The pair force and its stiffness are in :mod:`.particle_contact`; this
 Interaction keeps the contact neighbour list (current configuration, the
 same absolute Verlet skin as the SPH list or larger) and reports
 ``contacts_bodies``, the number of particles touching another body.
+
+The model and its tests: docs/theory.md, "Contact between bodies".
 """
 
 from __future__ import annotations

@@ -20,6 +20,8 @@ element that contains it, at its parametric point :math:`\boldsymbol\xi_s`
 The bar's volume overlaps the concrete's (perfect bond, no slip): the
 composite's axial stiffness is :math:`E_c A_c + E_s A_s` with the concrete's
 whole section, as in LS-DYNA. Beam rotations stay the beam's own.
+
+The model and its tests: docs/theory.md, "Bars embedded in solid elements".
 """
 
 from __future__ import annotations

@@ -14,6 +14,8 @@ external work: the stepper moves it from the interactions' work to
 as ``W_gravity_<part>`` (the loss of potential energy, :math:`M\,\mathbf g\cdot
 \Delta\mathbf x_c` for a body whose centre of mass moved by
 :math:`\Delta\mathbf x_c`).
+
+The model and its tests: docs/theory.md, "Gravity".
 """
 
 from __future__ import annotations

@@ -41,6 +41,8 @@ material with the point's volume and mass.
   (:func:`~.slaves.set_pair_gradient`), is taken off again after the step, so its
   internal energy is the work of the interface's pair forces on its side
   (the SPH energy equation's share), with its share of the viscous heat.
+
+The model and its tests: docs/theory.md, "SPH-FEM coupling by a hybrid transition layer".
 """
 
 from __future__ import annotations

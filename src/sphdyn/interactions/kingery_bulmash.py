@@ -43,6 +43,8 @@ between a face's outward normal and the direction to the charge
 .. math::
     p = p_r \cos^2\theta + p_s (1 + \cos^2\theta - 2\cos\theta)
     \quad (\cos\theta \ge 0), \qquad p = p_s \quad (\cos\theta < 0).
+
+The model and its tests: docs/theory.md, "Empirical blast loads".
 """
 
 from __future__ import annotations

@@ -16,6 +16,8 @@ or ``smooth`` (:math:`s - \\sin(2\\pi s)/2\\pi`, :math:`s = t/T`, whose rate
 starts and ends at zero, so a prescribed displacement starts and stops
 without a jerk). A time curve (:func:`curve_value`) takes the factor from a
 table of ``(t, factor)`` points instead.
+
+The model and its tests: docs/theory.md, "Prescribed motion, loads and damping".
 """
 
 from __future__ import annotations

@@ -25,6 +25,8 @@ had entered it) keep the overlap they had at birth without force, the
 allowance shrinking as they move apart (LS-DYNA's IGNORE): a spring loaded
 at birth would release energy that was never stored (kilojoules in the
 800 m/s penetration of docs/examples.md).
+
+The model and its tests: docs/theory.md, "Contact between bodies".
 """
 
 from __future__ import annotations

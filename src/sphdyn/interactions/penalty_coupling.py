@@ -5,6 +5,8 @@ list, :func:`~.penalty_geometry.candidate_pairs`), follows the master surface
 through erosion, ties particles to faces (``tie_factor``) and checkpoints the
 springs' state; the contact law, its springs and its equations are those of
 :mod:`.penalty_kernels` (the thesis, chapter 4, "Coupling SPH and FEM").
+
+The model and its tests: docs/theory.md, "SPH-FEM coupling by penalty".
 """
 
 from __future__ import annotations

@@ -48,6 +48,8 @@ With ``stiffness = "axial"`` the particles' stress acts along the bar only
 (:mod:`sphdyn.materials.uniaxial`); the coupling writes each particle's bar
 direction into its history before each material update
 (:func:`bar_directions`).
+
+The model and its tests: docs/theory.md, "Sublayer coupling of rebar".
 """
 
 from __future__ import annotations

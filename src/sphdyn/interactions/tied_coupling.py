@@ -43,6 +43,8 @@ the transfer does no work of its own. The kick skips slaves (``BC_SLAVE``):
 their kinetic energy is the nodes' (counted once). Each step, after the
 kick, :meth:`TiedCoupling.constrain` puts the slaves at their anchors and
 gives them :math:`\sum_a \mathsf B_a \mathbf v_a`.
+
+The model and its tests: docs/theory.md, "SPH-FEM coupling by constraint".
 """
 
 from __future__ import annotations

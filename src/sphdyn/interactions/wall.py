@@ -6,6 +6,8 @@ reached over a linear ramp), its force totals and impulse, and its history
 columns ``F_wall_<name>`` (normal force), ``F_wall_<name>_t`` (tangential),
 ``I_wall_<name>`` (impulse given so far), ``contacts_<name>`` and, for a
 moving wall, ``d_wall_<name>`` (travel along the normal).
+
+The model and its tests: docs/theory.md, "Rigid wall with penalty contact".
 """
 
 from __future__ import annotations

@@ -50,6 +50,8 @@ loaded releases no energy.
 Optional Coulomb friction opposes the tangential velocity with magnitude
 :math:`\mu |F_n|`, capped so that it cannot reverse the tangential velocity
 within one step (a regularised stick condition).
+
+The model and its tests: docs/theory.md, "Rigid wall with penalty contact".
 """
 
 from __future__ import annotations

@@ -25,6 +25,8 @@ Inside the kernels symmetric 3x3 tensors are carried as 6-tuples of scalars
 components. Tuples live in registers, so the per-particle loop allocates
 nothing. The spin tensor is carried as ``(w_xy, w_yz, w_xz)`` with
 ``W = (L - L^T)/2``.
+
+The model and its tests: docs/theory.md, "Materials".
 """
 
 from __future__ import annotations

@@ -10,6 +10,8 @@ Structures*, 2000, Sec. 5.4.1, hypoelastic Jaumann model).
 Parameters (``pack``): ``density`` and either ``E``, ``nu`` or ``K``, ``G``.
 Vector layout ``[density, K, G]``. No history. Deck table:
 :class:`ElasticParams`.
+
+The model and its tests: docs/theory.md, "Materials".
 """
 
 from __future__ import annotations

@@ -48,6 +48,8 @@ included), so the time step is already the one the burn will need.
 References: Lee, Hornig & Kury (1968), UCRL-50422 (JWL); LS-DYNA Keyword
 User's Manual vol. II, *MAT_HIGH_EXPLOSIVE_BURN; Dobratz & Crawford (1985),
 LLNL Explosives Handbook, UCRL-52997 (the TNT constants).
+
+The model and its tests: docs/theory.md, "Fluids: gas and high explosive".
 """
 
 from __future__ import annotations

@@ -19,6 +19,8 @@ linear in :math:`e^{n+1}`:
 (Wilkins 1964, the energy-pressure iteration of HEMP solved in closed form).
 A pressure below the cutoff :math:`p_{min} \le 0` is raised to it and the
 energy recomputed with it, so the work always pairs with the force pass.
+
+The model and its tests: docs/theory.md, "Materials".
 """
 
 from __future__ import annotations

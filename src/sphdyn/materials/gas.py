@@ -9,6 +9,8 @@ starts at its initial density with the energy ``E0`` per unit initial volume,
 or the one that gives the initial ``pressure``
 (:math:`E_0 = (p_0 - C_0)/C_4`; ideal gas :math:`E_0 = p_0/(\gamma - 1)`).
 Air at 1 atm: density 1.225 kg/m^3, gamma 1.4, pressure 101325 Pa.
+
+The model and its tests: docs/theory.md, "Fluids: gas and high explosive".
 """
 
 from __future__ import annotations

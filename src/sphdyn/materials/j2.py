@@ -25,6 +25,8 @@ default, perfect plasticity). Vector
 ``[density, K, G, yield_stress, hardening_modulus]``.
 History: ``("plastic_strain",)``, the equivalent plastic strain. Deck
 table: :class:`J2Params`.
+
+The model and its tests: docs/theory.md, "Materials".
 """
 
 from __future__ import annotations

@@ -40,6 +40,8 @@ speed: the bar's, :math:`c = \sqrt{E/\rho}`, :math:`E = 9KG/(3K + G)`.
 Parameter vector ``[density, K, G, yield_stress, hardening_modulus]`` (the J2
 layout, :func:`uniaxial_params`). Not a deck model: the sublayer builds its
 groups (:func:`sphdyn.build.model.build_model`).
+
+The model and its tests: docs/theory.md, "Materials".
 """
 
 from __future__ import annotations

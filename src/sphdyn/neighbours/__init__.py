@@ -96,6 +96,8 @@ Modules
 ``verlet``     ``NeighbourList``, ``build_neighbours``, skin checks, rebuilds
 ``reference``  ``brute_force_neighbours`` (O(N^2), for tests)
 ``stats``      ``max_neighbours``, ``mean_neighbours``
+
+The model and its tests: docs/theory.md, "Neighbour search".
 """
 
 from __future__ import annotations

@@ -25,6 +25,8 @@ The velocity is the one at the kick's time (the mid-kick velocity the
 stepper books energies with). Each gauge samples at the first kick at or after
 each multiple of its interval ``every``, at the history's time, and writes
 ``gauges/<name>.csv`` (time first); a restart continues the files.
+
+The model and its tests: docs/theory.md, "Gauges".
 """
 
 from __future__ import annotations

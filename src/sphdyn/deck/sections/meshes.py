@@ -4,7 +4,7 @@ A mesh is a generated block of hexahedra (3D) or plane-strain quadrilaterals
 (2D) ([mesh.block]), a generated prism of them (a polygon section extruded,
 [mesh.prism]), a generated line of beams or trusses ([mesh.line]), or a
 Gmsh / Abaqus file (``file``). Its elements use the deck's materials through
-the same point functions as particles (docs/theory.md, "Solid elements").
+the same point functions as particles (docs/theory.md, "Solid finite elements").
 [mesh.convert] replaces the elements of a region by SPH particles (one per
 element, at its centroid, with its volume and mass; thesis ch. 4) and couples
 them to the remaining mesh. [mesh.erosion] lets elements erode during the

@@ -26,6 +26,8 @@ Hugoniot from the unreacted state (``V = 1``, ``p = 0``, energy ``E0``),
 where the Rayleigh line :math:`p = \rho_0 D^2 (1 - V)` touches it: the
 smallest detonation speed :math:`D^2 = p_H / (\rho_0 (1 - V))` (Fickett &
 Davis, *Detonation*, 1979, ch. 2).
+
+The model and its tests: docs/theory.md, "Fluids: gas and high explosive".
 """
 
 from __future__ import annotations

@@ -20,6 +20,8 @@ e)_\rho`:
         + \frac{p\,b}{\rho^2}
 
 (for the ideal gas :math:`c^2 = \gamma p/\rho`).
+
+The model and its tests: docs/theory.md, "Fluids: gas and high explosive".
 """
 
 from __future__ import annotations

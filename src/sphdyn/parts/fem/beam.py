@@ -1,57 +1,13 @@
 r"""Numba kernels of the line elements: the co-rotational beam and the truss.
 
-Beam (2 nodes, 6 degrees of freedom per node)
----------------------------------------------
-A co-rotational resultant beam in the spirit of Belytschko & Schwer (1977)
-and Belytschko, Lin & Tsay (1977), with the element frame and the local
-rotations of Crisfield (1991, *Non-linear Finite Element Analysis of Solids
-and Structures*, vol. 1, ch. 7, and vol. 2, ch. 17):
-
-* every node carries a triad :math:`R_i` (rotation from the initial to the
-  current orientation, ``(N, 3, 3)``), advanced in the drift by the
-  incremental rotation :math:`\exp([\omega_i\,\Delta t]_\times)` (Rodrigues'
-  formula, :func:`rotation_from_vector`);
-* the element frame :math:`E = [e_1\ e_2\ e_3]` has :math:`e_1` along the
-  current chord, :math:`e_3 \parallel e_1 \times q` and :math:`e_2 = e_3
-  \times e_1`, with :math:`q = R_a E^0 \hat y + R_b E^0 \hat y` the mean of the
-  nodes' rotated initial section axes (:math:`E^0` the initial frame, its
-  second column the section's local y axis from the orientation vector);
-* the local (deformational) rotations are the rotation vectors of
-  :math:`E^T R_i E^0`, :math:`\theta_i = \log(E^T R_i E^0)`
-  (:func:`rotation_vector`), zero in any rigid motion;
-* the axial extension is :math:`u = l - L_0`.
-
-Elastic resultants (Timoshenko beam, stiffness of Przemieniecki 1968,
-*Theory of Matrix Structural Analysis*, sec. 5.6, with the chord through
-the nodes so that only the rotations remain):
-
-.. math::
-    N = \frac{EA}{L_0} u,\qquad T = \frac{GJ}{L_0}(\theta_{b,x} - \theta_{a,x}),
-
-    \begin{pmatrix} M_{a} \\ M_{b} \end{pmatrix} = \frac{EI}{L_0(1+\Phi)}
-    \begin{pmatrix} 4+\Phi & 2-\Phi \\ 2-\Phi & 4+\Phi \end{pmatrix}
-    \begin{pmatrix} \theta_a \\ \theta_b \end{pmatrix},\qquad
-    \Phi = \frac{12 EI}{\kappa G A L_0^2}
-
-for both section axes (:math:`I_z` with :math:`\theta_z`, bending in the
-local x-y plane; :math:`I_y` with :math:`\theta_y`). The nodal forces are
-:math:`B^T` of these resultants with the first-order variations
-:math:`\delta u = e_1\cdot(\delta x_b - \delta x_a)`, :math:`\delta\theta_{i,z}
-= e_3\cdot\delta\omega_i - e_2\cdot(\delta x_b - \delta x_a)/l`,
-:math:`\delta\theta_{i,y} = e_2\cdot\delta\omega_i + e_3\cdot(\delta x_b -
-\delta x_a)/l`, :math:`\delta(\theta_{b,x}-\theta_{a,x}) = e_1\cdot(\delta
-\omega_b - \delta\omega_a)`: the shear forces are the end moments over the
-current length, so every element is in equilibrium in its current
-configuration (forces and moments sum to zero exactly, which conserves
-linear and angular momentum). The strain energy is :math:`U = \tfrac12(N u +
-T\Delta\theta_x + \sum_i M_{i}\cdot\theta_i)`.
-
-Truss (2 nodes, 3 degrees of freedom per node)
-----------------------------------------------
-Axial force :math:`N = A\,\sigma_{11}` along the chord from the stress of
-one material point per element, kept in the bar's co-rotating frame (see
-:mod:`.line_part`). The logarithmic strain rate is
-:math:`\dot\varepsilon = \ln(l^{n+1}/l^n)/\Delta t`.
+Beam (2 nodes, 6 degrees of freedom per node): a co-rotational resultant
+Timoshenko beam (Belytschko & Schwer 1977; Crisfield 1991 for the element
+frame and the local rotations :math:`\theta_i = \log(E^T R_i E^0)`), elastic
+resultants :math:`N, T, M_a, M_b` of Przemieniecki (1968) and nodal forces in
+equilibrium in the current configuration. Truss (2 nodes, 3 degrees of
+freedom): :math:`N = A\sigma_{11}` along the chord, the logarithmic strain
+rate :math:`\ln(l^{n+1}/l^n)/\Delta t`. The model, its equations and their
+tests: docs/theory.md, "Beams and trusses".
 
 Conventions: SI units; ``x`` (N, 3) [m]; ``triad`` (N, 3, 3); ``conn``
 (E, 2); element nodal loads ``fe`` (E, 2, 6): force [N] and moment [N m]

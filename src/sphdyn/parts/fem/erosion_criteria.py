@@ -25,6 +25,8 @@ the flag array):
 3. :data:`BY_EFFECTIVE`: :math:`\varepsilon_{eff}` above a limit;
 4. :data:`BY_TIME_STEP`: the element's stable step (with the part's factor)
    below a minimum.
+
+The model and its tests: docs/theory.md, "Element erosion".
 """
 
 from __future__ import annotations

@@ -22,6 +22,8 @@ them). What differs is the layout: each block of
 
 A group at the end of a block is padded with copies of its last element;
 their results are not written.
+
+The model and its tests: docs/theory.md, "Solid finite elements".
 """
 
 from __future__ import annotations

@@ -8,55 +8,15 @@ section (:class:`BeamSection`) and one material:
   table ``kin.rot`` and a triad each);
 * ``element="truss"``: axial force only (3 degrees of freedom per node), the
   stress of one material point per element from the material's group
-  kernel, so every registered model (elastic, j2, ...) works.
+  kernel, kept in the bar's co-rotating frame with the lateral stresses
+  iterated to zero (``lateral_rtol``, ``lateral_iterations``), so every
+  registered model (elastic, j2, ...) works.
 
-Lumped masses and rotary inertia
---------------------------------
-Each element gives each of its nodes the mass :math:`\rho A L_0/2` and
-(beams) the isotropic rotary inertia :math:`I_r = s\,\rho I_{max} L_0/2`,
-with :math:`I_{max} = \max(I_y, I_z)`, i.e. ``s`` times the lumped bending
-rotary inertia. The default ``s = 3`` (``rotary_inertia_scale``) is the
-smallest scale for which no bending or rotation frequency of an element
-exceeds its axial frequency :math:`2c/l` (derived from the element
-eigenvalues of :func:`.beam.beam_stable_dt`: the mode
-:math:`(v,\theta,-v,\theta)` needs :math:`I_r \ge 1.5\rho I L/((1+\Phi) -
-12 I/(A L^2))`, at most :math:`1.5\rho I L` since :math:`E/(\kappa G) > 1`),
-so the beam runs at the bar's time step, as explicit codes do with scaled
-rotary inertia (Hughes, Taylor & Kanoknukulchai 1977; LS-DYNA Theory Manual,
-Belytschko-Schwer beam). The extra inertia changes the bending frequencies
-of slender beams by a fraction of order :math:`(r/L)^2`; for stocky beams
-give ``rotary_inertia_scale=1`` (the physical rotary inertia of bending; the
-step then follows from the rotational frequencies). The isotropic inertia
-makes the torsional inertia :math:`s\rho I_{max}L/2` instead of
-:math:`\rho(I_y+I_z)L/2`: torsional frequencies are off by that ratio.
-
-Truss: uniaxial stress
-----------------------
-The material point's stress is kept in the bar's co-rotating frame (axis 1
-along the bar), so the velocity gradient the material sees is
-:math:`\mathrm{diag}(\dot\varepsilon, \dot\varepsilon_{lat},
-\dot\varepsilon_{lat})`, symmetric (no spin): the frame rotation is carried
-exactly by the chord, and for an isotropic material this is the same update
-as in global axes with the bar's rotation removed. The lateral rate makes
-the lateral stresses vanish: the trial :math:`\dot\varepsilon_{lat} = \beta
-\dot\varepsilon` with the point's previous ratio :math:`\beta` (initially
-:math:`-\nu`, exact for elasticity, so the elastic model takes one update),
-then, while some point's lateral stress exceeds ``lateral_rtol`` times its
-stress scale, the point state (stress, energy, history, damage, wave speed)
-is restored and the rate corrected, first with the elastic lateral
-stiffness :math:`2(K + G/3)`, then by secant steps (:func:`.beam.lateral_secant`),
-at most ``lateral_iterations`` updates per step. The area is constant,
-:math:`N = A\sigma_{11}`, and the density passed to the material is
-:math:`\rho_0 L_0/l` so that the material's internal energy equals the
-work of the axial forces.
-
-Energy
-------
-``energies()`` returns the strain energy (beams: :math:`\sum U_e`; trusses:
-:math:`\sum m_e e_e` of the material points) plus the energy dissipated by
-the optional mass-proportional damping (``damping`` [1/s], the accelerations
-:math:`-c\,v` and :math:`-c\,\omega`), and that dissipated part as the second
-value, so the stepper's balance closes with or without damping.
+Lumped masses :math:`\rho A L_0/2` per node and the isotropic rotary inertia
+:math:`s\,\rho I_{max} L_0/2` (``rotary_inertia_scale`` s = 3: the beam runs
+at the bar's step); ``energies()`` the strain energy plus what the optional
+mass-proportional ``damping`` dissipated. The model and its tests:
+docs/theory.md, "Beams and trusses".
 """
 
 from __future__ import annotations

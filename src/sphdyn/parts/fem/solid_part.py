@@ -13,6 +13,8 @@ One step of the part (the stepper calls these in order; state at
 
 Masses are lumped: each node gets ``1/nen`` of the mass of every element it
 belongs to. The stable step is the element bound of :mod:`.solid`.
+
+The model and its tests: docs/theory.md, "Solid finite elements".
 """
 
 from __future__ import annotations

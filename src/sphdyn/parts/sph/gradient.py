@@ -6,6 +6,8 @@ scheme, its pairing with the forces and the references: :mod:`.passes`.
 Rows are gathered in ``prange`` and written only by their owner (race-free);
 long rows go through a row buffer of :data:`GRADIENT_ROWS` rows in
 :data:`GRADIENT_CHUNKS` chunks (:func:`gradient_scratch`).
+
+The model and its tests: docs/theory.md, "Updated-Lagrangian SPH for solids".
 """
 
 from __future__ import annotations

@@ -25,6 +25,8 @@ artificial-stress epsilon, the total-Lagrangian mask, the mesostructure
 phase and the variation factor) and its work arrays live in the particles'
 :class:`~sphdyn.state.ArrayStore`; when particles are added, :meth:`_grown`
 refreshes them, the material groups and the neighbour lists.
+
+The model and its tests: docs/theory.md, "Updated-Lagrangian SPH for solids".
 """
 
 from __future__ import annotations

@@ -38,6 +38,8 @@ Randles & Libersky (1996), CMAME 139, 375-408 (gradient renormalisation).
 Monaghan (1992), Annu. Rev. Astron. Astrophys. 30, 543-574 (artificial
 viscosity, XSPH).
 Benz (1989), NATO workshop, Les Arcs (smoothing-length evolution).
+
+The model and its tests: docs/theory.md, "Updated-Lagrangian SPH for solids".
 """
 
 from __future__ import annotations

@@ -5,6 +5,8 @@ gradient, velocity gradient, density ``rho0 / det F``) before the material
 update and :meth:`TotalLagrangian.accelerations` (first Piola-Kirchhoff
 stress, momentum balance, hourglass control) after it. See
 :mod:`sphdyn.parts.sph.total_lagrangian` for the equations.
+
+The model and its tests: docs/theory.md, "Total-Lagrangian SPH".
 """
 
 from __future__ import annotations

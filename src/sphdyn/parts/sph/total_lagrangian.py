@@ -24,6 +24,8 @@ References
 Ganzenmüller (2015), An hourglass control algorithm for Lagrangian Smooth
 Particle Hydrodynamics, CMAME 286, 87-106.
 Bonet & Lok (1999), CMAME 180, 97-115 (corrected gradients).
+
+The model and its tests: docs/theory.md, "Total-Lagrangian SPH".
 """
 
 from __future__ import annotations
