@@ -24,8 +24,12 @@ def _particles(n=4, seed=1):
 
 def test_every_field_is_described():
     for f in fields.FIELDS.values():
-        assert f.shape in ("scalar", "vector", "tensor", "history")
+        assert f.shape in ("scalar", "vector", "tensor", "history", "pair")
         assert f.unit and f.description.endswith(".")
+        # a field without a getter is a cell field of meshes only; "pair"
+        # (a value per element end) exists on line elements only
+        assert f.getter is not None or f.cells, f.name
+        assert f.shape != "pair" or f.getter is None, f.name
 
 
 def test_probe_values_are_the_particle_arrays():

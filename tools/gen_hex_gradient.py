@@ -50,6 +50,8 @@ def main():
         "",
         "The hex8 volume derivatives of :func:`.solid.volume_gradient` (3D), unrolled:",
         "one element, and the lanes of :mod:`.hex_lanes` side by side.",
+        "",
+        'The model and its tests: docs/theory.md, "Solid finite elements".',
         '"""',
         "",
         "from numba import njit",
