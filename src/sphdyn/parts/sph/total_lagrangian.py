@@ -319,16 +319,14 @@ def _viscous_hourglass(fk, hk, d0, d1, d2, w0, w1, w2, s0, s1, s2, hij, csum, rh
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _row_sums(i, three, kin, props, pairs, stress, viscosity):
+def _row_sums(i, three, x, v, X, m, rho, c, h0, offsets, idx, fac, hgk, Q, Fdef, av_alpha,
+              av_beta, support_scale):
     """Row ``i``'s pair sums of :func:`tl_forces`: ``(a0, a1, a2)``, the sum
     of fac Q_j (X_i - X_j); ``(q0, q1, q2)``, the viscous acceleration;
     ``(fh0, fh1, fh2)``, the hourglass force [N]; ``heat``, the viscous
-    heating rate [W/kg]."""
-    x, v, X = kin
-    m, rho, _, c, h0, _ = props
-    offsets, idx, fac, hgk = pairs
-    _, Q, _, Fdef, _ = stress
-    av_alpha, av_beta, support_scale = viscosity
+    heating rate [W/kg]. The arrays come one by one, unpacked by the kernel
+    outside its loop (unpacked here, in the loop, the TL rings ran 3 %
+    slower: docs/architecture.md, "Numba conventions")."""
     xi0, xi1, xi2 = load3(x, i)
     vi0, vi1, vi2 = load3(v, i)
     ci = c[i]
@@ -503,14 +501,17 @@ def tl_forces(rows, kin, props, pairs, stress, dim, viscosity, a, dedt_av):
     The inputs come grouped in tuples, the arrays it writes one by one
     (docs/architecture.md, "Numba conventions").
     """
-    v = kin[1]
-    m, _, rho0, _, _, _ = props
-    P, _, B0, _, gsum = stress
+    x, v, X = kin
+    m, rho, rho0, c, h0, _ = props
+    offsets, idx, fac, hgk = pairs
+    P, Q, B0, Fdef, gsum = stress
+    av_alpha, av_beta, support_scale = viscosity
     three = dim == 3
     for t in prange(rows.shape[0]):
         i = rows[t]
-        a0, a1, a2, q0, q1, q2, fh0, fh1, fh2, heat = _row_sums(i, three, kin, props,
-                                                                 pairs, stress, viscosity)
+        a0, a1, a2, q0, q1, q2, fh0, fh1, fh2, heat = _row_sums(
+            i, three, x, v, X, m, rho, c, h0, offsets, idx, fac, hgk, Q, Fdef, av_alpha,
+            av_beta, support_scale)
         pb0, pb1, pb2 = _own_share(i, P, B0, gsum)
         inv_rho0 = 1.0 / rho0[i]
         a[i, 0] = (a0 + pb0) * inv_rho0 + q0
