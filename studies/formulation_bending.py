@@ -177,7 +177,7 @@ def _run(case: str, template: str, n: int, form: tuple, t_end: float, prepare,
     values = np.asarray(sampler.values)
     if not np.all(np.isfinite(values)):
         raise RuntimeError(f"{case} {label} n={n}: non-finite signal")
-    return Run(case, n, label, np.asarray(sampler.t), values, stepper.particles.n,
+    return Run(case, n, label, np.asarray(sampler.t), values, stepper.part("sph").kin.n,
                stepper.step_count, seconds)
 
 
@@ -191,14 +191,14 @@ def run_cantilever(n: int, form: tuple, periods: float = 2.5) -> Run:
 
     def prepare(s):
         nonlocal tip
-        p = s.particles
+        p = s.part("sph").kin
         x = p.x0[:, 0]
         free = x > 0.0
         p.v[free, 1] = v_tip * mode_shape(x[free])
         tip = np.flatnonzero(x > LENGTH - THICKNESS / n)
 
     def signal(s):
-        p = s.particles
+        p = s.part("sph").kin
         return float(np.mean(p.x[tip, 1] - p.x0[tip, 1]))
 
     return _run("cantilever", "cantilever.toml.tmpl", n, form, t_end, prepare, signal)

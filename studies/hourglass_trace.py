@@ -73,7 +73,8 @@ def main(argv=None) -> int:
     sim = Simulation.from_directory(dst)
     st = sim.stepper
     part = next(p for p in st.parts if p.name == args.mesh)
-    el, pts, p = part.el, part.pts, st.particles
+    el, pts = part.el, part.pts
+    p = next((q.kin for q in st.parts if q.name == "sph"), None)  # the particles, if any
     books = st.record()
     for _ in range(args.steps):
         e_hg, active = el.e_hg.copy(), el.active.copy()

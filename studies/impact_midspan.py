@@ -37,7 +37,7 @@ def main(argv: list[str]) -> None:
     t_end = float(argv[0]) if argv and not argv[0].startswith("--") else 0.004
     sets = [a for k, a in enumerate(argv) if k > 0 and argv[k - 1] == "--set"]
     st = build_stepper(load_deck(DECK, overrides=QUICK + sets))
-    p = st.particles
+    p = st.part("sph").kin
     names = list(p.hist_names)
     col = {n: names.index(n) for n in names}
     column = np.flatnonzero((p.mat == 0) & (np.abs(p.x0[:, 0] - 0.585) < 1e-4)
