@@ -308,22 +308,27 @@ def _accelerate(i, c0, c1, c2, accel, a_p):
     a_p[i, 2] += accel[i, 2]
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _add_shares(face, share, mn, a_n):
+    """One particle's forces on the nodes of its ``face`` (nf,), ``share``
+    (4, 3) [N] (rows past nf unused), added to ``a_n`` (M, 3) [m/s^2]
+    (massless nodes skipped)."""
+    for a in range(face.shape[0]):
+        node = face[a]
+        if mn[node] > 0.0:
+            a_n[node, 0] += share[a, 0] / mn[node]
+            a_n[node, 1] += share[a, 1] / mn[node]
+            a_n[node, 2] += share[a, 2] / mn[node]
+
+
 @njit(cache=True, error_model="numpy")
 def _gather_shares(face_of, faces, shares, mn, a_n):
     """The face nodes' shares of the contact forces into ``a_n`` (M, 3)
     [m/s^2]: serial, in particle order (deterministic on any number of
     threads)."""
-    nf = faces.shape[1]
     for i in range(face_of.shape[0]):
-        f = face_of[i]
-        if f < 0:
-            continue
-        for a in range(nf):
-            node = faces[f, a]
-            if mn[node] > 0.0:
-                a_n[node, 0] += shares[i, a, 0] / mn[node]
-                a_n[node, 1] += shares[i, a, 1] / mn[node]
-                a_n[node, 2] += shares[i, a, 2] / mn[node]
+        if face_of[i] >= 0:
+            _add_shares(faces[face_of[i]], shares[i], mn, a_n)
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
@@ -544,14 +549,8 @@ def tie_forces(tied, tie_face, tie_xi, tie_eta, tie_offset, xp, mp, vol0, rho0, 
             shares[k, a, 2] = -N[a] * f2
     total = 0.0
     for k in range(nt):
-        f = tie_face[k]
         total += np.sqrt(force[k, 0] ** 2 + force[k, 1] ** 2 + force[k, 2] ** 2)
-        for a in range(nf):
-            node = faces[f, a]
-            if mn[node] > 0.0:
-                a_n[node, 0] += shares[k, a, 0] / mn[node]
-                a_n[node, 1] += shares[k, a, 1] / mn[node]
-                a_n[node, 2] += shares[k, a, 2] / mn[node]
+        _add_shares(faces[tie_face[k]], shares[k], mn, a_n)
     return total
 
 
