@@ -52,6 +52,7 @@ def mass_scaling(deck, model: Model, parts) -> MassScaling | None:
     if ms.parts is not None:
         names = set(ms.parts)
         bodies = [k for k, name in enumerate(model.body_names) if name in names]
-        select = {part.name: (np.isin(part.p.body, bodies) if part.kind == "sph"
+        # items labelled by body (the particles) by their bodies, the others by name
+        select = {part.name: (np.isin(part.kin.body, bodies) if "body" in part.kin.names()
                               else part.name in names) for part in parts}
     return MassScaling(ms.target, ms.max_added, select)
