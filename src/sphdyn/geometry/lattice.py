@@ -96,7 +96,7 @@ def _point(p, dim: int, name: str) -> np.ndarray:
     return out
 
 
-def _axis_index(axis) -> int:
+def axis_index(axis) -> int:
     """Axis name ("x", "y", "z", any case) or index (0, 1, 2) -> index."""
     if isinstance(axis, str) and axis.lower() in _AXIS_NAMES:
         return _AXIS_NAMES[axis.lower()]
@@ -164,7 +164,7 @@ def _radial_lattice(centre, inner: float, outer: float, length, axis, dx: float,
     if rule not in RULES:
         raise ValueError(f"rule must be one of {sorted(RULES)}, got {rule!r}")
     c = _point(centre, dim, "centre")
-    ax = _axis_index(axis)
+    ax = axis_index(axis)
     if dim == 2:
         if ax != 2:
             raise ValueError(f"in 2D the axis must be 'z' (a disc in the x-y plane), got {axis!r}")
@@ -198,7 +198,7 @@ def rotate_about(x, centre, axis, degrees: float) -> np.ndarray:
     """Points ``x`` (n, 3) [m] rotated by ``degrees`` about the line through
     ``centre`` (3,) along ``axis`` ("x", "y", "z" or 0, 1, 2), right-handed
     (a new array)."""
-    a = _axis_index(axis)
+    a = axis_index(axis)
     u, v = [k for k in range(3) if k != a]
     if a == 1:  # right-handed about y: z -> x
         u, v = v, u
@@ -368,7 +368,7 @@ def prism_section(points, dim: int, axis, length) -> tuple[np.ndarray, int]:
     poly = np.asarray(points, dtype=np.float64)
     if poly.ndim != 2 or poly.shape[1] != 2 or poly.shape[0] < 3:
         raise ValueError(f"points must be three or more [u, v] pairs, got shape {poly.shape}")
-    ax = _axis_index(axis)
+    ax = axis_index(axis)
     if dim == 2:
         if ax != 2:
             raise ValueError(f"in 2D the axis must be 'z' (a polygon in the x-y plane), "
@@ -503,7 +503,7 @@ def ogive_lattice(tip, radius: float, length: float, crh: float, dx: float, dim:
     if ogive_nose_length(a, crh) > length * (1.0 + _RTOL):
         raise ValueError(f"the nose ({ogive_nose_length(a, crh):g} m long) is longer than "
                          f"the projectile ({length:g} m)")
-    ax, sign = _axis_index(nose[1]), (1.0 if nose[0] == "+" else -1.0)
+    ax, sign = axis_index(nose[1]), (1.0 if nose[0] == "+" else -1.0)
     t = _point(tip, 3, "tip")
     centre = t.copy()
     centre[ax] -= sign * 0.5 * length

@@ -24,7 +24,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from .lattice import _axis_index, _check_dim, _point, _positive
+from .lattice import axis_index, _check_dim, _point, _positive
 
 __all__ = ["REGION_SHAPES", "bounding_box", "select"]
 
@@ -69,7 +69,7 @@ def _direction(axis, dim: int) -> np.ndarray:
     """Unit (3,) vector from an axis name/index or a direction vector."""
     if isinstance(axis, (str, int, np.integer)):
         d = np.zeros(3)
-        d[_axis_index(axis)] = 1.0
+        d[axis_index(axis)] = 1.0
         return d
     d = np.asarray(axis, dtype=np.float64).reshape(-1)
     if d.size == 2:

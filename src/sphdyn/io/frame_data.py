@@ -18,12 +18,12 @@ from pathlib import Path
 import numpy as np
 
 from ..fields import FIELDS
+from ..geometry.lattice import axis_index
 from .plots import time_unit
 
 __all__ = ["select_frames", "slab_mask", "particle_spacing", "field_values",
            "available_fields", "run_labels"]
 
-_AXES = {"x": 0, "y": 1, "z": 2}
 _TENSOR = ("xx", "xy", "xz", "yx", "yy", "yz", "zx", "zy", "zz")
 _TENSOR_RE = re.compile(r"^(.+)_(xx|xy|xz|yx|yy|yz|zx|zy|zz)$")
 _VECTOR_RE = re.compile(r"^(.+)_([xyz])$")
@@ -31,14 +31,6 @@ _VECTOR_RE = re.compile(r"^(.+)_([xyz])$")
 #: SI unit of each output field (components and magnitudes share it), from
 #: the field registry
 _UNITS = {name: f.unit for name, f in FIELDS.items()}
-
-
-def axis_index(axis: str | int) -> int:
-    if isinstance(axis, str) and axis.lower() in _AXES:
-        return _AXES[axis.lower()]
-    if isinstance(axis, (int, np.integer)) and 0 <= int(axis) <= 2:
-        return int(axis)
-    raise ValueError(f"slice axis must be 'x', 'y' or 'z', not {axis!r}")
 
 
 def select_frames(frame_times, times=None, n: int = 4) -> list[int]:

@@ -29,8 +29,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .frame_data import (axis_index, run_info, field_values, particle_spacing,
-                         run_labels, select_frames, slab_mask)
+from ..geometry.lattice import axis_index
+from .frame_data import (field_values, particle_spacing, run_info, run_labels,
+                         select_frames, slab_mask)
 from .plots import save_figure, time_unit
 from .frames import frames_of_run
 from .hdf5 import read_frame, read_frame_header
