@@ -309,16 +309,16 @@ def _accelerate(i, c0, c1, c2, accel, a_p):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _add_shares(face, share, mn, a_n):
+def _add_shares(face, share, mn, a_n, sign=1.0):
     """One particle's forces on the nodes of its ``face`` (nf,), ``share``
-    (4, 3) [N] (rows past nf unused), added to ``a_n`` (M, 3) [m/s^2]
-    (massless nodes skipped)."""
+    (4, 3) [N] (rows past nf unused), added to ``a_n`` (M, 3) [m/s^2] times
+    ``sign`` (-1: taken back, bitwise the inverse of adding them); massless
+    nodes skipped."""
     for a in range(face.shape[0]):
         node = face[a]
         if mn[node] > 0.0:
-            a_n[node, 0] += share[a, 0] / mn[node]
-            a_n[node, 1] += share[a, 1] / mn[node]
-            a_n[node, 2] += share[a, 2] / mn[node]
+            for c in range(3):
+                a_n[node, c] += sign * share[a, c] / mn[node]
 
 
 @njit(cache=True, error_model="numpy")
@@ -475,14 +475,8 @@ def withdraw_contact(face_of, faces, shares, accel, mn, a_p, a_n):
     for i in range(face_of.shape[0]):
         for c in range(3):
             a_p[i, c] -= accel[i, c]
-        f = face_of[i]
-        if f < 0:
-            continue
-        for a in range(faces.shape[1]):
-            node = faces[f, a]
-            if mn[node] > 0.0:
-                for c in range(3):
-                    a_n[node, c] -= shares[i, a, c] / mn[node]
+        if face_of[i] >= 0:
+            _add_shares(faces[face_of[i]], shares[i], mn, a_n, -1.0)
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
