@@ -28,6 +28,8 @@ def depth_inside(geometry, x: np.ndarray, dim: int) -> np.ndarray:
     outside (only the sign and the depth inside are used).
     """
     g = geometry
+    if g.shape == "points":  # no closed shape: nothing lies inside it
+        return np.full(x.shape[0], -np.inf)
     if g.shape == "box":
         lo, hi = np.asarray(g.lo)[:dim], np.asarray(g.hi)[:dim]
         return np.min(np.minimum(x[:, :dim] - lo, hi - x[:, :dim]), axis=1)
@@ -72,7 +74,7 @@ def placement_problems(deck, positions: list[np.ndarray]) -> list[str]:
     dim = deck.run.dimension
     problems = []
     for b, (body, x) in enumerate(zip(deck.body, positions)):
-        if x.shape[0] < 2:
+        if x.shape[0] < 2 and body.geometry.shape != "points":
             size = shape_volume(body.geometry, dim) ** (1.0 / dim)
             problems.append(format_problem(
                 f"body[{b}].dx",

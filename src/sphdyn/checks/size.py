@@ -21,7 +21,7 @@ import numpy as np
 
 from ..deck import DeckError
 from ..deck.errors import format_problem
-from ..geometry.lattice import ogive_volume, polygon_area
+from ..geometry.lattice import ogive_volume, polygon_area, read_points
 
 #: Bytes of per-particle state and work arrays (besides history variables and
 #: neighbour lists): about 850 measured for block3d at 1M particles
@@ -110,6 +110,15 @@ def shape_volume(geometry, dim: int) -> float:
     inner = 0.0 if g.shape == "cylinder" else g.inner_radius
     area = ball_volume(outer, 2) - ball_volume(inner, 2)
     return area if dim == 2 else area * g.length
+
+
+def body_count(body, dim: int) -> float:
+    """Particles of a ``[[body]]``: its geometry's volume over ``dx**dim``, or
+    the rows of a ``points`` file."""
+    g = body.geometry
+    if g.shape == "points":
+        return float(read_points(g.file, dim, g.length_unit).shape[0])
+    return lattice_count(shape_volume(g, dim), body.dx, dim)
 
 
 def lattice_count(volume: float, dx: float, dim: int) -> float:
@@ -271,8 +280,7 @@ def estimate_size(deck, model=None) -> SizeEstimate:
         bodies = {name: float(c) for name, c in zip(model.body_names, counts)}
         meshes = {mm.name: float(mm.cells.shape[0]) for mm in model.meshes}
     else:
-        bodies = {b.name: lattice_count(shape_volume(b.geometry, dim), b.dx, dim)
-                  for b in deck.body}
+        bodies = {b.name: body_count(b, dim) for b in deck.body}
         meshes = {m.name: _element_count(m, dim) for m in deck.mesh if m.file is None}
         if ELEMENT_BYTES * sum(meshes.values()) <= memory_limit(deck)[0]:
             bodies.update(_converted_counts(deck))

@@ -36,6 +36,8 @@ import math
 
 import numpy as np
 
+from ..geometry.lattice import read_points
+
 #: Timoshenko first frequency of the study's cantilever [Hz]
 #: (``timoshenko_f1()`` of studies/formulation_bending.py).
 F_TIMOSHENKO = 847.528
@@ -115,11 +117,12 @@ def _polygon_thickness(points) -> float:
     return best
 
 
-def member_extents(geometry, dim: int) -> tuple[float, float]:
+def member_extents(geometry, dim: int, dx: float = 0.0) -> tuple[float, float]:
     """(thickness, longest extent) [m] of a body geometry.
 
     The thickness is taken across its thinnest direction: box: its smallest
-    side in the run's ``dim`` dimensions; sphere: its diameter; ogive: its
+    side in the run's ``dim`` dimensions; points: the same of the particles'
+    bounding box, each particle ``dx`` wide; sphere: its diameter; ogive: its
     shank's diameter (its length the longest extent); cylinder:
     its diameter (and its length in 3D, the smaller); ring: its wall, outer
     - inner radius (the diameter if inner = 0; and the length in 3D); prism:
@@ -128,8 +131,13 @@ def member_extents(geometry, dim: int) -> tuple[float, float]:
     bounding box (a ring's outer diameter).
     """
     g = geometry
-    if g.shape == "box":
-        sides = [h - l for l, h in zip(g.lo[:dim], g.hi[:dim])]
+    if g.shape in ("box", "points"):
+        if g.shape == "box":
+            lo, hi = g.lo, g.hi
+        else:  # the particles' bounding box, each particle dx wide
+            x = read_points(g.file, dim, g.length_unit)
+            lo, hi = x.min(axis=0) - 0.5 * dx, x.max(axis=0) + 0.5 * dx
+        sides = [h - l for l, h in zip(lo[:dim], hi[:dim])]
         return float(min(sides)), float(max(sides))
     if g.shape == "sphere":
         return 2.0 * g.radius, 2.0 * g.radius
@@ -234,7 +242,7 @@ def thin_member_warnings(deck, model=None) -> list[str]:
         if b.material in fluid:  # a gas or an explosive has no stiffness to lose
             continue
         kind = _kind(b.formulation or sph.formulation, sph.correction)
-        out.append(thin_member_warning(b.name, *member_extents(b.geometry, dim), b.dx, kind))
+        out.append(thin_member_warning(b.name, *member_extents(b.geometry, dim, b.dx), b.dx, kind))
     if model is not None:
         kind = _kind(sph.formulation, sph.correction)
         for name, thickness, longest, size in _converted_members(model, dim):

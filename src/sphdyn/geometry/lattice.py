@@ -37,6 +37,8 @@ __all__ = [
     "rotate_about",
     "sphere_lattice",
     "prism_lattice",
+    "points_lattice",
+    "read_points",
     "ogive_lattice",
     "ogive_nose_length",
     "ogive_profile",
@@ -514,6 +516,51 @@ def ogive_lattice(tip, radius: float, length: float, crh: float, dx: float, dim:
     return x[r <= ogive_profile(zeta, a, crh) * (1.0 + _RTOL) + _RTOL * dx]
 
 
+def read_points(file, dim: int, length_unit: float = 1.0) -> np.ndarray:
+    """Positions of a ``points`` body: a CSV file whose header names the
+    columns, ``x, y`` in 2D and ``x, y, z`` in 3D (other columns are ignored),
+    one particle per row, in units of ``length_unit`` [m].
+
+    Returns (n, 3) float64 [m], ``z = 0`` in 2D. Raises :class:`ValueError`
+    naming the file and what is wrong (missing column, a value that is not a
+    finite number, no rows).
+    """
+    import csv
+
+    names = "xyz"[:dim]
+    with open(file, newline="") as f:
+        rows = list(csv.reader(line for line in f if not line.lstrip().startswith("#")))
+    if not rows:
+        raise ValueError(f"{file}: no header line (it must name the columns "
+                         f"{', '.join(names)})")
+    header = [c.strip().lower() for c in rows[0]]
+    missing = [c for c in names if c not in header]
+    if missing:
+        raise ValueError(f"{file}: no column {', '.join(missing)} in the header "
+                         f"{rows[0]} (a points file's header names x, y{', z' if dim == 3 else ''})")
+    cols = [header.index(c) for c in names]
+    x = np.zeros((len(rows) - 1, 3))
+    for r, row in enumerate(rows[1:]):
+        try:
+            x[r, :dim] = [float(row[c]) for c in cols]
+        except (ValueError, IndexError):
+            raise ValueError(f"{file}, line {r + 2}: {row} is not {dim} numbers in "
+                             f"the columns {', '.join(names)}") from None
+    if not x.shape[0]:
+        raise ValueError(f"{file}: a header and no particle")
+    if not np.isfinite(x).all():
+        raise ValueError(f"{file}: a coordinate is not a finite number")
+    return x * length_unit
+
+
+def points_lattice(file, dx: float, dim: int, length_unit: float = 1.0) -> np.ndarray:
+    """The ``points`` shape: the particles of a file (:func:`read_points`), each
+    standing for the volume ``dx**dim`` as a lattice's would (LS-DYNA's
+    ``*ELEMENT_SPH``, written by ``sphdyn import``)."""
+    _positive("dx", dx)
+    return read_points(file, dim, length_unit)
+
+
 # --------------------------------------------------------------------------
 # dispatch
 # --------------------------------------------------------------------------
@@ -524,6 +571,7 @@ SHAPES = {
     "sphere": sphere_lattice,
     "prism": prism_lattice,
     "ogive": ogive_lattice,
+    "points": points_lattice,
 }
 
 

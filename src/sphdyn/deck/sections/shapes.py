@@ -3,14 +3,14 @@
 from typing import Annotated, Literal, Optional, Union
 
 import numpy as np
-from pydantic import AfterValidator, Field, ValidationInfo, field_validator
+from pydantic import AfterValidator, Field, ValidationInfo, field_validator, model_validator
 
-from ...geometry.lattice import ogive_nose_length, polygon_area
+from ...geometry.lattice import ogive_nose_length, polygon_area, read_points
 from ..messages import problem, show_number
 from ..scope import dimension
 from ..units import LENGTH
-from ..values import (Axis, Corner, Direction, Position, PositiveLength, Section,
-                      UpperCorner, UpperPosition, quantity, real)
+from ..values import (Axis, Corner, Direction, ExistingFile, Position, PositiveLength,
+                      Section, UpperCorner, UpperPosition, quantity, real)
 
 
 class Box(Section):
@@ -198,7 +198,32 @@ class Ogive(Section):
         return crh
 
 
-Geometry = Annotated[Union[Box, Cylinder, Ring, Sphere, Prism, Ogive],
+class Points(Section):
+    """Particles at given positions (LS-DYNA's ``*ELEMENT_SPH``; ``sphdyn
+    import`` writes them): a CSV file whose header names the columns ``x, y``
+    (2D) or ``x, y, z`` (3D), one particle per row; other columns are
+    ignored, lines starting with ``#`` too. Each particle stands for the
+    volume ``dx**dimension`` of its body, as on a lattice. Bodies of points
+    are not checked for overlapping other bodies (they have no closed
+    shape); the domain and wall checks apply."""
+
+    shape: Literal["points"] = Field(description="Kind of shape.")
+    file: ExistingFile = Field(description="The CSV file of the positions.")
+    length_unit: quantity(LENGTH, "length unit", lo=0, lo_open=True) = Field(
+        1.0, description="Length of one file coordinate unit (\"1 mm\" for a file in "
+                         "millimetres).")
+
+    @model_validator(mode="after")
+    def _readable(self):
+        try:
+            read_points(self.file, dimension() or 3, self.length_unit)
+        except ValueError as e:
+            raise problem(str(e), "write the file as a CSV with a header line x,y,z "
+                          "(x,y in 2D) and one particle per row") from None
+        return self
+
+
+Geometry = Annotated[Union[Box, Cylinder, Ring, Sphere, Prism, Ogive, Points],
                      Field(discriminator="shape")]
 
 
