@@ -50,6 +50,7 @@ SKIP = {
     # installs the package: the test runs the installed tree already
     "pip install .": "installs the package",
     "pip install '.[test]'": "installs the package",
+    "pip install 'sphdyn[lsdyna]'": "installs the package with its LS-DYNA extra",
     # the whole test suite, from inside the test suite
     "pytest": "runs the test suite",
     # a remote Dask scheduler (SLURM through dask-jobqueue) that does not exist here

@@ -1,4 +1,4 @@
-"""Command line: ``sphdyn run|check|restart|ensemble|plot|ucs|export|info|bench|material-test``.
+"""Command line: ``sphdyn run|check|import|restart|ensemble|plot|ucs|export|info|bench|material-test``.
 
 Each subcommand is a thin function over the Python API. Exit codes: 0 success,
 1 a failed run (guard stopped it; all output kept), 2 bad input (deck or
@@ -11,7 +11,7 @@ import argparse
 import sys
 
 from .args import _duration, _positive, _whole
-from .commands import (cmd_airblast, cmd_bench, cmd_check, cmd_ensemble, cmd_export, cmd_info, cmd_mesostructure, cmd_plot, cmd_restart, cmd_run, cmd_ucs, cmd_validate)
+from .commands import (cmd_airblast, cmd_bench, cmd_check, cmd_ensemble, cmd_export, cmd_import, cmd_info, cmd_mesostructure, cmd_plot, cmd_restart, cmd_run, cmd_ucs, cmd_validate)
 from .material_test import cmd_material_test
 
 
@@ -35,6 +35,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="override a deck value, e.g. --set run.t_end=1e-4")
     r.add_argument("--max-steps", type=_whole(0), help="stop after this many steps")
     r.add_argument("-q", "--quiet", action="store_true", help=QUIET)
+    r.add_argument("--units", help="an LS-DYNA keyword deck's units (DECK.k, .key or "
+                   ".dyn: imported into OUT/imported/ first, docs/lsdyna.md)")
+    r.add_argument("--allow-partial", action="store_true", help="a keyword deck: run "
+                   "even when items left out by the import change the result")
     r.set_defaults(func=cmd_run)
 
     en = sub.add_parser("ensemble", help="run N random samples of a deck (and a grid "
@@ -65,6 +69,19 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--set", action="append", metavar="KEY=VALUE")
     c.add_argument("--resolved", help="also write the resolved deck here")
     c.set_defaults(func=cmd_check)
+
+    from ..lsdyna.units import help_text
+
+    im = sub.add_parser("import", help="an LS-DYNA keyword deck (.k) as a sphdyn deck, "
+                        "then check it (docs/lsdyna.md)")
+    im.add_argument("model", help="the keyword deck (its *INCLUDE files are followed)")
+    im.add_argument("-o", "--out", help="the sphdyn deck to write (default MODEL.toml; "
+                    "its mesh and particle files beside it)")
+    im.add_argument("--units", required=True, help="the keyword deck's consistent "
+                    "units, length-time-mass: " + help_text())
+    im.add_argument("--allow-partial", action="store_true", help="write the deck even "
+                    "when items left out change the result (they are listed at its top)")
+    im.set_defaults(func=cmd_import)
 
     s = sub.add_parser("restart", help="continue a run from DIR/checkpoint.h5")
     s.add_argument("dir")

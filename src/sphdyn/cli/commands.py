@@ -15,8 +15,14 @@ def cmd_run(args) -> int:
     from ..watchers.monitors import compile_notice
     from ..simulation import Simulation
 
-    deck = load_deck(args.deck, args.set)
     out = Path(args.out) if args.out else Path("out") / Path(args.deck).stem
+    deck_path = args.deck
+    if Path(args.deck).suffix.lower() in KEYWORD_SUFFIXES:
+        _writable_dir(out, "--out")
+        deck_path = _import_for_run(args, out)
+        if deck_path is None:
+            return 2
+    deck = load_deck(deck_path, args.set)
     _writable_dir(out, "--out")
     with compile_notice(None if args.quiet else _note):
         sim = Simulation.from_deck(deck, out)
@@ -27,6 +33,42 @@ def cmd_run(args) -> int:
               f"t_end = {deck.run.t_end:g} s, initial dt = {sim.stepper.dt0:.3e} s -> {out}")
     return _finish(sim.run(max_steps=args.max_steps, progress=not args.quiet and None,
                            threads=args.threads), out, args.quiet)
+
+
+#: file suffixes ``sphdyn run`` takes for LS-DYNA keyword decks
+KEYWORD_SUFFIXES = (".k", ".key", ".dyn")
+
+
+def _import_for_run(args, out: Path):
+    """``sphdyn run MODEL.k``: the keyword deck imported into ``out/imported/``
+    (the deck and its data files, kept with the run so that it can restart);
+    the deck's path, or None when items left out change the result."""
+    from ..lsdyna import import_deck, write_import
+
+    if not args.units:
+        raise ValueError(f"{args.deck} is an LS-DYNA keyword deck: give its units. Fix: "
+                         "add --units (e.g. --units mm-ms-kg; docs/lsdyna.md)")
+    deck_path = out / "imported" / (Path(args.deck).stem + ".toml")
+    imported = import_deck(args.deck, args.units, stem=deck_path.stem)
+    if not _report_dropped(imported, args.allow_partial):
+        return None
+    write_import(imported, deck_path)
+    return deck_path
+
+
+def _report_dropped(imported, allow_partial: bool) -> bool:
+    """Print what an import left out; False when that changes the result and
+    ``--allow-partial`` was not given."""
+    for d in imported.dropped:
+        print(f"not imported: {d.line()}", file=sys.stderr)
+    physics = [d for d in imported.dropped if d.physics]
+    if physics and not allow_partial:
+        print(f"sphdyn: {len(physics)} item(s) above would change the result; nothing "
+              "written. Fix: remove them from the keyword deck, or give "
+              "--allow-partial to go on without them (listed at the written deck's "
+              "top)", file=sys.stderr)
+        return False
+    return True
 
 
 def _warn_thin_members(deck, model) -> None:
@@ -108,6 +150,26 @@ def cmd_ensemble(args) -> int:
                         progress=not args.quiet)
     print(path)
     return 0
+
+
+def cmd_import(args) -> int:
+    """``sphdyn import MODEL.k``: the sphdyn deck of an LS-DYNA keyword deck,
+    then ``sphdyn check`` on it; exit 2 when an item left out changes the
+    result (unless ``--allow-partial``)."""
+    from ..lsdyna import import_deck, write_import
+
+    src = Path(args.model)
+    out = Path(args.out) if args.out else src.with_suffix(".toml")
+    if out.resolve() == src.resolve():
+        raise ValueError(f"-o {out} would overwrite the keyword deck. Fix: give "
+                         "another -o")
+    imported = import_deck(src, args.units, stem=out.stem)
+    if not _report_dropped(imported, args.allow_partial):
+        return 2
+    paths = write_import(imported, out)
+    print(f"sphdyn import: {src} ({args.units}) -> " + ", ".join(str(p) for p in paths))
+    args.deck, args.set, args.resolved = str(out), None, None
+    return cmd_check(args)
 
 
 def cmd_check(args) -> int:

@@ -1,0 +1,406 @@
+"""``sphdyn import``: LS-DYNA keyword decks become sphdyn decks (issue 55).
+
+The keyword decks are written here from the same lattice and block as an
+equivalent TOML deck: the imported model must equal the TOML deck's bit for
+bit (every particle and node position, mass, volume, density, smoothing
+length, material, velocity; the elements, their materials, the constrained
+node sets) and run the same steps to the same state. The fixed, free, long
+and included-and-parametrised forms of one deck must import alike; bad decks
+fail with one line naming the file, the line and the keyword.
+"""
+
+from __future__ import annotations
+
+import textwrap
+
+import numpy as np
+import pytest
+
+pytest.importorskip("ansys.dyna.core")
+
+from sphdyn.build.model import build_model  # noqa: E402
+from sphdyn.cli import main  # noqa: E402
+from sphdyn.deck import load_deck  # noqa: E402
+from sphdyn.geometry.lattice import box_lattice  # noqa: E402
+from sphdyn.geometry.mesh_blocks import block_mesh  # noqa: E402
+from sphdyn.lsdyna import KeywordError, import_deck, write_import  # noqa: E402
+
+DX = 0.002
+BALL = ([0.0, 0.0, 0.004], [0.012, 0.006, 0.010])     # SPH box, 6 x 3 x 3
+PLATE = ([0.020, 0.0, 0.030], [0.032, 0.008, 0.034], [3, 2, 1])  # hexahedra
+T_END = 4e-6
+
+TOML = f"""
+[run]
+title = "ball and plate"
+dimension = 3
+t_end = "{T_END!r} s"
+
+[[material]]
+name = "concrete"
+model = "elastic"
+density = "2400.0 kg/m^3"
+E = "30000000000.0 Pa"
+nu = 0.2
+
+[[material]]
+name = "steel"
+model = "j2"
+density = "7850.0 kg/m^3"
+E = "200000000000.0 Pa"
+nu = 0.3
+yield_stress = "500000000.0 Pa"
+hardening_modulus = "{200e9 * 2e9 / (200e9 - 2e9)!r} Pa"
+
+[[body]]
+name = "ball"
+material = "concrete"
+dx = "{DX!r} m"
+velocity = [0.0, 0.0, -10.0]
+geometry = {{shape = "box", lo = {BALL[0]}, hi = {BALL[1]}}}
+
+[sph]
+h_factor = 1.2
+smoothing_length = {{min_factor = 0.2, max_factor = 2.0}}
+
+[[mesh]]
+name = "solids"
+material = "steel"
+block = {{lo = {PLATE[0]}, hi = {PLATE[1]}, divisions = {PLATE[2]}}}
+cfl = 0.6
+velocity = [0.0, 0.0, 0.0]
+
+[[set]]
+name = "base"
+mesh = "solids"
+region = {{shape = "box", lo = [-1, -1, -1], hi = [1, 1, 0.030000001]}}
+
+[[boundary]]
+set = "base"
+type = "fixed"
+components = ["x", "y", "z"]
+
+[[wall]]
+name = "floor"
+point = [0.0, 0.0, 0.003]
+normal = [0.0, 0.0, 1.0]
+"""
+
+
+def _fmt(value, width: int, form: str) -> str:
+    """A field: "free" keeps every digit of a float; the other forms print
+    ``%.9g`` ("free9" comma-separated, "fixed" and "long" right-aligned in
+    their columns), so that they carry the same numbers."""
+    if isinstance(value, float):
+        text = repr(value) if form == "free" else f"{value:.9g}"
+    else:
+        text = str(value)
+    if form in ("free", "free9"):
+        return text
+    assert len(text) <= width, text
+    return text.rjust(width)
+
+
+def _row(values, form: str, widths) -> str:
+    sep = "," if form in ("free", "free9") else ""
+    return sep.join(_fmt(v, w, form) for v, w in zip(values, widths))
+
+
+def keyword_deck(form: str = "free") -> dict[str, str]:
+    """The TOML deck above as keyword files (name -> text) in ``form``:
+    "free" (commas, every digit), "free9" (commas, nine digits), "fixed"
+    (8/10/16-character fields), "long" (LONG=Y, 20-character fields) or
+    "include" (fixed, the nodes in an *INCLUDE and the steel's yield stress
+    a *PARAMETER)."""
+    long = form == "long"
+    f = "fixed" if form == "include" else form
+    i8 = 20 if long else 8
+    e16 = 20 if long else 16
+    i10 = 20 if long else 10
+    x = box_lattice(BALL[0], BALL[1], DX, 3)
+    mesh = block_mesh(PLATE[0], PLATE[1], PLATE[2], 3)
+    mass = 2400.0 * DX ** 3
+    nodes = ["*NODE"]
+    nodes += [_row([k + 1, *map(float, p)], f, (i8, e16, e16, e16))
+              for k, p in enumerate(x)]
+    first = x.shape[0] + 1
+    nodes += [_row([first + k, *map(float, p)], f, (i8, e16, e16, e16))
+              for k, p in enumerate(mesh.points)]
+    base = [first + k for k, p in enumerate(mesh.points) if p[2] <= 0.030000001]
+    lines = ["*KEYWORD LONG=Y" if long else "*KEYWORD", "*TITLE", "ball and plate"]
+    if form == "include":
+        lines += ["*PARAMETER", "R   sigy    500.0e6", "*INCLUDE", "nodes.k"]
+    else:
+        lines += nodes
+    lines += ["*ELEMENT_SPH"]
+    lines += [_row([k + 1, 1, mass], f, (i8, i8, e16)) for k in range(x.shape[0])]
+    lines += ["*ELEMENT_SOLID"]
+    lines += [_row([e + 1, 2, *(first + n for n in c)], f, (i8,) * 10)
+              for e, c in enumerate(mesh.cells)]
+    sigy = "&sigy" if form == "include" else 500e6
+    lines += ["*PART", "ball", _row([1, 1, 1], f, (i10,) * 3),
+              "*PART", "plate", _row([2, 2, 2], f, (i10,) * 3),
+              "*SECTION_SPH", _row([1, 1.2, 0.2, 2.0], f, (i10,) * 4),
+              "*SECTION_SOLID", _row([2, 1], f, (i10,) * 2),
+              "*MAT_ELASTIC_TITLE", "concrete",
+              _row([1, 2400.0, 30e9, 0.2], f, (i10,) * 4),
+              "*MAT_PLASTIC_KINEMATIC_TITLE", "steel",
+              _row([2, 7850.0, 200e9, 0.3, sigy, 2e9, 1.0], f, (i10,) * 7),
+              "*SET_NODE_LIST", _row([7], f, (i10,))]
+    lines += [_row(base[k:k + 8], f, (i10,) * 8) for k in range(0, len(base), 8)]
+    lines += ["*BOUNDARY_SPC_SET", _row([7, 0, 1, 1, 1, 0, 0, 0], f, (i10,) * 8),
+              "*INITIAL_VELOCITY_GENERATION",
+              _row([1, 2, 0.0, 0.0, 0.0, -10.0], f, (i10,) * 6),
+              "*RIGIDWALL_PLANAR", _row([0], f, (i10,)),
+              _row([0.0, 0.0, 0.003, 0.0, 0.0, 1.003, 0.0], f, (i10,) * 7),
+              "*CONTROL_TERMINATION", _fmt(T_END, i10, f),
+              "*CONTROL_TIMESTEP", _row([0.0, 0.6], f, (i10,) * 2),
+              "*END"]
+    files = {"model.k": "\n".join(lines) + "\n"}
+    if form == "include":
+        files["nodes.k"] = "*KEYWORD\n" + "\n".join(nodes) + "\n*END\n"
+    return files
+
+
+def _write(tmp_path, files: dict[str, str]):
+    for name, text in files.items():
+        (tmp_path / name).write_text(text)
+    return tmp_path / "model.k"
+
+
+def _imported_model(tmp_path, form="free"):
+    path = _write(tmp_path, keyword_deck(form))
+    imp = import_deck(path, "m-s-kg")
+    assert not imp.dropped, [d.line() for d in imp.dropped]
+    write_import(imp, tmp_path / "model.toml")
+    return imp, load_deck(tmp_path / "model.toml")
+
+
+def test_imported_model_equals_the_toml_decks_bit_for_bit(tmp_path):
+    """Free format carries every digit: the same particles, nodes, elements,
+    materials, sets and boundary as the TOML deck, to the bit."""
+    _, deck = _imported_model(tmp_path)
+    (tmp_path / "ref.toml").write_text(TOML)
+    ref = load_deck(tmp_path / "ref.toml")
+    a, b = build_model(deck), build_model(ref)
+    pa, pb = a.particles, b.particles
+    for name in ("x", "v", "m", "vol0", "rho0", "h", "mat", "c"):
+        np.testing.assert_array_equal(getattr(pa, name), getattr(pb, name), err_msg=name)
+    (ma,), (mb,) = a.meshes, b.meshes
+    np.testing.assert_array_equal(ma.points, mb.points)
+    np.testing.assert_array_equal(ma.cells, mb.cells)
+    np.testing.assert_array_equal(ma.mat, mb.mat)
+    assert ma.spec.integration == mb.spec.integration == "one_point"
+    assert ma.spec.cfl == mb.spec.cfl == 0.6
+    (sa,), (sb,) = a.mesh_sets.values(), b.mesh_sets.values()
+    np.testing.assert_array_equal(np.sort(sa[1]), np.sort(sb[1]))
+    for ga, gb in zip(a.groups, b.groups):
+        np.testing.assert_array_equal(ga.params, gb.params)
+    assert [w.point.tolist() for w in a.walls] == [w.point.tolist() for w in b.walls]
+    assert deck.boundary[0].components == ("x", "y", "z")
+
+
+def test_imported_deck_runs_as_the_toml_deck(tmp_path):
+    """A few steps of both decks end in the same state (boundary, wall,
+    velocities and materials all in play)."""
+    from sphdyn.simulation import Simulation
+
+    _, deck = _imported_model(tmp_path)
+    (tmp_path / "ref.toml").write_text(TOML)
+    ref = load_deck(tmp_path / "ref.toml")
+    states = []
+    for d, out in ((deck, "a"), (ref, "b")):
+        sim = Simulation.from_deck(d, tmp_path / out)
+        sim.run(max_steps=20, progress=False)
+        states.append((sim.particles.x.copy(), sim.stepper.part("solids").kin.x.copy()))
+    np.testing.assert_array_equal(states[0][0], states[1][0])
+    np.testing.assert_array_equal(states[0][1], states[1][1])
+
+
+@pytest.mark.parametrize("form", ["fixed", "long", "include"])
+def test_the_forms_of_one_deck_import_alike(tmp_path, form):
+    """Fixed 8/16-character fields, long 20-character fields (``*KEYWORD
+    LONG=Y``), and a deck whose nodes are an ``*INCLUDE`` and whose yield
+    stress is a ``*PARAMETER``: each imports to the same deck and files as
+    the free-format deck with the same (nine-digit) numbers."""
+    ref_dir, dir_ = tmp_path / "ref", tmp_path / form
+    ref_dir.mkdir(), dir_.mkdir()
+    free = import_deck(_write(ref_dir, keyword_deck("free9")), "m-s-kg")
+    other = import_deck(_write(dir_, keyword_deck(form)), "m-s-kg")
+    assert other.deck == free.deck
+    assert other.files.keys() == free.files.keys()
+    np.testing.assert_array_equal(other.files["model_ball.csv"], free.files["model_ball.csv"])
+    ma, mb = other.files["model_solids.inp"], free.files["model_solids.inp"]
+    np.testing.assert_array_equal(ma.points, mb.points)
+    np.testing.assert_array_equal(ma.cells[0].data, mb.cells[0].data)
+
+
+def test_units_convert_every_quantity(tmp_path):
+    """The same deck in mm-ms-kg (lengths /1e-3, times /1e-3, stresses
+    /1e9, densities /1e-9) imports to the same SI values to round-off."""
+    files = keyword_deck("free")
+    path = _write(tmp_path, files)
+    si = import_deck(path, "m-s-kg")
+    mm = import_deck(path, "mm-ms-kg")
+    # the same numbers read in other units: each quantity scales by its unit
+    def value(s):
+        return float(s.split()[0])
+    assert value(mm.deck["run"]["t_end"]) == pytest.approx(value(si.deck["run"]["t_end"]) * 1e-3, rel=1e-15)
+    steel_si, steel_mm = si.deck["material"][1], mm.deck["material"][1]
+    assert value(steel_mm["E"]) == pytest.approx(value(steel_si["E"]) * 1e9, rel=1e-15)
+    assert value(steel_mm["density"]) == pytest.approx(value(steel_si["density"]) * 1e9, rel=1e-15)
+    np.testing.assert_allclose(mm.files["model_ball.csv"], si.files["model_ball.csv"] * 1e-3,
+                               rtol=1e-15)
+    v_si = value(si.deck["body"][0]["velocity"][2])
+    assert value(mm.deck["body"][0]["velocity"][2]) == pytest.approx(v_si, rel=1e-15)
+    # the mass is in kg in both systems, the density 1e9 larger: the spacing
+    # from mass / density is 1e-3 of the m-s-kg one, as the coordinates are
+    assert value(mm.deck["body"][0]["dx"]) == pytest.approx(DX * 1e-3, rel=1e-12)
+
+
+def _bad(tmp_path, text: str, capsys, extra: dict | None = None) -> str:
+    (tmp_path / "bad.k").write_text(textwrap.dedent(text))
+    for name, t in (extra or {}).items():
+        (tmp_path / name).write_text(t)
+    code = main(["import", str(tmp_path / "bad.k"), "--units", "m-s-kg"])
+    err = capsys.readouterr().err
+    assert code == 2, err
+    return err
+
+
+GOOD_HEAD = """\
+*KEYWORD
+*NODE
+       1             0.0             0.0             0.0
+       2           0.002             0.0             0.0
+*ELEMENT_SPH
+       1       1  1.92e-5
+       2       1  1.92e-5
+*PART
+ball
+         1         1         1
+*SECTION_SPH
+         1       1.2
+*CONTROL_TERMINATION
+    1.0e-5
+"""
+
+
+def test_a_deck_without_end_is_refused(tmp_path, capsys):
+    err = _bad(tmp_path, GOOD_HEAD + "*MAT_ELASTIC\n         1    2400.0    3.0e10       0.2\n",
+               capsys)
+    assert "no *END" in err and "bad.k" in err
+
+
+def test_a_node_referenced_but_not_defined(tmp_path, capsys):
+    text = GOOD_HEAD.replace("       2       1  1.92e-5", "       9       1  1.92e-5")
+    err = _bad(tmp_path, text + "*MAT_ELASTIC\n         1    2400.0    3.0e10       0.2\n*END\n",
+               capsys)
+    assert "node 9" in err and "*NODE" in err
+
+
+def test_a_part_without_its_section(tmp_path, capsys):
+    text = GOOD_HEAD.replace("*SECTION_SPH\n         1       1.2\n", "")
+    err = _bad(tmp_path, text + "*MAT_ELASTIC\n         1    2400.0    3.0e10       0.2\n*END\n",
+               capsys)
+    assert "line 8: *PART" in err and "*SECTION_SPH 1" in err
+
+
+def test_a_material_card_that_cannot_be_read(tmp_path, capsys):
+    err = _bad(tmp_path, GOOD_HEAD + "*MAT_ELASTIC\n         1    2400.0    abcdef       0.2\n*END\n",
+               capsys)
+    assert "line 15: *MAT_ELASTIC" in err and "cannot be read" in err
+
+
+def test_a_missing_include(tmp_path, capsys):
+    err = _bad(tmp_path, GOOD_HEAD + "*INCLUDE\nmissing.k\n*END\n", capsys)
+    assert "line 15: *INCLUDE" in err and "missing.k" in err
+
+
+def test_what_changes_the_result_stops_the_import_unless_allowed(tmp_path, capsys):
+    """A keyword sphdyn does not import (here a load curve's body load) is
+    listed; it changes the result, so the import fails with exit 2 and
+    writes nothing, and with --allow-partial writes the deck listing it."""
+    text = (GOOD_HEAD + "*MAT_ELASTIC\n         1    2400.0    3.0e10       0.2\n"
+            "*LOAD_BODY_Z\n         1       1.0\n*END\n")
+    err = _bad(tmp_path, text, capsys)
+    assert "line 17: *LOAD_BODY_Z" in err and "change the result" in err
+    assert not (tmp_path / "bad.toml").exists()
+    code = main(["import", str(tmp_path / "bad.k"), "--units", "m-s-kg", "--allow-partial"])
+    assert code == 0
+    head = (tmp_path / "bad.toml").read_text().splitlines()[:3]
+    assert any("LOAD_BODY_Z" in line for line in head)
+
+
+def test_cscm_units_must_agree(tmp_path):
+    """MAT_CSCM_CONCRETE's UNITS field names the units of FPC and DAGG: one
+    that disagrees with --units is an error, not a silent factor of 1e9."""
+    text = GOOD_HEAD + textwrap.dedent("""\
+        *MAT_CSCM_CONCRETE
+                 1    2400.0         1       0.0         0       0.0       0.0         0
+               0.0
+            38.0e6     0.016         4
+        *END
+        """)
+    (tmp_path / "c.k").write_text(text)
+    imp = import_deck(tmp_path / "c.k", "m-s-kg")
+    m = imp.deck["material"][0]
+    assert (m["model"], m["fc"], m["aggregate_size"], m["rate_effects"]) == \
+        ("cscm", "38000000.0 Pa", "0.016 m", False)
+    with pytest.raises(KeywordError, match="UNITS = 4"):
+        import_deck(tmp_path / "c.k", "mm-ms-kg")
+
+
+def test_sph_rows_all_read(tmp_path):
+    """ansys-dyna-core 0.12 keeps only the first row of *ELEMENT_SPH; every
+    row must arrive (scan.sph_elements)."""
+    imp = import_deck(_write(tmp_path, keyword_deck("fixed")), "m-s-kg")
+    assert imp.files["model_ball.csv"].shape == (box_lattice(BALL[0], BALL[1], DX, 3).shape[0], 3)
+
+
+def test_run_takes_a_keyword_deck(tmp_path, capsys):
+    """``sphdyn run MODEL.k --units ...`` imports into OUT/imported/ and runs
+    that deck; without --units it says what to add."""
+    path = _write(tmp_path, keyword_deck("free"))
+    out = tmp_path / "run"
+    assert main(["run", str(path), "--out", str(out), "-q", "--max-steps", "3"]) == 2
+    assert "--units" in capsys.readouterr().err
+    code = main(["run", str(path), "--units", "m-s-kg", "--out", str(out), "-q",
+                 "--max-steps", "3"])
+    assert code == 0, capsys.readouterr().err
+    assert (out / "imported" / "model.toml").is_file()
+    assert (out / "imported" / "model_solids.inp").is_file()
+    assert (out / "summary.json").is_file()
+
+
+def test_the_shipped_example_is_the_tested_deck():
+    """examples/lsdyna/ball_and_plate.k (docs/lsdyna.md runs it) is the fixed
+    form tested above, below its comment lines."""
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "lsdyna" / "ball_and_plate.k"
+    lines = path.read_text().splitlines()
+    body = "\n".join(line for line in lines if not line.startswith("$")) + "\n"
+    assert body == keyword_deck("fixed")["model.k"]
+
+
+def test_initial_velocity_of_every_node(tmp_path):
+    """``*INITIAL_VELOCITY`` with NSID = 0 gives every body its velocity; with a
+    node set it is listed as changing the result."""
+    text = GOOD_HEAD + textwrap.dedent("""\
+        *MAT_ELASTIC
+                 1    2400.0    3.0e10       0.2
+        *INITIAL_VELOCITY
+                 0
+               0.0       0.0     -15.0
+        *END
+        """)
+    (tmp_path / "v.k").write_text(text)
+    imp = import_deck(tmp_path / "v.k", "m-s-kg")
+    assert imp.deck["body"][0]["velocity"] == ["0.0 m/s", "0.0 m/s", "-15.0 m/s"]
+    assert not imp.dropped
+    (tmp_path / "w.k").write_text(text.replace("\n         0\n", "\n         3\n"))
+    imp = import_deck(tmp_path / "w.k", "m-s-kg")
+    assert "velocity" not in imp.deck["body"][0]
+    assert [d.physics for d in imp.dropped] == [True]
+    assert "line 17: *INITIAL_VELOCITY" in imp.dropped[0].line()
