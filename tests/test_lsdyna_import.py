@@ -404,3 +404,48 @@ def test_initial_velocity_of_every_node(tmp_path):
     assert "velocity" not in imp.deck["body"][0]
     assert [d.physics for d in imp.dropped] == [True]
     assert "line 17: *INITIAL_VELOCITY" in imp.dropped[0].line()
+
+
+@pytest.mark.parametrize("name", ["m-s-kg", "mm-ms-kg", "mm-s-t", "mm-ms-g", "cm-us-g",
+                                  "m-ms-kg"])
+def test_each_unit_system_has_the_stress_unit_it_names(name):
+    """Stress = mass / (length time^2) of the system equals the stress unit
+    its help names (pint's, independent of units.py), and velocity and
+    density follow from length, time and mass."""
+    import pint
+
+    from sphdyn.lsdyna.units import SYSTEMS, Units
+
+    u = Units.named(name)
+    stress_unit = SYSTEMS[name][3].split(", ")[1]
+    assert u.stress == pytest.approx(pint.UnitRegistry()(stress_unit).to("Pa").magnitude,
+                                     rel=1e-12)
+    assert u.velocity == pytest.approx(u.length / u.time, rel=1e-15)
+    assert u.density == pytest.approx(u.mass / u.length ** 3, rel=1e-15)
+
+
+def test_plastic_kinematic_etan_is_the_slope_past_yield():
+    """ETAN becomes j2's plastic modulus H = E Et / (E - Et): a material point
+    of the imported steel pulled in uniaxial stress past yield has the
+    tangent modulus ETAN (2 GPa), whatever the formula's algebra."""
+    from sphdyn.materials.driver import drive
+
+    text = GOOD_HEAD.replace("*CONTROL_TERMINATION", "*MAT_PLASTIC_KINEMATIC\n"
+                             "         1    7850.0   2.0e+11       0.3   5.0e+08   2.0e+09"
+                             "       1.0\n*CONTROL_TERMINATION") + "*END\n"
+    m = _import_text(text)["material"][0]
+    params = {k: float(v.split()[0]) if isinstance(v, str) and " " in v else v
+              for k, v in m.items() if k not in ("name", "model")}
+    res = drive("j2", params, "uniaxial-tension", strain=0.01, n_steps=400)
+    s, e = res["stress"][:, 0], res["strain"][:, 0]
+    slope = (s[-1] - s[-50]) / (e[-1] - e[-50])
+    assert slope == pytest.approx(2.0e9, rel=1e-6)
+
+
+def _import_text(text: str) -> dict:
+    import tempfile
+    from pathlib import Path
+
+    with tempfile.TemporaryDirectory() as d:
+        (Path(d) / "m.k").write_text(text)
+        return import_deck(Path(d) / "m.k", "m-s-kg").deck

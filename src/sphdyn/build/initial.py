@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from ..deck.expressions import ExpressionError, evaluate
+from ..geometry.lattice import read_point_table
 
 #: the stress component names and their (row, column) in the 3x3 tensor
 COMPONENTS = {"xx": (0, 0), "yy": (1, 1), "zz": (2, 2), "xy": (0, 1), "xz": (0, 2),
@@ -21,35 +22,14 @@ COMPONENTS = {"xx": (0, 0), "yy": (1, 1), "zz": (2, 2), "xy": (0, 1), "xz": (0, 
 
 
 def read_points(path: Path, dim: int) -> dict[str, np.ndarray]:
-    """The columns of a ``[body.initial] file``: a CSV with a header row.
-
-    Needs ``x``, ``y`` (and ``z`` in 3D); other columns from ``vx, vy, vz,
-    sxx, syy, szz, sxy, sxz, syz``. Returns arrays of shape (P,) by name.
+    """The columns of a ``[body.initial] file``: a CSV with a header row
+    (:func:`~sphdyn.geometry.lattice.read_point_table`). Needs ``x``, ``y``
+    (and ``z`` in 3D); other columns from ``vx, vy, vz, sxx, syy, szz, sxy,
+    sxz, syz``. Returns arrays of shape (P,) by name.
     """
     from ..deck.sections.bodies import FILE_COLUMNS
 
-    try:
-        data = np.genfromtxt(path, delimiter=",", names=True, dtype=float,
-                             encoding="utf-8", ndmin=1)
-    except (ValueError, OSError) as exc:
-        raise ValueError(f"{path}: not a CSV table of numbers with a header row "
-                         f"({exc})") from None
-    names = data.dtype.names or ()
-    need = ("x", "y", "z")[:dim]
-    missing = [c for c in need if c not in names]
-    if missing:
-        raise ValueError(f"{path}: no column {', '.join(missing)}; the header must "
-                         f"name {', '.join(need)} and any of {', '.join(FILE_COLUMNS)}")
-    unknown = [c for c in names if c not in ("x", "y", "z") + FILE_COLUMNS]
-    if unknown:
-        raise ValueError(f"{path}: unknown column {', '.join(unknown)}; the columns "
-                         f"are x, y, z, {', '.join(FILE_COLUMNS)}")
-    cols = {c: np.atleast_1d(data[c]).astype(float) for c in names}
-    for c, v in cols.items():
-        bad = np.flatnonzero(~np.isfinite(v))
-        if bad.size:
-            raise ValueError(f"{path}: column {c} row {bad[0] + 2} is not a number")
-    return cols
+    return read_point_table(path, dim, allowed=FILE_COLUMNS, what="point")
 
 
 def interpolate(points: np.ndarray, values: np.ndarray, x: np.ndarray, how: str,

@@ -38,6 +38,7 @@ __all__ = [
     "sphere_lattice",
     "prism_lattice",
     "points_lattice",
+    "read_point_table",
     "read_points",
     "ogive_lattice",
     "ogive_nose_length",
@@ -516,40 +517,61 @@ def ogive_lattice(tip, radius: float, length: float, crh: float, dx: float, dim:
     return x[r <= ogive_profile(zeta, a, crh) * (1.0 + _RTOL) + _RTOL * dx]
 
 
-def read_points(file, dim: int, length_unit: float = 1.0) -> np.ndarray:
-    """Positions of a ``points`` body: a CSV file whose header names the
-    columns, ``x, y`` in 2D and ``x, y, z`` in 3D (other columns are ignored),
-    one particle per row, in units of ``length_unit`` [m].
-
-    Returns (n, 3) float64 [m], ``z = 0`` in 2D. Raises :class:`ValueError`
-    naming the file and what is wrong (missing column, a value that is not a
-    finite number, no rows).
+def read_point_table(path, dim: int, allowed=None, what: str = "row") -> dict:
+    """The columns of a CSV table of points: a header row naming them, then
+    one point per line (lines starting with ``#`` skipped). ``x, y`` (and
+    ``z`` in 3D) are required; other columns must be among ``allowed``, or
+    are any (``allowed`` None). Returns (P,) float arrays by column name.
+    Raises :class:`ValueError` naming the file and the line: no header, a
+    missing or unknown column, a value that is not a finite number, or no
+    ``what`` after the header. The ``points`` body shape
+    (:func:`read_points`) and ``[body.initial] file`` read through it.
     """
     import csv
 
-    names = "xyz"[:dim]
-    with open(file, newline="") as f:
-        rows = list(csv.reader(line for line in f if not line.lstrip().startswith("#")))
-    if not rows:
-        raise ValueError(f"{file}: no header line (it must name the columns "
-                         f"{', '.join(names)})")
-    header = [c.strip().lower() for c in rows[0]]
-    missing = [c for c in names if c not in header]
+    need = list("xyz"[:dim])
+    with open(path, newline="") as f:
+        lines = [(k, line) for k, line in enumerate(f, start=1)
+                 if line.strip() and not line.lstrip().startswith("#")]
+    if not lines:
+        raise ValueError(f"{path}: no header line (it must name the columns "
+                         f"{', '.join(need)})")
+    rows = list(csv.reader(line for _, line in lines))
+    header = [c.strip() for c in rows[0]]
+    missing = [c for c in need if c not in header]
     if missing:
-        raise ValueError(f"{file}: no column {', '.join(missing)} in the header "
-                         f"{rows[0]} (a points file's header names x, y{', z' if dim == 3 else ''})")
-    cols = [header.index(c) for c in names]
-    x = np.zeros((len(rows) - 1, 3))
+        any_of = f" and any of {', '.join(allowed)}" if allowed else ""
+        raise ValueError(f"{path}: no column {', '.join(missing)}; the header must "
+                         f"name {', '.join(need)}{any_of}")
+    if allowed is not None:
+        unknown = [c for c in header if c not in ("x", "y", "z", *allowed)]
+        if unknown:
+            raise ValueError(f"{path}: unknown column {', '.join(unknown)}; the columns "
+                             f"are x, y, z, {', '.join(allowed)}")
+    table = np.full((len(rows) - 1, len(header)), np.nan)
     for r, row in enumerate(rows[1:]):
         try:
-            x[r, :dim] = [float(row[c]) for c in cols]
-        except (ValueError, IndexError):
-            raise ValueError(f"{file}, line {r + 2}: {row} is not {dim} numbers in "
-                             f"the columns {', '.join(names)}") from None
-    if not x.shape[0]:
-        raise ValueError(f"{file}: a header and no particle")
-    if not np.isfinite(x).all():
-        raise ValueError(f"{file}: a coordinate is not a finite number")
+            table[r] = [float(v) for v in row]
+        except ValueError:
+            pass  # reported below with its line
+        if len(row) != len(header) or not np.isfinite(table[r]).all():
+            raise ValueError(f"{path}, line {lines[r + 1][0]}: {row} is not "
+                             f"{len(header)} finite numbers (columns "
+                             f"{', '.join(header)})")
+    if not table.shape[0]:
+        raise ValueError(f"{path}: a header and no {what}")
+    return {c: table[:, k] for k, c in enumerate(header)}
+
+
+def read_points(file, dim: int, length_unit: float = 1.0) -> np.ndarray:
+    """Positions of a ``points`` body (:func:`read_point_table`: columns
+    ``x, y`` in 2D and ``x, y, z`` in 3D, others ignored), one particle per
+    row, in units of ``length_unit`` [m]. Returns (n, 3) float64 [m],
+    ``z = 0`` in 2D."""
+    cols = read_point_table(file, dim, what="particle")
+    x = np.zeros((cols["x"].shape[0], 3))
+    for k, c in enumerate("xyz"[:dim]):
+        x[:, k] = cols[c]
     return x * length_unit
 
 

@@ -52,7 +52,8 @@ class Dropped:
 @dataclass
 class Imported:
     """The deck as a dictionary (TOML tables), the data files to write beside
-    it (name -> writer) and what was dropped."""
+    it (name -> contents: an (n, 3) array of points for ``.csv``, a
+    ``meshio.Mesh`` for ``.inp``) and what was dropped."""
 
     deck: dict
     files: dict = field(default_factory=dict)
@@ -107,7 +108,7 @@ class Converter:
         self.density: dict[int, float] = {}  # mid -> [kg/m^3]
         self.node_sets: dict[int, list[int]] = {}
         self.spcs: list[tuple[str, list[int] | int, tuple[str, ...]]] = []
-        self.velocities: list[tuple[Keyword, int, int, tuple[float, float, float]]] = []
+        self.velocities: list[tuple[int, int, tuple[float, float, float]]] = []  # STYP, ID, v
         self.walls: list[dict] = []
         self.run: dict = {"title": kd.title, "dimension": 3}
         self.output: dict = {}
@@ -164,7 +165,7 @@ class Converter:
 
     def section_sph(self, kw):
         o = kw.obj
-        if not math.isnan(_num(o.sphini, float("nan"))) and _num(o.sphini):
+        if _num(o.sphini):
             self.drop(kw, "SPHINI (a given initial smoothing length)",
                       "h = CSLH times the particle spacing")
         self.sections[int(o.secid)] = {"kind": "sph", "cslh": _num(o.cslh, 1.2),
@@ -194,7 +195,8 @@ class Converter:
                                                          "kg/m^3"),
                             "E": _q(E, "Pa"), "nu": float(o.pr),
                             "yield_stress": _q(o.sigy * self.u.stress, "Pa"),
-                            # LS-DYNA's tangent modulus as the plastic modulus
+                            # the plastic modulus H of the bilinear curve whose
+                            # slope past yield is ETAN: Et = E H / (E + H)
                             "hardening_modulus": _q(E * Et / (E - Et), "Pa")})
 
     def mat_cscm_concrete(self, kw):
@@ -256,7 +258,7 @@ class Converter:
                       "no initial velocity from it (a part, STYP = 2, or ID = 0 is "
                       "imported)")
             return
-        self.velocities.append((kw, styp, ident, v))
+        self.velocities.append((styp, ident, v))
 
     def initial_velocity(self, kw):
         """``*INITIAL_VELOCITY``: with NSID = 0 every node and particle (the
@@ -270,7 +272,7 @@ class Converter:
         if any(_num(getattr(o, f"v{a}r")) for a in "xyz"):
             self.drop(kw, "VXR / VYR / VZR (rotational velocities of beam nodes)", "none")
         v = tuple(_num(getattr(o, f"v{a}")) * self.u.velocity for a in "xyz")
-        self.velocities.append((kw, 2, 0, v))
+        self.velocities.append((2, 0, v))
 
     def rigidwall_planar(self, kw):
         o = kw.obj
@@ -323,8 +325,7 @@ class Converter:
         if missing:
             raise KeywordError(f"{self.kd.path}: material {missing[0]} is used by a part "
                                "but not defined by a *MAT_ keyword sphdyn imports")
-        out.deck["material"] = [{k: v for k, v in self.materials[m].items()}
-                                for m in used]
+        out.deck["material"] = [dict(self.materials[m]) for m in used]
         self._bodies(out)
         self._meshes(out)
         if self.walls:
@@ -358,7 +359,7 @@ class Converter:
         return _name(self.parts[pid]["title"], f"part{pid}")
 
     def _velocity(self, pid: int) -> tuple[float, float, float] | None:
-        for kw, styp, ident, v in self.velocities:
+        for styp, ident, v in self.velocities:
             if ident == 0 or (styp == 2 and ident == pid):
                 return v
         return None

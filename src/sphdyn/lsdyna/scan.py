@@ -52,6 +52,11 @@ class Block:
     def where(self) -> str:
         return f"{self.file}, line {self.line}: *{self.name}"
 
+    def long(self, deck_long: bool) -> bool:
+        """Whether the block's fields are long (20 characters): the deck's
+        ``*KEYWORD LONG=Y`` or the keyword's ``+`` suffix."""
+        return deck_long or self.title.split()[0].endswith("+")
+
 
 def _blocks(path: Path) -> tuple[list[Block], bool, bool]:
     """The blocks of one file, whether it has ``*END`` and whether its
@@ -135,8 +140,7 @@ def sph_elements(block: Block, long: bool) -> list[tuple[int, int, float]]:
     NID, PID (I8) and MASS (E16), or I20/I20/E20 in long format
     (``*ELEMENT_SPH +`` or ``*KEYWORD LONG=Y``), or comma-separated. MASS
     blank or 0 is returned as 0.0 (the caller decides)."""
-    long = long or block.title.split()[0].endswith("+")
-    widths = (20, 20, 20) if long else (8, 8, 16)
+    widths = (20, 20, 20) if block.long(long) else (8, 8, 16)
     rows = []
     for k, line in block.lines:
         if not line.strip():
@@ -158,8 +162,7 @@ def node_list(block: Block, long: bool) -> tuple[int, list[int]]:
     format) or comma-separated; blanks and zeros end nothing and are skipped.
     Read here because ansys-dyna-core 0.12 keeps only the first fields of a
     comma-separated node line (found by this project's tests)."""
-    long = long or block.title.split()[0].endswith("+")
-    width = 20 if long else 10
+    width = 20 if block.long(long) else 10
     cards = [(k, s) for k, s in block.lines if s.strip()]
     if "TITLE" in block.title.upper():
         cards = cards[1:]
@@ -191,8 +194,7 @@ def solid_elements(block: Block, long: bool) -> list[tuple[int, int, tuple[int, 
     block: fields of 8 characters (20 in long format) or comma-separated.
     Read here because ansys-dyna-core 0.12 misreads the long-format rows it
     writes itself (found by this project's tests)."""
-    long = long or block.title.split()[0].endswith("+")
-    width = 20 if long else 8
+    width = 20 if block.long(long) else 8
     rows = []
     for k, line in block.lines:
         if not line.strip():

@@ -51,14 +51,6 @@ class Units:
     def stress(self) -> float:
         return self.mass / (self.length * self.time ** 2)
 
-    @property
-    def force(self) -> float:
-        return self.mass * self.length / self.time ** 2
-
-    @property
-    def acceleration(self) -> float:
-        return self.length / self.time ** 2
-
 
 def help_text() -> str:
     """The systems for ``--help``."""
