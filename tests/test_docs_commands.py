@@ -69,6 +69,13 @@ SKIP = {
     "sphdyn validate --docs": "runs the full validation cases (hours)",
     "sphdyn plot out/validation/lozano2017_dropweight_2.5m-quick --snapshots damage":
         "needs the quick validation run (tests/test_validation_quick.py makes it)",
+    # the paper's disc as a keyword deck: the script writes its 0.9 MB particle
+    # include into examples/lsdyna/; tests/test_lsdyna_import.py runs the same
+    # script's text, imports it and runs 60 steps against the TOML deck
+    "python examples/lsdyna/disc_impact.py":
+        "writes the disc's particle include (tests/test_lsdyna_import.py runs it)",
+    "sphdyn run examples/lsdyna/disc_impact.k --units mm-ms-kg":
+        "needs the include the script above writes (tests/test_lsdyna_import.py)",
     # starts an MPI job of 34 ranks
     "mpirun -np 34 dask-mpi --scheduler-file sched.json --nthreads 1 &":
         "starts an MPI job",

@@ -19,11 +19,33 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .reader import Keyword, KeywordDeck
-from .scan import KeywordError, node_list, solid_elements, sph_elements
+from .scan import KeywordError, id_list, solid_elements, sph_elements
 from .units import Units
 
 #: MAT_CSCM_CONCRETE's UNITS field -> the unit system it means
 CSCM_UNITS = {0: "mm-ms-kg", 1: "mm-ms-g", 2: "mm-s-t", 4: "m-s-kg"}
+
+#: *MAT_CSCM's fields (ansys-dyna-core's names) -> (sphdyn's key, the field's
+#: unit as powers of the deck's stress and length units). ETA0C and ETA0T
+#: (time^(1 - NC), time^(1 - NT)) are converted apart.
+CSCM_FIELDS = (("g", "G", 1, 0), ("k", "K", 1, 0),
+               ("alpha", "alpha", 1, 0), ("theta", "theta", 0, 0),
+               ("lamda", "lamda", 1, 0), ("beta", "beta", -1, 0),
+               ("alpha1", "alpha1", 0, 0), ("theta1", "theta1", -1, 0),
+               ("lamda1", "lamda1", 0, 0), ("beta1", "beta1", -1, 0),
+               ("alpha2", "alpha2", 0, 0), ("theta2", "theta2", -1, 0),
+               ("lamda2", "lamda2", 0, 0), ("beta2", "beta2", -1, 0),
+               ("r", "R", 0, 0), ("xd", "X0", 1, 0), ("w", "W", 0, 0),
+               ("d1", "D1", -1, 0), ("d2", "D2", -2, 0),
+               ("b", "B", 0, 0), ("gfc", "GFC", 1, 1), ("d", "D", 0, 0),
+               ("gft", "GFT", 1, 1), ("gfs", "GFS", 1, 1),
+               ("pwrc", "pwrc", 0, 0), ("pwrt", "pwrt", 0, 0),
+               ("nc", "nc", 0, 0), ("nt", "nt", 0, 0),
+               ("overc", "overc", 1, 0), ("overt", "overt", 1, 0),
+               ("srate", "srate", 0, 0), ("rep0w", "repow", 0, 0))
+
+#: BOUNDARY_PRESCRIBED_MOTION's VAD -> [[boundary]] type
+VAD = {0: "velocity", 2: "displacement"}
 
 #: SECTION_SOLID ELFORM -> [[mesh]] integration
 ELFORM = {1: "one_point", 2: "selective_reduced"}
@@ -107,8 +129,15 @@ class Converter:
         self.materials: dict[int, dict] = {}
         self.density: dict[int, float] = {}  # mid -> [kg/m^3]
         self.node_sets: dict[int, list[int]] = {}
+        self.part_sets: dict[int, list[int]] = {}
         self.spcs: list[tuple[str, list[int] | int, tuple[str, ...]]] = []
-        self.velocities: list[tuple[int, int, tuple[float, float, float]]] = []  # STYP, ID, v
+        # (what: "all", "part", "part_set" or "node_set", its id, v [m/s], keyword)
+        self.velocities: list[tuple[str, int, tuple[float, float, float], Keyword]] = []
+        self.curves: dict[int, tuple[np.ndarray, np.ndarray] | str] = {}  # or why not
+        self.body_loads: list[tuple[int, int, float, Keyword]] = []  # axis, LCID, SF
+        # NSID, axis, "velocity" or "displacement", LCID, SF, (birth, death) [s], keyword
+        self.motions: list[tuple] = []
+        self.t_end = 0.0  # [s]
         self.walls: list[dict] = []
         self.run: dict = {"title": kd.title, "dimension": 3}
         self.output: dict = {}
@@ -200,6 +229,7 @@ class Converter:
                             "hardening_modulus": _q(E * Et / (E - Et), "Pa")})
 
     def mat_cscm_concrete(self, kw):
+        """``*MAT_CSCM_CONCRETE``: the parameters generated from FPC and DAGG."""
         o = kw.obj
         units = _int(o.units, 0)
         if CSCM_UNITS.get(units) != self.u.name:
@@ -207,9 +237,40 @@ class Converter:
                                f"({CSCM_UNITS.get(units, 'inch-pound')}) disagrees with "
                                f"--units {self.u.name}: FPC and DAGG are read in UNITS; "
                                "give --units as the deck's consistent system")
+        self._material(kw, {**self._cscm_switches(kw),
+                            "fc": _q(o.fpc * self.u.stress, "Pa"),
+                            "aggregate_size": _q(o.dagg * self.u.length, "m")})
+
+    def mat_cscm(self, kw):
+        """``*MAT_CSCM`` (MAT_159 with every parameter given): each field in
+        the deck's units; a blank one is listed (sphdyn would generate it
+        from its own fc = 30 MPa, which this form does not give)."""
+        o = kw.obj
+        m = self._cscm_switches(kw)
+        for field_, key, stress, length in CSCM_FIELDS:
+            v = _num(getattr(o, field_), None)
+            if v is None:
+                self.drop(kw, f"{field_.upper()} blank", f"{key} generated from sphdyn's "
+                          "default fc")
+                continue
+            m[key] = v * self.u.stress ** stress * self.u.length ** length
+        for field_, key, power in (("eta0c", "eta0c", "nc"), ("etaot", "eta0t", "nt")):
+            v, n = _num(getattr(o, field_), None), _num(getattr(o, power), 0.0)
+            if v is not None:  # the fluidity eta = eta0 / rate^n is a time
+                m[key] = v * self.u.time ** (1.0 - n)
+        for field_, what in (("nh", "NH, CH (pre-peak hardening)"),
+                             ("ch", "NH, CH (pre-peak hardening)"),
+                             ("pmod", "PMOD (moderate-pressure softening)")):
+            if _num(getattr(o, field_)):
+                self.drop(kw, f"{field_.upper()} = {_num(getattr(o, field_)):g}: {what}",
+                          "not in sphdyn's CSCM (docs/cscm.md): as if 0")
+        self._material(kw, m)
+
+    def _cscm_switches(self, kw) -> dict:
+        """The fields both CSCM keywords share: RO, IRATE, ERODE, RECOV,
+        ITRETRC, INCRE, PRED."""
+        o = kw.obj
         m = {"model": "cscm", "density": _q(o.ro * self.u.density, "kg/m^3"),
-             "fc": _q(o.fpc * self.u.stress, "Pa"),
-             "aggregate_size": _q(o.dagg * self.u.length, "m"),
              "rate_effects": _int(o.irate) == 1}
         erode = _num(o.erode)
         if erode >= 1.0:
@@ -222,7 +283,7 @@ class Converter:
             m["incre"] = _num(o.incre)
         if _num(o.pred):
             self.drop(kw, "PRED (pre-existing damage)", "none")
-        self._material(kw, m)
+        return m
 
     def _material(self, kw, values: dict) -> None:
         mid = int(kw.obj.mid)
@@ -231,8 +292,12 @@ class Converter:
         self.materials[mid] = {"name": _name(title, f"mat{mid}"), **values}
 
     def set_node_list(self, kw):
-        sid, nodes = node_list(kw.block, self.kd.long)
+        sid, nodes = id_list(kw.block, self.kd.long)
         self.node_sets[sid] = nodes
+
+    def set_part_list(self, kw):
+        sid, pids = id_list(kw.block, self.kd.long)
+        self.part_sets[sid] = pids
 
     def boundary_spc_set(self, kw):
         o = kw.obj
@@ -253,26 +318,25 @@ class Converter:
             self.drop(kw, "OMEGA (an initial rotation)", "no rotation")
         v = tuple(_num(getattr(o, f"v{a}")) * self.u.velocity for a in "xyz")
         styp, ident = _int(o.styp, 2), _int(o.id)
-        if ident and styp != 2:
-            self.drop(kw, f"STYP = {styp} (a {'part' if styp == 1 else 'node'} set)",
-                      "no initial velocity from it (a part, STYP = 2, or ID = 0 is "
-                      "imported)")
+        what = {1: "part_set", 2: "part", 3: "node_set"}.get(styp) if ident else "all"
+        if what is None:
+            self.drop(kw, f"STYP = {styp}", "no initial velocity from it (STYP 1, 2, 3)")
             return
-        self.velocities.append((styp, ident, v))
+        self.velocities.append((what, ident, v, kw))
 
     def initial_velocity(self, kw):
-        """``*INITIAL_VELOCITY``: with NSID = 0 every node and particle (the
-        same as ``*INITIAL_VELOCITY_GENERATION`` with ID = 0); a node set, an
-        exempted set or a box is listed."""
+        """``*INITIAL_VELOCITY``: the nodes of set NSID (0: every node and
+        particle); an exempted set or a box is listed."""
         o = kw.obj
-        if _int(o.nsid) or _int(o.nsidex) or _int(o.boxid):
-            self.drop(kw, "NSID / NSIDEX / BOXID (a velocity for some nodes)",
-                      "no initial velocity from it (NSID = 0, every node, is imported)")
+        if _int(o.nsidex) or _int(o.boxid):
+            self.drop(kw, "NSIDEX / BOXID (nodes exempted, or a box)",
+                      "no initial velocity from it")
             return
         if any(_num(getattr(o, f"v{a}r")) for a in "xyz"):
             self.drop(kw, "VXR / VYR / VZR (rotational velocities of beam nodes)", "none")
         v = tuple(_num(getattr(o, f"v{a}")) * self.u.velocity for a in "xyz")
-        self.velocities.append((2, 0, v))
+        nsid = _int(o.nsid)
+        self.velocities.append(("node_set" if nsid else "all", nsid, v, kw))
 
     def rigidwall_planar(self, kw):
         o = kw.obj
@@ -291,7 +355,53 @@ class Converter:
                            "friction": fric})
 
     def control_termination(self, kw):
-        self.run["t_end"] = _q(kw.obj.endtim * self.u.time, "s")
+        self.t_end = kw.obj.endtim * self.u.time
+        self.run["t_end"] = _q(self.t_end, "s")
+
+    def define_curve(self, kw):
+        """``*DEFINE_CURVE``: the points, abscissae times SFA and ordinates
+        times SFO; a curve with offsets (OFFA, OFFO) or a dynamic-relaxation
+        flag (SIDR) is kept as the reason it cannot be used."""
+        o = kw.obj
+        lcid = int(o.lcid)
+        if _num(o.offa) or _num(o.offo):
+            self.curves[lcid] = f"curve {lcid} has OFFA / OFFO offsets ({kw.block.where()})"
+            return
+        if _int(o.sidr):
+            self.curves[lcid] = (f"curve {lcid} is a dynamic-relaxation curve (SIDR = "
+                                 f"{_int(o.sidr)}; {kw.block.where()})")
+            return
+        pts = o.curves  # SFA, SFO: 0 means 1
+        a = np.asarray(pts.iloc[:, 0], float) * (_num(o.sfa, 1.0) or 1.0) * self.u.time
+        self.curves[lcid] = (a, np.asarray(pts.iloc[:, 1], float) * (_num(o.sfo, 1.0) or 1.0))
+
+    def load_body(self, kw):
+        """``*LOAD_BODY_X``, ``_Y``, ``_Z``: a base acceleration SF times the
+        curve; the model's body force acts against it ("positive body load
+        acts in the negative direction", LS-DYNA Keyword Manual Vol. I,
+        *LOAD_BODY), so [run] gravity = -SF curve along the axis."""
+        o = kw.obj
+        if _int(o.lciddr):
+            self.drop(kw, "LCIDDR (a dynamic-relaxation curve)", "no dynamic relaxation")
+        if _int(o.cid):
+            self.drop(kw, "CID (a local coordinate system)", "the global axes")
+        axis = "XYZ".index(kw.name[-1])
+        self.body_loads.append((axis, _int(o.lcid), _num(o.sf, 1.0), kw))
+
+    def boundary_prescribed_motion_set(self, kw):
+        """``*BOUNDARY_PRESCRIBED_MOTION_SET``: a velocity (VAD = 0) or a
+        displacement (VAD = 2) along x, y or z (DOF 1-3) of a node set,
+        whose curve is constant, or rises linearly from zero and is then
+        constant (a [[boundary]] with its ramp_time)."""
+        o = kw.obj
+        dof, vad = _int(o.dof), _int(o.vad)
+        if dof not in (1, 2, 3) or vad not in VAD:
+            self.drop(kw, f"DOF = {dof}, VAD = {vad}", "no motion from it (DOF 1-3 with "
+                      "VAD 0, a velocity, or 2, a displacement, is imported)")
+            return
+        span = (_num(o.birth) * self.u.time, (_num(o.death) or 1e28) * self.u.time)
+        self.motions.append((_int(o.nsid), dof - 1, VAD[vad], _int(o.lcid),
+                             _num(o.sf, 1.0), span, kw))
 
     def control_timestep(self, kw):
         o = kw.obj
@@ -306,6 +416,9 @@ class Converter:
         if form:
             self.drop(kw, f"FORM = {form}", "sphdyn's default formulation (the "
                       "updated-Lagrangian kernel, FORM = 0)")
+        if _int(kw.obj.deriv):
+            self.drop(kw, f"DERIV = {_int(kw.obj.deriv)} (h from the cube root of the "
+                      "divergence)", "dh/dt = h div(v) / d (DERIV = 0)")
 
     def database_binary_d3plot(self, kw):
         if _num(kw.obj.dt):
@@ -326,6 +439,8 @@ class Converter:
             raise KeywordError(f"{self.kd.path}: material {missing[0]} is used by a part "
                                "but not defined by a *MAT_ keyword sphdyn imports")
         out.deck["material"] = [dict(self.materials[m]) for m in used]
+        self.initial_v = self._initial_velocities()
+        self._gravity()
         self._bodies(out)
         self._meshes(out)
         if self.walls:
@@ -359,10 +474,93 @@ class Converter:
         return _name(self.parts[pid]["title"], f"part{pid}")
 
     def _velocity(self, pid: int) -> tuple[float, float, float] | None:
-        for styp, ident, v in self.velocities:
-            if ident == 0 or (styp == 2 and ident == pid):
-                return v
+        return self.initial_v.get(pid)
+
+    def _part_nodes(self) -> dict[int, set[int]]:
+        """The nodes (particles) of each part."""
+        nodes: dict[int, set[int]] = {}
+        for n, pid, _ in self.sph:
+            nodes.setdefault(pid, set()).add(n)
+        for _, pid, ns in self.solids:
+            nodes.setdefault(pid, set()).update(ns)
+        return nodes
+
+    def _initial_velocities(self) -> dict[int, tuple[float, float, float]]:
+        """Each part's initial velocity from the velocity keywords in deck
+        order: every part, a part, the parts of a part set, or the parts
+        whose nodes make up a node set exactly (sphdyn gives a body or a mesh
+        one velocity; any other node set is listed). A part given two
+        different velocities keeps the first (the second is listed)."""
+        part_nodes = self._part_nodes()
+        given: dict[int, tuple[float, float, float]] = {}
+        for what, ident, v, kw in self.velocities:
+            if what == "all":
+                pids = list(part_nodes)
+            elif what == "part":
+                pids = [ident]
+            elif what == "part_set":
+                if ident not in self.part_sets:
+                    raise KeywordError(f"{kw.block.where()}: part set {ident}, which no "
+                                       "*SET_PART_LIST defines")
+                pids = self.part_sets[ident]
+            else:
+                if ident not in self.node_sets:
+                    raise KeywordError(f"{kw.block.where()}: node set {ident}, which no "
+                                       "*SET_NODE_LIST defines")
+                nodes = set(self.node_sets[ident])
+                pids = [p for p, ns in part_nodes.items() if ns <= nodes]
+                if set().union(*(part_nodes[p] for p in pids)) != nodes:
+                    self.drop(kw, f"node set {ident} is not the nodes of whole parts",
+                              "no initial velocity from it (sphdyn gives each body and "
+                              "mesh one velocity)")
+                    continue
+            for p in pids:
+                if given.setdefault(p, v) != v:
+                    self.drop(kw, f"part {p}: a second initial velocity",
+                              "the first one given for it")
+        return given
+
+    def _curve_shape(self, lcid: int, kw, what: str) -> tuple[float, float] | None:
+        """``(value, ramp time [s])`` of curve ``lcid`` over the run: constant
+        (ramp 0), or rising linearly from 0 at t = 0 to its second point's
+        value and constant after it. Any other shape, or a curve that does
+        not span 0 to the end time, is listed and gives None."""
+        curve = self.curves.get(lcid)
+        if curve is None:
+            raise KeywordError(f"{kw.block.where()}: curve {lcid}, which no "
+                               "*DEFINE_CURVE defines")
+        if isinstance(curve, str):
+            self.drop(kw, curve, f"no {what} from it")
+            return None
+        a, o = curve
+        if a[0] > 0.0 or a[-1] < self.t_end * (1.0 - 1e-12):
+            self.drop(kw, f"curve {lcid} spans {a[0]:g} to {a[-1]:g} s, not the run's "
+                      f"0 to {self.t_end:g} s", f"no {what} from it")
+            return None
+        if np.all(o == o[0]):
+            return float(o[0]), 0.0
+        if len(a) >= 2 and a[0] == 0.0 and o[0] == 0.0 and a[1] > 0.0 \
+                and np.all(o[1:] == o[1]):
+            return float(o[1]), float(a[1])
+        self.drop(kw, f"curve {lcid} is neither constant nor a linear rise to a "
+                  "constant", f"no {what} from it (sphdyn's are constant or ramped)")
         return None
+
+    def _gravity(self) -> None:
+        """[run] gravity from the body loads: -SF times the curve's value along
+        each axis (:meth:`load_body` says why the sign)."""
+        g = np.zeros(3)
+        for axis, lcid, sf, kw in self.body_loads:
+            shape = self._curve_shape(lcid, kw, "body load")
+            if shape is None:
+                continue
+            value, ramp = shape
+            if ramp:
+                self.drop(kw, f"curve {lcid} ramps the load up over {ramp:g} s",
+                          "gravity at its full value from the start")
+            g[axis] -= sf * value * self.u.length / self.u.time ** 2
+        if g.any():
+            self.run["gravity"] = [_q(c, "m/s^2") for c in g]
 
     def _bodies(self, out: Imported) -> None:
         pids = sorted({pid for _, pid, _ in self.sph})
@@ -404,11 +602,48 @@ class Converter:
         if more:
             self.drop(self.parts[pids[0]]["kw"], "different CSLH, HMIN or HMAX per "
                       "part", f"the first part's for all ({cs:g}, {hmin:g}, {hmax:g})")
-        out.deck["sph"] = {"h_factor": cs,
-                           "smoothing_length": {"min_factor": hmin, "max_factor": hmax}}
+        out.deck["sph"] = {"h_factor": cs, "smoothing_length": self._smoothing(hmin, hmax)}
+
+    def _smoothing(self, hmin: float, hmax: float) -> dict:
+        """[sph.smoothing_length] of SECTION_SPH's HMIN, HMAX: LS-DYNA
+        recomputes h every cycle from the velocity divergence, within HMIN
+        and HMAX times the initial h, and keeps it constant with HMIN = HMAX
+        = 1 (S. Bala, "Smoothing length in SPH", d3view, 2007): sphdyn's
+        "benz" rule dh/dt = h div(v) / d, or "constant"."""
+        if hmin == hmax == 1.0:
+            return {"mode": "constant"}
+        return {"mode": "benz", "min_factor": hmin, "max_factor": hmax}
+
+    def _motion(self, nsid, axis, kind, lcid, sf, span, kw) -> dict | None:
+        """A prescribed motion as a [[boundary]]'s keys (without its set), or
+        None when it cannot be carried over (listed)."""
+        if span[0] > 0.0 or span[1] < self.t_end:
+            self.drop(kw, f"BIRTH / DEATH ({span[0]:g} to {span[1]:g} s: acting part "
+                      "of the run)", "it acts from the start to the end")
+        shape = self._curve_shape(lcid, kw, "motion")
+        if shape is None:
+            return None
+        value, ramp = shape
+        if kind == "displacement" and ramp == 0.0:
+            self.drop(kw, f"curve {lcid}: a displacement reached at once",
+                      "no motion from it (a displacement boundary needs a ramp)")
+            return None
+        unit, factor = (("m/s", self.u.velocity) if kind == "velocity"
+                        else ("m", self.u.length))
+        vec = [0.0, 0.0, 0.0]
+        vec[axis] = sf * value * factor
+        b = {"type": kind, kind: [_q(c, unit) for c in vec], "components": ["xyz"[axis]]}
+        if ramp:
+            b["ramp_time"] = _q(ramp, "s")
+        return b
 
     def _meshes(self, out: Imported) -> None:
         if not self.solids:
+            for where, _, _ in self.spcs:
+                self.dropped.append(Dropped(where, "constraints on SPH particles",
+                                            "the particles are free", True))
+            for *_, kw in self.motions:
+                self.drop(kw, "a motion of SPH particles", "the particles are free")
             return
         import meshio
 
@@ -429,25 +664,35 @@ class Converter:
         cells = np.vectorize(index.__getitem__)(conn)
         pid_of = np.array([pid for _, pid, _ in self.solids])
         cell_sets = {f"part{pid}": [np.flatnonzero(pid_of == pid)] for pid in pids}
-        point_sets = {}
         name = "solids"
-        sets, boundaries = [], []
-        for k, (where, ref, dofs) in enumerate(self.spcs, start=1):
+        point_sets, sets, boundaries = {}, [], []
+
+        def group(where: str, ref, label: str) -> str | None:
+            """A [[set]] of the mesh's nodes in node set ``ref`` (or a list of
+            nodes); nodes that are no solid element's are listed as free."""
             nodes = self.node_sets.get(ref) if isinstance(ref, int) else ref
             if nodes is None:
                 raise KeywordError(f"{where}: node set {ref}, which no *SET_NODE_LIST "
                                    "defines")
             on = [index[n] for n in nodes if n in index]
             if len(on) != len(nodes):
-                self.dropped.append(Dropped(where, "constraints on nodes that are not "
+                self.dropped.append(Dropped(where, "a condition on nodes that are not "
                                             "a solid element's (SPH particles)",
                                             "those nodes are free", True))
-            if not on or not dofs:
-                continue
-            group = f"spc{k}"
-            point_sets[group] = np.array(on)
-            sets.append({"name": group, "mesh": name, "group": group})
-            boundaries.append({"set": group, "type": "fixed", "components": list(dofs)})
+            if not on:
+                return None
+            point_sets[label] = np.array(on)
+            sets.append({"name": label, "mesh": name, "group": label})
+            return label
+
+        for k, (where, ref, dofs) in enumerate(self.spcs, start=1):
+            if dofs and (g := group(where, ref, f"spc{k}")):
+                boundaries.append({"set": g, "type": "fixed", "components": list(dofs)})
+        for k, motion in enumerate(self.motions, start=1):
+            b = self._motion(*motion)
+            if b is not None and (g := group(motion[-1].block.where(), motion[0],
+                                             f"motion{k}")):
+                boundaries.append({"set": g, **b})
         file = f"{self.stem}_{name}.inp"
         out.files[file] = meshio.Mesh(points, [("hexahedron", cells)],
                                       cell_sets=cell_sets, point_sets=point_sets)
@@ -482,7 +727,15 @@ HANDLED = {
     "MAT_PLASTIC_KINEMATIC": Converter.mat_plastic_kinematic,
     "MAT_003": Converter.mat_plastic_kinematic,
     "MAT_CSCM_CONCRETE": Converter.mat_cscm_concrete,
+    "MAT_CSCM": Converter.mat_cscm,
+    "MAT_159": Converter.mat_cscm,
     "SET_NODE_LIST": Converter.set_node_list,
+    "SET_PART_LIST": Converter.set_part_list,
+    "DEFINE_CURVE": Converter.define_curve,
+    "LOAD_BODY_X": Converter.load_body,
+    "LOAD_BODY_Y": Converter.load_body,
+    "LOAD_BODY_Z": Converter.load_body,
+    "BOUNDARY_PRESCRIBED_MOTION_SET": Converter.boundary_prescribed_motion_set,
     "BOUNDARY_SPC_SET": Converter.boundary_spc_set,
     "BOUNDARY_SPC_NODE": Converter.boundary_spc_node,
     "INITIAL_VELOCITY_GENERATION": Converter.initial_velocity_generation,

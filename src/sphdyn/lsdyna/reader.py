@@ -41,7 +41,8 @@ class KeywordDeck:
 
 
 #: Blocks read here, not by the library (:mod:`.scan` says why)
-OWN = ("ELEMENT_SPH", "ELEMENT_SOLID", "SET_NODE_LIST", "SET_NODE_LIST_TITLE")
+OWN = ("ELEMENT_SPH", "ELEMENT_SOLID", "SET_NODE_LIST", "SET_NODE_LIST_TITLE",
+       "SET_PART_LIST", "SET_PART_LIST_TITLE")
 
 
 def read_keyword_deck(path) -> KeywordDeck:

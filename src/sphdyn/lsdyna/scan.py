@@ -9,8 +9,8 @@ that each keyword can be named with its file and line in a message, follows
 the main file), refuses a main file without ``*END``, and reads the rows of
 ``*ELEMENT_SPH``, of which ansys-dyna-core 0.12 keeps only the first (its
 class holds one card, not a table), of ``*ELEMENT_SOLID``, whose long-format
-rows it misreads, and of ``*SET_NODE_LIST``, whose comma-separated node
-lines it cuts short (all three found by this project's tests,
+rows it misreads, and of ``*SET_NODE_LIST`` and ``*SET_PART_LIST``, whose
+comma-separated lines it cuts short (found by this project's tests,
 tests/test_lsdyna_import.py).
 """
 
@@ -156,13 +156,14 @@ def sph_elements(block: Block, long: bool) -> list[tuple[int, int, float]]:
     return rows
 
 
-def node_list(block: Block, long: bool) -> tuple[int, list[int]]:
-    """``(sid, nodes)`` of a ``*SET_NODE_LIST`` block: the first card's SID,
-    then node ids eight to a line in fields of 10 characters (20 in long
-    format) or comma-separated; blanks and zeros end nothing and are skipped.
-    Read here because ansys-dyna-core 0.12 keeps only the first fields of a
-    comma-separated node line (found by this project's tests)."""
+def id_list(block: Block, long: bool) -> tuple[int, list[int]]:
+    """``(sid, ids)`` of a ``*SET_NODE_LIST`` or ``*SET_PART_LIST`` block: the
+    first card's SID, then ids eight to a line in fields of 10 characters (20
+    in long format) or comma-separated; blanks and zeros end nothing and are
+    skipped. Read here because ansys-dyna-core 0.12 keeps only the first
+    fields of a comma-separated line (found by this project's tests)."""
     width = 20 if block.long(long) else 10
+    what = f"*{block.name}"
     cards = [(k, s) for k, s in block.lines if s.strip()]
     if "TITLE" in block.title.upper():
         cards = cards[1:]
@@ -172,9 +173,9 @@ def node_list(block: Block, long: bool) -> tuple[int, list[int]]:
     try:
         sid = int(_fields(first, (width,) * 5)[0])
     except ValueError:
-        raise KeywordError(f"{block.file}, line {k}: *SET_NODE_LIST's first field "
+        raise KeywordError(f"{block.file}, line {k}: {what}'s first field "
                            f"{first.strip()[:20]!r} is not the set's id") from None
-    nodes = []
+    ids = []
     for k, line in cards[1:]:
         for text in _fields(line, (width,) * 8):
             if not text:
@@ -182,11 +183,11 @@ def node_list(block: Block, long: bool) -> tuple[int, list[int]]:
             try:
                 n = int(text)
             except ValueError:
-                raise KeywordError(f"{block.file}, line {k}: {text!r} is not a node "
-                                   "id (*SET_NODE_LIST)") from None
+                raise KeywordError(f"{block.file}, line {k}: {text!r} is not an id "
+                                   f"({what})") from None
             if n:
-                nodes.append(n)
-    return sid, nodes
+                ids.append(n)
+    return sid, ids
 
 
 def solid_elements(block: Block, long: bool) -> list[tuple[int, int, tuple[int, ...]]]:
