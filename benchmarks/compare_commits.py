@@ -2,11 +2,14 @@
 
 This VM's speed changes 2-3x from day to day, so a speed claim is a ratio
 measured in one sitting. Each case runs in a fresh process per tree, the two
-trees alternating (A B A B ...) so that a drift of the machine's speed hits
-both alike; the best of the repeats is kept. Usage::
+trees alternating so that a drift of the machine's speed hits both alike,
+and taking turns to go first (A B, B A, A B, ...): the process run first in
+a round was measured 10 % faster than the one after it, the same code in
+both (session 40, BENCHMARKS.md), so a fixed order biases the ratio. The
+best of the repeats is kept; give an even ``--repeats``. Usage::
 
     git worktree add /tmp/old 7e739c7
-    python benchmarks/compare_commits.py /tmp/old/src src --repeats 3 > compare.md
+    python benchmarks/compare_commits.py /tmp/old/src src --repeats 4 > compare.md
 
 Cases: ``sphdyn bench rings2d``, ``rings2d_tl``, ``block3d --particles
 100000`` (particle-steps per second of the stepping alone) and the paper's
@@ -79,7 +82,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("old")
     ap.add_argument("new")
-    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--repeats", type=int, default=4)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--cases", default=",".join(name for name, _ in CASES))
     a = ap.parse_args()
@@ -90,8 +93,8 @@ def main():
         for src in (a.old, a.new):  # compile / fill the Numba caches first
             measure(src, warm_up(args), a.threads)
         best = {a.old: 0.0, a.new: 0.0}
-        for _ in range(a.repeats):
-            for src in (a.old, a.new):
+        for r in range(a.repeats):  # each tree first in every other round
+            for src in (a.old, a.new) if r % 2 == 0 else (a.new, a.old):
                 best[src] = max(best[src], measure(src, args, a.threads))
         print(f"| {name} | {best[a.old]:.4g} | {best[a.new]:.4g} | "
               f"{best[a.new] / best[a.old]:.3f} |", flush=True)
