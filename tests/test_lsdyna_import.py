@@ -726,3 +726,31 @@ def test_every_imported_keyword_is_in_the_docs_table():
     doc = (Path(__file__).resolve().parents[1] / "docs" / "lsdyna.md").read_text()
     table = doc.split("## What is imported")[1].split("## ")[0]
     assert [k for k in HANDLED if f"`*{k}`" not in table] == []
+
+
+@pytest.mark.parametrize("cards, friction, listed", [
+    ("1,2,3,3\n0.3,0.3\n1.0,1.0", 0.3, []),
+    ("1,2,3,3\n0.3,0.1\n1.0,1.0", 0.3, ["FD / DC / VC"]),
+    ("2,1,3,3\n0.3\n1.0,1.0", None, ["side A is not every SPH part"]),
+    ("1,2,3,3\n0.0\n2.0,1.0", 0.0, ["SFSA = 2"]),
+])
+def test_nodes_to_surface_contact_is_the_meshs_contact(tmp_path, cards, friction, listed):
+    """*CONTACT_AUTOMATIC_NODES_TO_SURFACE with the SPH part on side A and the
+    solid part on side B is [mesh.contact] with FS as its friction, the deck
+    the same as the TOML deck with that table; what sphdyn's contact cannot
+    be (another FD, a scaled stiffness, the sides swapped) is listed."""
+    files = keyword_deck("free")
+    files["model.k"] = files["model.k"].replace(
+        "*END", f"*CONTACT_AUTOMATIC_NODES_TO_SURFACE\n{cards}\n*END")
+    imp = import_deck(_write(tmp_path, files), "m-s-kg")
+    assert [any(w in d.line() for w in listed) and d.physics for d in imp.dropped] == \
+        [True] * len(listed)
+    if friction is None:
+        assert "contact" not in imp.deck["mesh"][0]
+        return
+    assert imp.deck["mesh"][0]["contact"] == {"friction": friction}
+    write_import(imp, tmp_path / "model.toml")
+    (tmp_path / "ref.toml").write_text(TOML.replace(
+        "cfl = 0.6\n", f"cfl = 0.6\ncontact = {{friction = {friction}}}\n"))
+    ours, ref = (load_deck(tmp_path / f).mesh[0].contact for f in ("model.toml", "ref.toml"))
+    assert ours is not None and ours == ref

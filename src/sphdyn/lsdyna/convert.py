@@ -137,6 +137,7 @@ class Converter:
         self.body_loads: list[tuple[int, int, float, Keyword]] = []  # axis, LCID, SF
         # NSID, axis, "velocity" or "displacement", LCID, SF, (birth, death) [s], keyword
         self.motions: list[tuple] = []
+        self.contacts: list[tuple[tuple[int, int], tuple[int, int], float, Keyword]] = []
         self.t_end = 0.0  # [s]
         self.walls: list[dict] = []
         self.run: dict = {"title": kd.title, "dimension": 3}
@@ -637,8 +638,69 @@ class Converter:
             b["ramp_time"] = _q(ramp, "s")
         return b
 
+    def contact_automatic_nodes_to_surface(self, kw):
+        """``*CONTACT_AUTOMATIC_NODES_TO_SURFACE`` with SPH particles on side
+        A and solid parts on side B: [mesh.contact] (sphdyn's penalty spring,
+        paper eq. 8; LS-DYNA's segment stiffness is not reproduced, the same
+        difference as the rigid wall's); FS as the friction coefficient."""
+        o = kw.obj
+        fs, fd = _num(o.fs), _num(o.fd)
+        if fd and fd != fs or _num(o.dc) or _num(o.vc):
+            self.drop(kw, "FD / DC / VC (dynamic friction, its decay, viscous "
+                      "friction)", f"Coulomb friction FS = {fs:g}")
+        for field_ in ("sfsa", "sfsb"):
+            if _num(getattr(o, field_), 1.0) not in (0.0, 1.0):
+                self.drop(kw, f"{field_.upper()} = {_num(getattr(o, field_)):g}",
+                          "sphdyn's penalty stiffness ([mesh.contact] alpha)")
+        if _int(getattr(o, "soft", 0)):
+            self.drop(kw, f"SOFT = {_int(o.soft)}", "sphdyn's penalty stiffness "
+                      "([mesh.contact] stiffness = \"mass\": alpha m / dt^2)")
+        self.contacts.append(((_int(o.surfa), _int(o.surfatyp)),
+                              (_int(o.surfb), _int(o.surfbtyp)), fs, kw))
+
+    def _side_parts(self, side: tuple[int, int], kw) -> set[int] | None:
+        """The parts of a contact side (a part, a part set, or everything;
+        None for other side types, listed)."""
+        ident, typ = side
+        if typ == 3:
+            return {ident}
+        if typ == 2:
+            if ident not in self.part_sets:
+                raise KeywordError(f"{kw.block.where()}: part set {ident}, which no "
+                                   "*SET_PART_LIST defines")
+            return set(self.part_sets[ident])
+        if typ == 5:
+            return set(self.parts)
+        self.drop(kw, f"a contact side of type {typ}", "no contact from it (a part, "
+                  "3, a part set, 2, or everything, 5, is imported)")
+        return None
+
+    def _contact(self, solid_pids: list[int]) -> dict | None:
+        """[mesh.contact] of the contact keywords: side A must hold every SPH
+        part (sphdyn's contact acts on every body's particles) and side B
+        every solid part (the solids are one mesh); otherwise listed."""
+        table = None
+        sph_pids = {pid for _, pid, _ in self.sph}
+        for a, b, fs, kw in self.contacts:
+            slaves, masters = self._side_parts(a, kw), self._side_parts(b, kw)
+            if slaves is None or masters is None:
+                continue
+            if not sph_pids or not sph_pids <= slaves or masters & sph_pids \
+                    or not set(solid_pids) <= masters:
+                self.drop(kw, "a contact whose side A is not every SPH part or whose "
+                          "side B is not every solid part", "no contact from it "
+                          "(sphdyn's [mesh.contact]: every body's particles against "
+                          "the mesh's faces)")
+                continue
+            if table is not None and table["friction"] != fs:
+                self.drop(kw, "a second contact with another FS", "the first one's")
+            table = table or {"friction": fs}
+        return table
+
     def _meshes(self, out: Imported) -> None:
         if not self.solids:
+            for *_, kw in self.contacts:
+                self.drop(kw, "a contact without solid elements", "none")
             for where, _, _ in self.spcs:
                 self.dropped.append(Dropped(where, "constraints on SPH particles",
                                             "the particles are free", True))
@@ -701,6 +763,9 @@ class Converter:
                           for pid in pids]}
         if self.tssfac is not None:
             mesh["cfl"] = self.tssfac
+        contact = self._contact(pids)
+        if contact is not None:
+            mesh["contact"] = contact
         vs = {self._velocity(pid) for pid in pids}
         if len(vs) > 1:
             self.drop(self.parts[pids[0]]["kw"], "different initial velocities of the "
@@ -736,6 +801,7 @@ HANDLED = {
     "LOAD_BODY_Y": Converter.load_body,
     "LOAD_BODY_Z": Converter.load_body,
     "BOUNDARY_PRESCRIBED_MOTION_SET": Converter.boundary_prescribed_motion_set,
+    "CONTACT_AUTOMATIC_NODES_TO_SURFACE": Converter.contact_automatic_nodes_to_surface,
     "BOUNDARY_SPC_SET": Converter.boundary_spc_set,
     "BOUNDARY_SPC_NODE": Converter.boundary_spc_node,
     "INITIAL_VELOCITY_GENERATION": Converter.initial_velocity_generation,
