@@ -754,3 +754,37 @@ def test_nodes_to_surface_contact_is_the_meshs_contact(tmp_path, cards, friction
         "cfl = 0.6\n", f"cfl = 0.6\ncontact = {{friction = {friction}}}\n"))
     ours, ref = (load_deck(tmp_path / f).mesh[0].contact for f in ("model.toml", "ref.toml"))
     assert ours is not None and ours == ref
+
+
+@pytest.mark.parametrize("cards, curve, listed", [
+    ("1,7850.0,2.0e11,0.3,4.0e8,2.0e9", "", False),
+    ("1,7850.0,2.0e11,0.3,1.0e8,5.0e9\n0.0,0.0,8", "0.0,4.0e8\n0.1,6.0e8", False),
+    ("1,7850.0,2.0e11,0.3\n0.0,0.0,8", "0.0,4.0e8\n0.05,5.0e8\n0.1,6.0e8", False),
+    ("1,7850.0,2.0e11,0.3\n0.0,0.0,8", "0.0,4.0e8\n0.05,5.0e8\n0.1,5.5e8", True),
+    ("1,7850.0,2.0e11,0.3\n0.0,0.0\n0.0,0.1\n4.0e8,6.0e8", "", False),
+])
+def test_piecewise_linear_plasticity_is_j2(tmp_path, cards, curve, listed):
+    """*MAT_PIECEWISE_LINEAR_PLASTICITY: SIGY with ETAN as the plastic
+    hardening modulus, or a straight yield curve (LCSS or EPS/ES), is j2
+    with yield 400 MPa and H = 2 GPa: a material point pulled past yield has
+    the tangent E H / (E + H); a curve of two slopes is listed and its first
+    segment kept."""
+    from sphdyn.materials.driver import drive
+
+    text = GOOD_HEAD.replace("*CONTROL_TERMINATION", f"*MAT_PIECEWISE_LINEAR_PLASTICITY\n"
+                             f"{cards}\n*CONTROL_TERMINATION")
+    if curve:
+        text += f"*DEFINE_CURVE\n8\n{curve}\n"
+    (tmp_path / "p.k").write_text(text + "*END\n")
+    imp = import_deck(tmp_path / "p.k", "m-s-kg")
+    assert [d.physics and "segments" in d.line() for d in imp.dropped] == [True] * listed
+    m = imp.deck["material"][0]
+    assert m["model"] == "j2"
+    assert float(m["yield_stress"].split()[0]) == pytest.approx(4.0e8, rel=1e-12)
+    assert float(m["hardening_modulus"].split()[0]) == pytest.approx(2.0e9, rel=1e-12)
+    params = {k: float(v.split()[0]) if isinstance(v, str) and " " in v else v
+              for k, v in m.items() if k not in ("name", "model")}
+    res = drive("j2", params, "uniaxial-tension", strain=0.01, n_steps=400)
+    s, e = res["stress"][:, 0], res["strain"][:, 0]
+    assert (s[-1] - s[-50]) / (e[-1] - e[-50]) == pytest.approx(2e11 * 2e9 / 2.02e11,
+                                                                 rel=1e-6)

@@ -134,6 +134,7 @@ class Converter:
         # (what: "all", "part", "part_set" or "node_set", its id, v [m/s], keyword)
         self.velocities: list[tuple[str, int, tuple[float, float, float], Keyword]] = []
         self.curves: dict[int, tuple[np.ndarray, np.ndarray] | str] = {}  # or why not
+        self.yield_curves: list[tuple[int, int, Keyword]] = []  # MID, LCSS
         self.body_loads: list[tuple[int, int, float, Keyword]] = []  # axis, LCID, SF
         # NSID, axis, "velocity" or "displacement", LCID, SF, (birth, death) [s], keyword
         self.motions: list[tuple] = []
@@ -228,6 +229,53 @@ class Converter:
                             # the plastic modulus H of the bilinear curve whose
                             # slope past yield is ETAN: Et = E H / (E + H)
                             "hardening_modulus": _q(E * Et / (E - Et), "Pa")})
+
+    def mat_piecewise_linear_plasticity(self, kw):
+        """``*MAT_PIECEWISE_LINEAR_PLASTICITY`` (MAT_024) as j2: SIGY and ETAN,
+        the plastic hardening modulus (Altair's reference of the LS-DYNA
+        keyword: "ETAN: plastic hardening modulus"), or the yield stress
+        against effective plastic strain (the curve LCSS or EPS1-8 / ES1-8)
+        when it is a straight line; sphdyn's j2 hardens linearly, so a curve
+        of several slopes is listed and its first segment kept."""
+        o = kw.obj
+        if _num(o.c) and _num(o.p):
+            self.drop(kw, "C, P (Cowper-Symonds rate effects)", "no rate effects")
+        if _int(o.lcsr) or _int(o.vp):
+            self.drop(kw, "LCSR / VP (strain-rate scaling, viscoplastic form)",
+                      "no rate effects")
+        if 0.0 < _num(o.fail, 1e21) < 1e20:
+            self.drop(kw, f"FAIL = {_num(o.fail):g} (failure strain)", "no failure")
+        E = o.e * self.u.stress
+        m = {"model": "j2", "density": _q(o.ro * self.u.density, "kg/m^3"),
+             "E": _q(E, "Pa"), "nu": float(o.pr),
+             "yield_stress": _q(_num(o.sigy) * self.u.stress, "Pa"),
+             "hardening_modulus": _q(_num(o.etan) * self.u.stress, "Pa")}
+        self._material(kw, m)
+        eps = [_num(getattr(o, f"eps{k}"), None) for k in range(1, 9)]
+        es = [_num(getattr(o, f"es{k}"), None) for k in range(1, 9)]
+        n = sum(1 for e, s_ in zip(eps, es) if e is not None and s_ is not None
+                and (e or s_))
+        if _int(o.lcss):
+            self.yield_curves.append((int(o.mid), _int(o.lcss), kw))
+        elif n:
+            self._yield_line(kw, int(o.mid), np.array(eps[:n]), np.array(es[:n]))
+
+    def _yield_line(self, kw, mid: int, eps: np.ndarray, sig: np.ndarray) -> None:
+        """j2's yield stress and hardening modulus from a yield curve (effective
+        plastic strain, stress in the deck's units): the line through its
+        first two points, listed unless every point lies on it (1e-9)."""
+        if len(eps) < 2 or not np.all(np.diff(eps) > 0.0):
+            raise KeywordError(f"{kw.block.where()}: the yield curve needs two or more "
+                               "points of rising plastic strain")
+        H = (sig[1] - sig[0]) / (eps[1] - eps[0])
+        y0 = sig[0] - H * eps[0]
+        line = y0 + H * eps
+        if np.any(np.abs(line - sig) > 1e-9 * np.abs(sig).max()):
+            self.drop(kw, f"a yield curve of {len(eps) - 1} segments of different slope",
+                      "the line through its first two points (sphdyn's j2 hardens "
+                      "linearly)")
+        self.materials[mid]["yield_stress"] = _q(y0 * self.u.stress, "Pa")
+        self.materials[mid]["hardening_modulus"] = _q(H * self.u.stress, "Pa")
 
     def mat_cscm_concrete(self, kw):
         """``*MAT_CSCM_CONCRETE``: the parameters generated from FPC and DAGG."""
@@ -372,8 +420,8 @@ class Converter:
             self.curves[lcid] = (f"curve {lcid} is a dynamic-relaxation curve (SIDR = "
                                  f"{_int(o.sidr)}; {kw.block.where()})")
             return
-        pts = o.curves  # SFA, SFO: 0 means 1
-        a = np.asarray(pts.iloc[:, 0], float) * (_num(o.sfa, 1.0) or 1.0) * self.u.time
+        pts = o.curves  # SFA, SFO: 0 means 1; in the deck's units
+        a = np.asarray(pts.iloc[:, 0], float) * (_num(o.sfa, 1.0) or 1.0)
         self.curves[lcid] = (a, np.asarray(pts.iloc[:, 1], float) * (_num(o.sfo, 1.0) or 1.0))
 
     def load_body(self, kw):
@@ -439,6 +487,14 @@ class Converter:
         if missing:
             raise KeywordError(f"{self.kd.path}: material {missing[0]} is used by a part "
                                "but not defined by a *MAT_ keyword sphdyn imports")
+        for mid, lcid, kw in self.yield_curves:
+            curve = self.curves.get(lcid)
+            if curve is None:
+                raise KeywordError(f"{kw.block.where()}: curve {lcid}, which no "
+                                   "*DEFINE_CURVE defines")
+            if isinstance(curve, str):
+                raise KeywordError(f"{kw.block.where()}: LCSS {lcid}: {curve}")
+            self._yield_line(kw, mid, *curve)
         out.deck["material"] = [dict(self.materials[m]) for m in used]
         self.initial_v = self._initial_velocities()
         self._gravity()
@@ -533,7 +589,7 @@ class Converter:
         if isinstance(curve, str):
             self.drop(kw, curve, f"no {what} from it")
             return None
-        a, o = curve
+        a, o = curve[0] * self.u.time, curve[1]
         if a[0] > 0.0 or a[-1] < self.t_end * (1.0 - 1e-12):
             self.drop(kw, f"curve {lcid} spans {a[0]:g} to {a[-1]:g} s, not the run's "
                       f"0 to {self.t_end:g} s", f"no {what} from it")
@@ -791,6 +847,8 @@ HANDLED = {
     "MAT_001": Converter.mat_elastic,
     "MAT_PLASTIC_KINEMATIC": Converter.mat_plastic_kinematic,
     "MAT_003": Converter.mat_plastic_kinematic,
+    "MAT_PIECEWISE_LINEAR_PLASTICITY": Converter.mat_piecewise_linear_plasticity,
+    "MAT_024": Converter.mat_piecewise_linear_plasticity,
     "MAT_CSCM_CONCRETE": Converter.mat_cscm_concrete,
     "MAT_CSCM": Converter.mat_cscm,
     "MAT_159": Converter.mat_cscm,
