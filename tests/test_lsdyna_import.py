@@ -788,3 +788,73 @@ def test_piecewise_linear_plasticity_is_j2(tmp_path, cards, curve, listed):
     s, e = res["stress"][:, 0], res["strain"][:, 0]
     assert (s[-1] - s[-50]) / (e[-1] - e[-50]) == pytest.approx(2e11 * 2e9 / 2.02e11,
                                                                  rel=1e-6)
+
+
+HE = """\
+*KEYWORD
+*NODE
+1,0.0,0.0,0.0
+2,0.002,0.0,0.0
+3,0.0,0.002,0.0
+4,0.002,0.002,0.0
+*ELEMENT_SPH
+1,1,1.304e-5
+2,1,1.304e-5
+3,2,9.8e-9
+4,2,9.8e-9
+*PART
+charge
+1,1,1,1
+*PART
+air
+2,1,2,2
+*SECTION_SPH
+1,1.2,0.2,2.0
+*MAT_HIGH_EXPLOSIVE_BURN
+1,1630.0,6930.0,2.1e10
+*EOS_JWL
+1,3.712e11,3.231e9,4.15,0.95,0.3,7.0e9
+*MAT_NULL
+2,1.225,-10.0
+*EOS_LINEAR_POLYNOMIAL
+2,0.0,0.0,0.0,0.0,0.4,0.4,0.0
+2.5e5
+*INITIAL_DETONATION
+1,0.0,0.0,0.0,1.0e-6
+*CONTROL_TERMINATION
+1.0e-5
+*END
+"""
+
+
+def test_explosive_and_air_with_their_eos(tmp_path):
+    """*MAT_HIGH_EXPLOSIVE_BURN with *EOS_JWL (TNT's numbers) is the
+    high_explosive material of preset "tnt" (the same parameter vector, to
+    the bit), *MAT_NULL with *EOS_LINEAR_POLYNOMIAL (C4 = C5 = 0.4) the
+    linear-polynomial gas, and *INITIAL_DETONATION a [[detonation]] of the
+    charge's material at its point and time."""
+    (tmp_path / "he.k").write_text(HE)
+    imp = import_deck(tmp_path / "he.k", "m-s-kg")
+    assert not imp.dropped, [d.line() for d in imp.dropped]
+    he, air = imp.deck["material"]
+    assert (he["model"], he["burn"], air["model"], air["eos"]) == \
+        ("high_explosive", "both", "gas", "linear_polynomial")
+    assert imp.deck["detonation"] == [{"point": ["0.0 m", "0.0 m", "0.0 m"],
+                                       "time": "1e-06 s", "material": he["name"]}]
+    write_import(imp, tmp_path / "he.toml")
+    deck = load_deck(tmp_path / "he.toml")
+    import tomli_w
+
+    ref = dict(imp.deck, material=[
+        {"name": he["name"], "model": "high_explosive", "preset": "tnt"},
+        {"name": air["name"], "model": "gas", "eos": "linear_polynomial",
+         "density": "1.225 kg/m^3", "C4": 0.4, "C5": 0.4, "E0": "250000.0 Pa",
+         "pressure_cutoff": "-10.0 Pa"}])
+    ref = tomli_w.dumps(ref)
+    (tmp_path / "ref.toml").write_text(ref)
+    a, b = build_model(deck), build_model(load_deck(tmp_path / "ref.toml"))
+    for ga, gb in zip(a.groups, b.groups):
+        np.testing.assert_array_equal(ga.params, gb.params)
+    (tmp_path / "bad.k").write_text(HE.replace("*EOS_JWL\n1,", "*EOS_JWL\n7,"))
+    with pytest.raises(KeywordError, match="needs an \\*EOS_JWL"):
+        import_deck(tmp_path / "bad.k", "m-s-kg")

@@ -44,6 +44,13 @@ CSCM_FIELDS = (("g", "G", 1, 0), ("k", "K", 1, 0),
                ("overc", "overc", 1, 0), ("overt", "overt", 1, 0),
                ("srate", "srate", 0, 0), ("rep0w", "repow", 0, 0))
 
+#: MAT_HIGH_EXPLOSIVE_BURN's BETA -> the explosive's burn
+BURN = {0: "both", 1: "beta", 2: "programmed"}
+
+#: The material models that take their pressure from a part's *EOS_ and the
+#: EOS keyword each needs
+EOS_OF = {"high_explosive": "JWL", "gas": "LINEAR_POLYNOMIAL"}
+
 #: BOUNDARY_PRESCRIBED_MOTION's VAD -> [[boundary]] type
 VAD = {0: "velocity", 2: "displacement"}
 
@@ -135,6 +142,8 @@ class Converter:
         self.velocities: list[tuple[str, int, tuple[float, float, float], Keyword]] = []
         self.curves: dict[int, tuple[np.ndarray, np.ndarray] | str] = {}  # or why not
         self.yield_curves: list[tuple[int, int, Keyword]] = []  # MID, LCSS
+        self.eos: dict[int, tuple[str, dict, Keyword]] = {}  # EOSID -> kind, keys
+        self.detonations: list[tuple] = []  # PID, point, time [s], keyword
         self.body_loads: list[tuple[int, int, float, Keyword]] = []  # axis, LCID, SF
         # NSID, axis, "velocity" or "displacement", LCID, SF, (birth, death) [s], keyword
         self.motions: list[tuple] = []
@@ -180,11 +189,10 @@ class Converter:
         for row in kw.obj.parts.itertuples(index=False):
             pid = int(row.pid)
             self.parts[pid] = {"title": row.heading, "secid": _int(row.secid),
-                               "mid": _int(row.mid), "kw": kw}
-            if _int(row.eosid) or _int(row.hgid):
-                self.drop(kw, f"part {pid}: EOSID / HGID (an equation of state or an "
-                          "hourglass card)", "the material's own pressure and "
-                          "[[mesh]]'s hourglass control are used")
+                               "mid": _int(row.mid), "eosid": _int(row.eosid), "kw": kw}
+            if _int(row.hgid):
+                self.drop(kw, f"part {pid}: HGID (an hourglass card)",
+                          "[[mesh]]'s hourglass control")
 
     def section_solid(self, kw):
         o = kw.obj
@@ -276,6 +284,93 @@ class Converter:
                       "linearly)")
         self.materials[mid]["yield_stress"] = _q(y0 * self.u.stress, "Pa")
         self.materials[mid]["hardening_modulus"] = _q(H * self.u.stress, "Pa")
+
+    def mat_high_explosive_burn(self, kw):
+        """``*MAT_HIGH_EXPLOSIVE_BURN`` (MAT_008) with its part's ``*EOS_JWL``:
+        ``model = "high_explosive"``, D, PCJ, BETA as the burn."""
+        o = kw.obj
+        beta = _int(o.beta)
+        if beta not in BURN:
+            raise KeywordError(f"{kw.block.where()}: BETA = {beta} is not 0, 1 or 2")
+        if _num(o.k) or _num(o.g) or _num(o.sigy):
+            self.drop(kw, "K, G, SIGY (the unreacted explosive's strength)",
+                      "the explosive carries pressure only")
+        self._material(kw, {"model": "high_explosive",
+                            "density": _q(o.ro * self.u.density, "kg/m^3"),
+                            "D": _q(o.d * self.u.velocity, "m/s"),
+                            "P_CJ": _q(o.pcj * self.u.stress, "Pa"), "burn": BURN[beta]})
+
+    def mat_null(self, kw):
+        """``*MAT_NULL`` (MAT_009) with its part's ``*EOS_LINEAR_POLYNOMIAL``:
+        ``model = "gas"``; PC as the pressure cutoff."""
+        o = kw.obj
+        if _num(o.mu):
+            self.drop(kw, "MU (viscosity)", "no viscosity but the artificial one")
+        if _num(o.terod) or _num(o.cerod):
+            self.drop(kw, "TEROD / CEROD (erosion by relative volume)", "no erosion")
+        self._material(kw, {"model": "gas", "density": _q(o.ro * self.u.density, "kg/m^3"),
+                            "pressure_cutoff": _q(min(_num(o.pc), 0.0) * self.u.stress,
+                                                  "Pa")})
+
+    def eos_jwl(self, kw):
+        o = kw.obj
+        S = self.u.stress
+        self._eos(kw, "JWL", o.vo, {"A": _q(o.a * S, "Pa"), "B": _q(o.b * S, "Pa"),
+                                    "R1": float(o.r1), "R2": float(o.r2),
+                                    "omega": float(o.omeg), "E0": _q(o.e0 * S, "Pa")})
+
+    def eos_linear_polynomial(self, kw):
+        o = kw.obj
+        S = self.u.stress
+        keys = {"eos": "linear_polynomial"}
+        keys |= {f"C{k}": _q(_num(getattr(o, f"c{k}")) * S, "Pa") for k in range(4)}
+        keys |= {f"C{k}": _num(getattr(o, f"c{k}")) for k in range(4, 7)}
+        keys["E0"] = _q(_num(o.e0) * S, "Pa")
+        self._eos(kw, "LINEAR_POLYNOMIAL", o.v0, keys)
+
+    def _eos(self, kw, kind: str, v0, keys: dict) -> None:
+        if _num(v0, 1.0) not in (0.0, 1.0):
+            self.drop(kw, f"V0 = {_num(v0):g} (an initial relative volume)", "1")
+        self.eos[int(kw.obj.eosid)] = (kind, keys, kw)
+
+    def _with_eos(self, pids: list[int]) -> None:
+        """Each part's *EOS_ into its material: JWL for an explosive, a linear
+        polynomial for a null material; an EOS on another material, or one
+        material with two EOS, is listed."""
+        given: dict[int, int] = {}
+        for pid in pids:
+            part = self.parts[pid]
+            mid, eosid = part["mid"], part["eosid"]
+            m = self.materials.get(mid)
+            if m is None:
+                continue
+            need = EOS_OF.get(m["model"])
+            if need is None:
+                if eosid:
+                    self.drop(part["kw"], f"part {pid}: EOSID {eosid} on a material with "
+                              "its own pressure", "the material's own pressure")
+                continue
+            if eosid not in self.eos or self.eos[eosid][0] != need:
+                raise KeywordError(f"{part['kw'].block.where()}: part {pid}'s material "
+                                   f"{mid} needs an *EOS_{need} (EOSID {eosid})")
+            if given.setdefault(mid, eosid) != eosid:
+                self.drop(part["kw"], f"part {pid}: material {mid} with a second EOS",
+                          f"EOS {given[mid]} for every part of it")
+                continue
+            m.update(self.eos[eosid][1])
+
+    def initial_detonation(self, kw):
+        """``*INITIAL_DETONATION``: a [[detonation]] at X, Y, Z, lit at LT, of
+        part PID's explosive (0: every explosive)."""
+        o = kw.obj
+        pid = _int(o.pid)
+        if pid < 0:
+            self.drop(kw, f"PID = {pid} (a part set, or an acoustic boundary)",
+                      "no detonation from it")
+            return
+        self.detonations.append((pid, [_q(_num(getattr(o, a)) * self.u.length, "m")
+                                       for a in "xyz"],
+                                 _num(o.lt) * self.u.time, kw))
 
     def mat_cscm_concrete(self, kw):
         """``*MAT_CSCM_CONCRETE``: the parameters generated from FPC and DAGG."""
@@ -495,7 +590,16 @@ class Converter:
             if isinstance(curve, str):
                 raise KeywordError(f"{kw.block.where()}: LCSS {lcid}: {curve}")
             self._yield_line(kw, mid, *curve)
+        self._with_eos(self._pids())
         out.deck["material"] = [dict(self.materials[m]) for m in used]
+        for pid, point, lt, kw in self.detonations:
+            d = {"point": point, "time": _q(lt, "s")}
+            if pid:
+                if pid not in self.parts:
+                    raise KeywordError(f"{kw.block.where()}: part {pid}, which no "
+                                       "*PART defines")
+                d["material"] = self._mat_name(pid)
+            out.deck.setdefault("detonation", []).append(d)
         self.initial_v = self._initial_velocities()
         self._gravity()
         self._bodies(out)
@@ -850,6 +954,13 @@ HANDLED = {
     "MAT_PIECEWISE_LINEAR_PLASTICITY": Converter.mat_piecewise_linear_plasticity,
     "MAT_024": Converter.mat_piecewise_linear_plasticity,
     "MAT_CSCM_CONCRETE": Converter.mat_cscm_concrete,
+    "MAT_HIGH_EXPLOSIVE_BURN": Converter.mat_high_explosive_burn,
+    "MAT_008": Converter.mat_high_explosive_burn,
+    "MAT_NULL": Converter.mat_null,
+    "MAT_009": Converter.mat_null,
+    "EOS_JWL": Converter.eos_jwl,
+    "EOS_LINEAR_POLYNOMIAL": Converter.eos_linear_polynomial,
+    "INITIAL_DETONATION": Converter.initial_detonation,
     "MAT_CSCM": Converter.mat_cscm,
     "MAT_159": Converter.mat_cscm,
     "SET_NODE_LIST": Converter.set_node_list,
