@@ -613,6 +613,15 @@ def test_prescribed_motion_of_a_node_set(tmp_path, vad, curve, expect):
     write_import(imp, tmp_path / "m.toml")
     model = build_model(load_deck(tmp_path / "m.toml"))
     assert model is not None
+    one = HEX + f"*BOUNDARY_PRESCRIBED_MOTION_NODE\n7,3,{vad},9,-3.0\n" \
+        f"*DEFINE_CURVE\n9\n{curve}\n*END\n"
+    (tmp_path / "n.k").write_text(one)
+    imp = import_deck(tmp_path / "n.k", "m-s-kg")
+    (b1,) = [b for b in imp.deck["boundary"] if b["type"] != "fixed"]
+    assert {k: v for k, v in b1.items() if k != "set"} == \
+        {k: v for k, v in b.items() if k != "set"}
+    group = next(s["group"] for s in imp.deck["set"] if s["name"] == b1["set"])
+    assert list(imp.files["n_solids.inp"].point_sets[group]) == [6]  # node 7
 
 
 def test_motion_curves_that_cannot_be_carried_over_are_listed(tmp_path):

@@ -145,7 +145,8 @@ class Converter:
         self.eos: dict[int, tuple[str, dict, Keyword]] = {}  # EOSID -> kind, keys
         self.detonations: list[tuple] = []  # PID, point, time [s], keyword
         self.body_loads: list[tuple[int, int, float, Keyword]] = []  # axis, LCID, SF
-        # NSID, axis, "velocity" or "displacement", LCID, SF, (birth, death) [s], keyword
+        # NSID (or a list of nodes), axis, "velocity" or "displacement", LCID, SF,
+        # (birth, death) [s], keyword
         self.motions: list[tuple] = []
         self.contacts: list[tuple[tuple[int, int], tuple[int, int], float, Keyword]] = []
         self.t_end = 0.0  # [s]
@@ -537,6 +538,13 @@ class Converter:
         displacement (VAD = 2) along x, y or z (DOF 1-3) of a node set,
         whose curve is constant, or rises linearly from zero and is then
         constant (a [[boundary]] with its ramp_time)."""
+        self._prescribed(kw, _int(kw.obj.nsid))
+
+    def boundary_prescribed_motion_node(self, kw):
+        """``*BOUNDARY_PRESCRIBED_MOTION_NODE``: the same for one node."""
+        self._prescribed(kw, [_int(kw.obj.nid)])
+
+    def _prescribed(self, kw, ref) -> None:
         o = kw.obj
         dof, vad = _int(o.dof), _int(o.vad)
         if dof not in (1, 2, 3) or vad not in VAD:
@@ -544,7 +552,7 @@ class Converter:
                       "VAD 0, a velocity, or 2, a displacement, is imported)")
             return
         span = (_num(o.birth) * self.u.time, (_num(o.death) or 1e28) * self.u.time)
-        self.motions.append((_int(o.nsid), dof - 1, VAD[vad], _int(o.lcid),
+        self.motions.append((ref, dof - 1, VAD[vad], _int(o.lcid),
                              _num(o.sf, 1.0), span, kw))
 
     def control_timestep(self, kw):
@@ -970,6 +978,7 @@ HANDLED = {
     "LOAD_BODY_Y": Converter.load_body,
     "LOAD_BODY_Z": Converter.load_body,
     "BOUNDARY_PRESCRIBED_MOTION_SET": Converter.boundary_prescribed_motion_set,
+    "BOUNDARY_PRESCRIBED_MOTION_NODE": Converter.boundary_prescribed_motion_node,
     "CONTACT_AUTOMATIC_NODES_TO_SURFACE": Converter.contact_automatic_nodes_to_surface,
     "BOUNDARY_SPC_SET": Converter.boundary_spc_set,
     "BOUNDARY_SPC_NODE": Converter.boundary_spc_node,
