@@ -867,3 +867,56 @@ def test_explosive_and_air_with_their_eos(tmp_path):
     (tmp_path / "bad.k").write_text(HE.replace("*EOS_JWL\n1,", "*EOS_JWL\n7,"))
     with pytest.raises(KeywordError, match="needs an \\*EOS_JWL"):
         import_deck(tmp_path / "bad.k", "m-s-kg")
+
+
+@pytest.mark.parametrize("extra, material_erosion, mesh_erosion", [
+    ("*MAT_ADD_EROSION\n1,0.0\n0.0,0.0,0.0,0.3\n",
+     {"principal_strain": 0.3}, {"to": "nothing"}),
+    ("*MAT_ADD_EROSION\n1,-1.0,0.0,0.0,0.5\n-1.0,-1.0,-1.0,0.3\n"
+     "*DEFINE_ADAPTIVE_SOLID_TO_SPH\n1,0,2,3,1,1,1\n",
+     {"principal_strain": 0.3, "effective_strain": 0.5},
+     {"to": "particles", "particles_per_element": 8}),
+])
+def test_element_erosion(tmp_path, extra, material_erosion, mesh_erosion):
+    """*MAT_ADD_EROSION's MXEPS and EFFEPS are the material's principal and
+    effective strain rules (0 or EXCL: no rule) and the mesh erodes its
+    elements away (LS-DYNA's erosion), or into eight particles each with
+    *DEFINE_ADAPTIVE_SOLID_TO_SPH NQ = 2; the deck's tables are the TOML
+    deck's."""
+    (tmp_path / "e.k").write_text(HEX + extra + "*END\n")
+    imp = import_deck(tmp_path / "e.k", "m-s-kg")
+    assert not imp.dropped, [d.line() for d in imp.dropped]
+    assert imp.deck["material"][0]["erosion"] == material_erosion
+    assert imp.deck["mesh"][0]["erosion"] == mesh_erosion
+    write_import(imp, tmp_path / "e.toml")
+    deck = load_deck(tmp_path / "e.toml")
+    assert deck.mesh[0].erosion.to == mesh_erosion["to"]
+    assert deck.material[0].erosion.principal_strain == 0.3
+    build_model(deck)
+    if "ADAPTIVE" in extra:  # the _ID form's first card is the ID (ansys-dyna-core
+        # reads that card always: a plain block must not lose its first card to it)
+        text = extra.replace("SOLID_TO_SPH\n", "SOLID_TO_SPH_ID\n9,debris\n")
+        (tmp_path / "i.k").write_text(HEX + text + "*END\n")
+        same = import_deck(tmp_path / "i.k", "m-s-kg")
+        assert not same.dropped
+        assert same.deck["mesh"][0]["erosion"] == imp.deck["mesh"][0]["erosion"]
+
+
+def test_cscm_erode_erodes_elements_and_other_criteria_are_listed(tmp_path):
+    """MAT_159's ERODE on a solid part is the damage rule of its elements; a
+    *MAT_ADD_EROSION criterion sphdyn has no rule for (MXPRES) is listed, and
+    adaptivity without an erosion rule is listed as eroding nothing."""
+    cscm = ("*MAT_CSCM_CONCRETE\n1,2400.0,1,0.0,0,1.05,0.0,0\n0.0\n38.0e6,0.016,4\n")
+    (tmp_path / "c.k").write_text(HEX.replace("*MAT_ELASTIC\n1,7850.0,2.0e11,0.3\n", cscm)
+                                  + "*END\n")
+    imp = import_deck(tmp_path / "c.k", "m-s-kg")
+    assert imp.deck["material"][0]["erosion"] == {"erode": 1.05}
+    assert imp.deck["mesh"][0]["erosion"] == {"to": "nothing"}
+    (tmp_path / "d.k").write_text(HEX + "*MAT_ADD_EROSION\n1,0.0,1.0e9\n*END\n")
+    imp = import_deck(tmp_path / "d.k", "m-s-kg")
+    assert ["MXPRES" in d.line() for d in imp.dropped] == [True]
+    assert "erosion" not in imp.deck["mesh"][0]
+    (tmp_path / "f.k").write_text(HEX + "*DEFINE_ADAPTIVE_SOLID_TO_SPH\n1,0,1,3,1,1,1\n"
+                                  "*END\n")
+    imp = import_deck(tmp_path / "f.k", "m-s-kg")
+    assert ["without an erosion rule" in d.line() for d in imp.dropped] == [True]

@@ -144,6 +144,8 @@ class Converter:
         self.yield_curves: list[tuple[int, int, Keyword]] = []  # MID, LCSS
         self.eos: dict[int, tuple[str, dict, Keyword]] = {}  # EOSID -> kind, keys
         self.detonations: list[tuple] = []  # PID, point, time [s], keyword
+        self.erosion_rules: dict[int, dict] = {}  # MID -> [material.erosion]
+        self.adaptive: list[tuple[int, int, int, Keyword]] = []  # IPID, ITYPE, per
         self.body_loads: list[tuple[int, int, float, Keyword]] = []  # axis, LCID, SF
         # NSID (or a list of nodes), axis, "velocity" or "displacement", LCID, SF,
         # (birth, death) [s], keyword
@@ -360,6 +362,46 @@ class Converter:
                 continue
             m.update(self.eos[eosid][1])
 
+    def mat_add_erosion(self, kw):
+        """``*MAT_ADD_EROSION``: MXEPS and EFFEPS as the principal and effective
+        strain rules of material MID's [material.erosion] (a value of 0 or EXCL
+        is no rule); the other criteria are listed."""
+        o = kw.obj
+        excl = _num(o.excl)
+
+        def rule(field_):
+            v = _num(getattr(o, field_))
+            return None if v in (0.0, excl) else v
+
+        rules = {key: v for field_, key in (("mxeps", "principal_strain"),
+                                             ("effeps", "effective_strain"))
+                 if (v := rule(field_)) is not None}
+        others = [f.upper() for f in ("mxpres", "mneps", "voleps", "mnpres", "sigp1",
+                                      "sigvm", "epssh", "sigth", "impulse", "failtm",
+                                      "dtmin") if rule(f) is not None]
+        if others:
+            self.drop(kw, f"{', '.join(others)} (failure criteria)", "not used: sphdyn's "
+                      "rules are the principal and effective strain, MAT_159's ERODE and "
+                      "a minimum time step")
+        self.erosion_rules.setdefault(int(o.mid), {}).update(rules)
+
+    def define_adaptive_solid_to_sph(self, kw):
+        """``*DEFINE_ADAPTIVE_SOLID_TO_SPH``: the eroded elements of part (set)
+        IPID become particles (NQ 1: one, 2: eight per element) coupled to the
+        rest (ICPL 1) from their failure (IOPT 1): ``[mesh.erosion] to =
+        "particles"``."""
+        o = kw.obj
+        nq = _int(o.nq, 1)
+        if nq not in (1, 2):
+            self.drop(kw, f"NQ = {nq}", "eight particles per element (NQ = 2)")
+        if _int(o.icpl, 1) != 1:
+            self.drop(kw, f"ICPL = {_int(o.icpl)} (debris not coupled)", "the particles "
+                      "meet the elements by penalty (ICPL = 1)")
+        if _int(o.iopt, 1) != 1:
+            self.drop(kw, "IOPT = 0 (particles in the elements from the start)",
+                      "particles made when an element erodes (IOPT = 1)")
+        self.adaptive.append((_int(o.ipid), _int(o.itype), 8 if nq >= 2 else 1, kw))
+
     def initial_detonation(self, kw):
         """``*INITIAL_DETONATION``: a [[detonation]] at X, Y, Z, lit at LT, of
         part PID's explosive (0: every explosive)."""
@@ -420,6 +462,8 @@ class Converter:
         erode = _num(o.erode)
         if erode >= 1.0:
             m["erode"], m["erode_strain"] = True, float(f"{erode - 1.0:.12g}")
+            if erode > 1.0:  # its elements erode by the same rule
+                self.erosion_rules.setdefault(int(o.mid), {})["erode"] = erode
         if _num(o.recov):
             m["recovery"] = _num(o.recov)
         if _int(o.itretrc):
@@ -599,6 +643,9 @@ class Converter:
                 raise KeywordError(f"{kw.block.where()}: LCSS {lcid}: {curve}")
             self._yield_line(kw, mid, *curve)
         self._with_eos(self._pids())
+        for mid, rules in self.erosion_rules.items():
+            if mid in self.materials and rules:
+                self.materials[mid]["erosion"] = dict(rules)
         out.deck["material"] = [dict(self.materials[m]) for m in used]
         for pid, point, lt, kw in self.detonations:
             d = {"point": point, "time": _q(lt, "s")}
@@ -865,6 +912,36 @@ class Converter:
             table = table or {"friction": fs}
         return table
 
+    def _erosion(self, solid_pids: list[int]) -> dict | None:
+        """[mesh.erosion] when a solid part's material has erosion rules:
+        LS-DYNA deletes eroded elements (``to = "nothing"``), or with
+        *DEFINE_ADAPTIVE_SOLID_TO_SPH on every solid part turns them into
+        particles (the solids are one mesh: adaptivity on some parts only
+        is listed)."""
+        eroding = [p for p in solid_pids if self.parts[p]["mid"] in self.erosion_rules
+                   and self.erosion_rules[self.parts[p]["mid"]]]
+        table = None
+        for ipid, itype, per, kw in self.adaptive:
+            if itype:
+                if ipid not in self.part_sets:
+                    raise KeywordError(f"{kw.block.where()}: part set {ipid}, which no "
+                                       "*SET_PART_LIST defines")
+                pids = set(self.part_sets[ipid])
+            else:
+                pids = {ipid}
+            if not set(solid_pids) <= pids:
+                self.drop(kw, "adaptivity on some of the solid parts", "on none (the "
+                          "solids are one mesh; name every solid part)")
+            else:
+                table = {"to": "particles", "particles_per_element": per}
+        if table is not None and not eroding:
+            self.drop(self.adaptive[0][-1], "adaptivity without an erosion rule on the "
+                      "solids' materials", "no element erodes")
+            return None
+        if eroding:
+            return table or {"to": "nothing"}
+        return None
+
     def _meshes(self, out: Imported) -> None:
         if not self.solids:
             for *_, kw in self.contacts:
@@ -934,6 +1011,9 @@ class Converter:
         contact = self._contact(pids)
         if contact is not None:
             mesh["contact"] = contact
+        erosion = self._erosion(pids)
+        if erosion is not None:
+            mesh["erosion"] = erosion
         vs = {self._velocity(pid) for pid in pids}
         if len(vs) > 1:
             self.drop(self.parts[pids[0]]["kw"], "different initial velocities of the "
@@ -969,6 +1049,9 @@ HANDLED = {
     "EOS_JWL": Converter.eos_jwl,
     "EOS_LINEAR_POLYNOMIAL": Converter.eos_linear_polynomial,
     "INITIAL_DETONATION": Converter.initial_detonation,
+    "MAT_ADD_EROSION": Converter.mat_add_erosion,
+    "DEFINE_ADAPTIVE_SOLID_TO_SPH": Converter.define_adaptive_solid_to_sph,
+    "DEFINE_ADAPTIVE_SOLID_TO_SPH_ID": Converter.define_adaptive_solid_to_sph,
     "MAT_CSCM": Converter.mat_cscm,
     "MAT_159": Converter.mat_cscm,
     "SET_NODE_LIST": Converter.set_node_list,

@@ -45,6 +45,20 @@ OWN = ("ELEMENT_SPH", "ELEMENT_SOLID", "SET_NODE_LIST", "SET_NODE_LIST_TITLE",
        "SET_PART_LIST", "SET_PART_LIST_TITLE")
 
 
+#: Keywords whose first card (an ID and heading) exists only with the ``_ID``
+#: option, but which ansys-dyna-core 0.12.1 reads always: it took a plain
+#: block's first data card for the ID card (found by this project's tests).
+#: A plain block is given to it with a blank first card.
+OPTION_ID = ("DEFINE_ADAPTIVE_SOLID_TO_SPH",)
+
+
+def _library_text(b: Block) -> str:
+    """A block's text as the library reads it (:data:`OPTION_ID`)."""
+    if b.name in OPTION_ID:
+        return "\n".join([b.title, ""] + [s for _, s in b.lines])
+    return b.text()
+
+
 def read_keyword_deck(path) -> KeywordDeck:
     """Read ``path`` and its includes. Raises :class:`KeywordError`."""
     try:
@@ -59,7 +73,7 @@ def read_keyword_deck(path) -> KeywordDeck:
     body = [b for b in blocks if f"*{b.name}" not in FRAME]
     given = [b for b in body if b.name not in OWN]
     text = "\n".join(["*KEYWORD LONG=Y" if long else "*KEYWORD"]
-                     + [b.text() for b in given] + ["*END"])
+                     + [_library_text(b) for b in given] + ["*END"])
     deck = Deck()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -72,7 +86,7 @@ def read_keyword_deck(path) -> KeywordDeck:
     starts, at = [], 2  # the line of each block in the text given to the library
     for b in given:
         starts.append(at)
-        at += 1 + len(b.lines)
+        at += 1 + len(b.lines) + (b.name in OPTION_ID)
     messages = [str(w.message) for w in caught]
     for b, obj, start in zip(given, objs, starts):
         if isinstance(obj, str):
