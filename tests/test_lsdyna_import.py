@@ -920,3 +920,16 @@ def test_cscm_erode_erodes_elements_and_other_criteria_are_listed(tmp_path):
                                   "*END\n")
     imp = import_deck(tmp_path / "f.k", "m-s-kg")
     assert ["without an erosion rule" in d.line() for d in imp.dropped] == [True]
+
+
+def test_curves_for_dynamic_relaxation(tmp_path):
+    """SIDR = 1 (a curve of the dynamic-relaxation initialisation only) gives
+    no motion; SIDR = 2 drives the run too, and its initialisation, which
+    sphdyn does not do, is listed."""
+    for sidr, boundaries, words in ((1, 1, "SIDR = 1"), (2, 2, "SIDR = 2")):
+        (tmp_path / "m.k").write_text(
+            HEX + "*BOUNDARY_PRESCRIBED_MOTION_SET\n1,3,0,9,-3.0\n"
+            f"*DEFINE_CURVE\n9,{sidr}\n0.0,2.0\n1.0,2.0\n*END\n")
+        imp = import_deck(tmp_path / "m.k", "m-s-kg")
+        assert len(imp.deck["boundary"]) == boundaries
+        assert [words in d.line() and d.physics for d in imp.dropped] == [True]

@@ -15,7 +15,6 @@ from .scan import KeywordError
 VAD = {0: "velocity", 2: "displacement"}
 
 
-
 class ConditionKeywords:
     """Readers of the load, condition and coupling keywords, and their
     resolution once every keyword is read; mixed into the converter."""
@@ -92,17 +91,22 @@ class ConditionKeywords:
 
     def define_curve(self, kw):
         """``*DEFINE_CURVE``: the points, abscissae times SFA and ordinates
-        times SFO; a curve with offsets (OFFA, OFFO) or a dynamic-relaxation
-        flag (SIDR) is kept as the reason it cannot be used."""
+        times SFO; a curve with offsets (OFFA, OFFO) or one for the stress
+        initialisation by dynamic relaxation only (SIDR = 1) is kept as the
+        reason it cannot be used; SIDR = 2 (that initialisation and the run)
+        is used for the run, its initialisation listed."""
         o = kw.obj
         lcid = int(o.lcid)
         if number(o.offa) or number(o.offo):
             self.curves[lcid] = f"curve {lcid} has OFFA / OFFO offsets ({kw.block.where()})"
             return
-        if integer(o.sidr):
-            self.curves[lcid] = (f"curve {lcid} is a dynamic-relaxation curve (SIDR = "
-                                 f"{integer(o.sidr)}; {kw.block.where()})")
+        if integer(o.sidr) == 1:
+            self.curves[lcid] = (f"curve {lcid} drives only the dynamic-relaxation "
+                                 f"initialisation (SIDR = 1; {kw.block.where()})")
             return
+        if integer(o.sidr) == 2:
+            self.drop(kw, f"curve {lcid}: SIDR = 2 (also a stress initialisation by "
+                      "dynamic relaxation)", "no initialisation: the run starts unloaded")
         pts = o.curves  # SFA, SFO: 0 means 1; in the deck's units
         a = np.asarray(pts.iloc[:, 0], float) * (number(o.sfa, 1.0) or 1.0)
         self.curves[lcid] = (a, np.asarray(pts.iloc[:, 1], float) * (number(o.sfo, 1.0) or 1.0))
