@@ -933,3 +933,16 @@ def test_curves_for_dynamic_relaxation(tmp_path):
         imp = import_deck(tmp_path / "m.k", "m-s-kg")
         assert len(imp.deck["boundary"]) == boundaries
         assert [words in d.line() and d.physics for d in imp.dropped] == [True]
+
+
+def test_body_loads_on_a_part_set(tmp_path):
+    """*LOAD_BODY_PARTS with a set holding every part changes nothing; a set
+    without the cube's part is listed (sphdyn's gravity acts on every part)."""
+    for parts, listed in (("1", []), ("7", ["set 5 only"])):
+        (tmp_path / "g.k").write_text(
+            HEX + "*LOAD_BODY_Z\n4,9.81\n*DEFINE_CURVE\n4\n0.0,1.0\n1.0,1.0\n"
+            f"*LOAD_BODY_PARTS\n5\n*SET_PART_LIST\n5\n{parts}\n*END\n")
+        imp = import_deck(tmp_path / "g.k", "m-s-kg")
+        assert imp.deck["run"]["gravity"][2] == "-9.81 m/s^2"
+        assert [any(w in d.line() for w in listed) and d.physics
+                for d in imp.dropped] == [True] * len(listed)

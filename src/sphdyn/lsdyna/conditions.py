@@ -165,6 +165,19 @@ class ConditionKeywords:
             g[axis] -= sf * value * self.u.length / self.u.time ** 2
         if g.any():
             self.run["gravity"] = [quantity(c, "m/s^2") for c in g]
+        for psid, kw in self.body_load_parts:
+            if psid not in self.part_sets:
+                raise KeywordError(f"{kw.block.where()}: part set {psid}, which no "
+                                   "*SET_PART_LIST defines")
+            if g.any() and not set(self._pids()) <= set(self.part_sets[psid]):
+                self.drop(kw, f"body loads on the parts of set {psid} only",
+                          "gravity on every part (sphdyn's [run] gravity)")
+
+    def load_body_parts(self, kw):
+        """``*LOAD_BODY_PARTS``: the body loads act on part set PSID only;
+        sphdyn's gravity acts on every part, so a set without some part is
+        listed."""
+        self.body_load_parts.append((integer(kw.obj.psid), kw))
 
     def boundary_prescribed_motion_set(self, kw):
         """``*BOUNDARY_PRESCRIBED_MOTION_SET``: a velocity (VAD = 0) or a

@@ -88,6 +88,7 @@ class Converter(MaterialKeywords, ConditionKeywords):
         self.erosion_rules: dict[int, dict] = {}  # MID -> [material.erosion]
         self.adaptive: list[tuple[int, int, int, Keyword]] = []  # IPID, ITYPE, per
         self.body_loads: list[tuple[int, int, float, Keyword]] = []  # axis, LCID, SF
+        self.body_load_parts: list[tuple[int, Keyword]] = []  # PSID
         # NSID (or a list of nodes), axis, "velocity" or "displacement", LCID, SF,
         # (birth, death) [s], keyword
         self.motions: list[tuple] = []
@@ -459,6 +460,7 @@ HANDLED = {
     "LOAD_BODY_X": Converter.load_body,
     "LOAD_BODY_Y": Converter.load_body,
     "LOAD_BODY_Z": Converter.load_body,
+    "LOAD_BODY_PARTS": Converter.load_body_parts,
     "BOUNDARY_PRESCRIBED_MOTION_SET": Converter.boundary_prescribed_motion_set,
     "BOUNDARY_PRESCRIBED_MOTION_NODE": Converter.boundary_prescribed_motion_node,
     "CONTACT_AUTOMATIC_NODES_TO_SURFACE": Converter.contact_automatic_nodes_to_surface,
