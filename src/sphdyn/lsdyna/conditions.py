@@ -45,6 +45,14 @@ class ConditionKeywords:
         nsid = integer(o.nsid)
         self.velocities.append(("node_set" if nsid else "all", nsid, v, kw))
 
+    def _part_set(self, sid: int, kw) -> set[int]:
+        """The parts of part set ``sid``, named by keyword ``kw``; an error if
+        no *SET_PART_LIST defines it."""
+        if sid not in self.part_sets:
+            raise KeywordError(f"{kw.block.where()}: part set {sid}, which no "
+                               "*SET_PART_LIST defines")
+        return set(self.part_sets[sid])
+
     def _part_nodes(self) -> dict[int, set[int]]:
         """The nodes (particles) of each part."""
         nodes: dict[int, set[int]] = {}
@@ -68,10 +76,7 @@ class ConditionKeywords:
             elif what == "part":
                 pids = [ident]
             elif what == "part_set":
-                if ident not in self.part_sets:
-                    raise KeywordError(f"{kw.block.where()}: part set {ident}, which no "
-                                       "*SET_PART_LIST defines")
-                pids = self.part_sets[ident]
+                pids = self._part_set(ident, kw)
             else:
                 if ident not in self.node_sets:
                     raise KeywordError(f"{kw.block.where()}: node set {ident}, which no "
@@ -166,10 +171,7 @@ class ConditionKeywords:
         if g.any():
             self.run["gravity"] = [quantity(c, "m/s^2") for c in g]
         for psid, kw in self.body_load_parts:
-            if psid not in self.part_sets:
-                raise KeywordError(f"{kw.block.where()}: part set {psid}, which no "
-                                   "*SET_PART_LIST defines")
-            if g.any() and not set(self._pids()) <= set(self.part_sets[psid]):
+            if not set(self._pids()) <= self._part_set(psid, kw) and g.any():
                 self.drop(kw, f"body loads on the parts of set {psid} only",
                           "gravity on every part (sphdyn's [run] gravity)")
 
@@ -251,10 +253,7 @@ class ConditionKeywords:
         if typ == 3:
             return {ident}
         if typ == 2:
-            if ident not in self.part_sets:
-                raise KeywordError(f"{kw.block.where()}: part set {ident}, which no "
-                                   "*SET_PART_LIST defines")
-            return set(self.part_sets[ident])
+            return self._part_set(ident, kw)
         if typ == 5:
             return set(self.parts)
         self.drop(kw, f"a contact side of type {typ}", "no contact from it (a part, "
@@ -310,13 +309,7 @@ class ConditionKeywords:
                    and self.erosion_rules[self.parts[p]["mid"]]]
         table = None
         for ipid, itype, per, kw in self.adaptive:
-            if itype:
-                if ipid not in self.part_sets:
-                    raise KeywordError(f"{kw.block.where()}: part set {ipid}, which no "
-                                       "*SET_PART_LIST defines")
-                pids = set(self.part_sets[ipid])
-            else:
-                pids = {ipid}
+            pids = self._part_set(ipid, kw) if itype else {ipid}
             if not set(solid_pids) <= pids:
                 self.drop(kw, "adaptivity on some of the solid parts", "on none (the "
                           "solids are one mesh; name every solid part)")
